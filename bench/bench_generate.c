@@ -1,0 +1,107 @@
+// Benchmark: the hawk preset (2 vanes x 2200 barbs x 30 samples) — generation,
+// export and a 2000 x 2000 PNG render. Prints medians over repeated runs.
+//
+// Usage: bench_generate [SPEC.json] [OUTPUT_DIR]   (defaults: the hawk preset, /tmp)
+#define _POSIX_C_SOURCE 200809L
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <time.h>
+
+#include "plume/plume.h"
+
+static double now(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int compare(const void *a, const void *b)
+{
+	double x = *(const double *)a, y = *(const double *)b;
+	return (x > y) - (x < y);
+}
+
+static double median(double *values, int count)
+{
+	qsort(values, (size_t)count, sizeof *values, compare);
+	return count % 2 ? values[count / 2] : 0.5 * (values[count / 2 - 1] + values[count / 2]);
+}
+
+static void check(plume_status status, const plume_error *err)
+{
+	if (status != PLUME_OK) {
+		fprintf(stderr, "bench_generate: %s\n", err->message);
+		exit(1);
+	}
+}
+
+int main(int argc, char **argv)
+{
+	const char *spec = argc > 1 ? argv[1] : PLUME_SOURCE_DIR "/examples/franco-walter/hawk.json";
+	const char *dir = argc > 2 ? argv[2] : "/tmp";
+	plume_error err = {0};
+	plume_fw_def def;
+	uint64_t seed;
+	check(plume_fw_def_read(spec, &def, &seed, &err), &err);
+
+	enum { GENERATE_RUNS = 41, EXPORT_RUNS = 5, RENDER_RUNS = 3 };
+	double times[GENERATE_RUNS];
+	plume_feather *feather = NULL;
+	for (int i = 0; i < GENERATE_RUNS; ++i) {
+		plume_feather_destroy(feather);
+		double start = now();
+		check(plume_fw_generate(&def, seed, &feather, &err), &err);
+		times[i] = now() - start;
+	}
+	plume_feather_info info = plume_feather_get_info(feather);
+	printf("feather: %s\n", spec);
+	printf("  barbs %d (%d per vane), points %d, shaft samples %d, memory %.1f MiB\n", info.barb_count,
+		   info.barb_count_left, info.point_count, info.shaft_sample_count, plume_bytes_in_use() / 1048576.0);
+	printf("generate            median %8.3f ms   (min %.3f ms, %d runs, one thread)\n", 1e3 * median(times, GENERATE_RUNS),
+		   1e3 * times[0], GENERATE_RUNS);
+
+	static const char *const names[] = {"obj", "usda", "json"};
+	for (int format = 0; format < 3; ++format) {
+		char path[4096];
+		snprintf(path, sizeof path, "%s/bench-feather.%s", dir, names[format]);
+		for (int i = 0; i < EXPORT_RUNS; ++i) {
+			double start = now();
+			plume_status status = format == 0 ? plume_write_obj(feather, path, &err)
+								  : format == 1 ? plume_write_usda(feather, path, &err)
+												: plume_write_json(feather, path, &err);
+			check(status, &err);
+			times[i] = now() - start;
+		}
+		FILE *file = fopen(path, "rb");
+		long size = 0;
+		if (file != NULL) {
+			fseek(file, 0, SEEK_END);
+			size = ftell(file);
+			fclose(file);
+		}
+		printf("export %-4s         median %8.1f ms   (%.1f MiB, %d runs)\n", names[format],
+			   1e3 * median(times, EXPORT_RUNS), size / 1048576.0, EXPORT_RUNS);
+		remove(path);
+	}
+
+	plume_render2d_def render = plume_render2d_default_def();
+	render.width = render.height = 2000;
+	char path[4096];
+	snprintf(path, sizeof path, "%s/bench-feather.png", dir);
+	for (int i = 0; i < RENDER_RUNS; ++i) {
+		double start = now();
+		check(plume_render2d(feather, &render, PLUME_IMAGE_PNG, path, &err), &err);
+		times[i] = now() - start;
+	}
+	printf("render PNG 2000x2000 median %8.1f ms   (%d runs)\n", 1e3 * median(times, RENDER_RUNS), RENDER_RUNS);
+	remove(path);
+
+	plume_feather_destroy(feather);
+	struct rusage usage;
+	getrusage(RUSAGE_SELF, &usage);
+	printf("peak resident memory %.1f MiB\n", usage.ru_maxrss / 1024.0);
+	return 0;
+}

@@ -1,0 +1,81 @@
+// The plume command: shared pieces of the subcommands.
+#ifndef PLUME_CLI_H
+#define PLUME_CLI_H
+
+#include <stdbool.h>
+
+#include "plume/plume.h"
+
+/// Exit codes (docs/cli.md).
+enum {
+	CLI_EXIT_OK = 0,
+	CLI_EXIT_FAILURE = 1, ///< a computation failed
+	CLI_EXIT_USAGE = 2,   ///< bad command line
+	CLI_EXIT_INPUT = 3,   ///< a spec or input file is malformed or has a bad value
+	CLI_EXIT_IO = 4,      ///< a file could not be read or written
+};
+
+/// Output formats, as a bit set.
+enum {
+	CLI_FORMAT_PNG = 1u << 0,
+	CLI_FORMAT_SVG = 1u << 1,
+	CLI_FORMAT_PDF = 1u << 2,
+	CLI_FORMAT_OBJ = 1u << 3,
+	CLI_FORMAT_USDA = 1u << 4,
+	CLI_FORMAT_JSON = 1u << 5,
+	CLI_FORMAT_ALL = (1u << 6) - 1,
+};
+
+/// Prints "plume: message" on stderr and returns the exit code for the status.
+int cli_fail(const plume_error *err);
+
+/// Prints "plume: <command>: message" and a hint to the command's help; returns CLI_EXIT_USAGE.
+int cli_usage_error(const char *command, const char *format, ...)
+#if defined(__GNUC__)
+	__attribute__((format(printf, 2, 3)))
+#endif
+	;
+
+/// Parses "png,svg,obj"; false (and a usage message) on an unknown name.
+bool cli_parse_formats(const char *command, const char *list, unsigned *formats);
+
+/// Parses "WxH" with both in [16, 16384].
+bool cli_parse_size(const char *command, const char *text, int *width, int *height);
+
+/// Parses a decimal seed.
+bool cli_parse_seed(const char *command, const char *text, uint64_t *seed);
+
+/// How a feather's images are drawn.
+typedef struct cli_image_options {
+	int width, height;              ///< 0: height 1200 and the width from the feather's aspect
+	const plume_texture *texture;   ///< NULL: the line style
+} cli_image_options;
+
+// A set of output files written all together or not at all: files go to a
+// staging folder beside or inside the destination and are moved in place only
+// when every one of them was written.
+typedef struct cli_output {
+	char dir[2048];
+	char stage[4160];
+	bool dir_existed;
+	char names[32][80];
+	int name_count;
+} cli_output;
+
+plume_status cli_output_begin(cli_output *output, const char *dir, plume_error *err);
+/// Path of a new file in the staging folder; remembers the name for commit.
+const char *cli_output_path(cli_output *output, const char *name, char *buffer, size_t size);
+plume_status cli_output_commit(cli_output *output, plume_error *err);
+void cli_output_abort(cli_output *output);
+
+/// Writes <stem>.<ext> for every format in the set into the staging folder.
+plume_status cli_write_feather(cli_output *output, const plume_feather *feather, const char *stem, unsigned formats,
+							   const cli_image_options *images, plume_error *err);
+
+int cli_generate(int argc, char **argv);
+int cli_demo(int argc, char **argv);
+
+void cli_help_generate(void);
+void cli_help_demo(void);
+
+#endif

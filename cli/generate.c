@@ -1,0 +1,93 @@
+// plume generate SPEC.json -o DIR [--seed N] [--format LIST] [--size WxH] [--texture IMAGE]
+#define _POSIX_C_SOURCE 200809L
+#include <getopt.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "cli.h"
+
+void cli_help_generate(void)
+{
+	puts("Usage: plume generate SPEC.json -o DIR [options]\n"
+		 "\n"
+		 "Generates the feather that SPEC.json describes and writes DIR/feather.<ext>\n"
+		 "for each format. All files appear together, or none when anything fails.\n"
+		 "\n"
+		 "Options:\n"
+		 "  -o, --output DIR       output folder (created if missing)\n"
+		 "  -s, --seed N           random seed; overrides the spec's \"seed\" (default 1)\n"
+		 "  -f, --format LIST      comma-separated: png,svg,pdf,obj,usda,json (default: all)\n"
+		 "      --size WxH         image size in pixels (default: 1200 tall, width to fit)\n"
+		 "  -t, --texture IMAGE    colour the barbs from IMAGE (Franco & Walter 4.4) instead\n"
+		 "                         of the line style\n"
+		 "  -h, --help             this help\n"
+		 "\n"
+		 "Specs are described in docs/spec-franco-walter.md; examples/ has ready ones.");
+}
+
+int cli_generate(int argc, char **argv)
+{
+	static const struct option options[] = {
+		{"output", required_argument, NULL, 'o'}, {"seed", required_argument, NULL, 's'},
+		{"format", required_argument, NULL, 'f'}, {"size", required_argument, NULL, 'S'},
+		{"texture", required_argument, NULL, 't'}, {"help", no_argument, NULL, 'h'},
+		{NULL, 0, NULL, 0},
+	};
+	const char *output_dir = NULL, *texture_path = NULL;
+	unsigned formats = CLI_FORMAT_ALL;
+	plume_spec_options spec_options = {.seed = 0, .seed_given = false};
+	cli_image_options images = {0, 0, NULL};
+	int option;
+	optind = 1;
+	opterr = 0;
+	while ((option = getopt_long(argc, argv, ":o:s:f:t:h", options, NULL)) != -1) {
+		switch (option) {
+		case 'o': output_dir = optarg; break;
+		case 's':
+			if (!cli_parse_seed("generate", optarg, &spec_options.seed))
+				return CLI_EXIT_USAGE;
+			spec_options.seed_given = true;
+			break;
+		case 'f':
+			if (!cli_parse_formats("generate", optarg, &formats))
+				return CLI_EXIT_USAGE;
+			break;
+		case 'S':
+			if (!cli_parse_size("generate", optarg, &images.width, &images.height))
+				return CLI_EXIT_USAGE;
+			break;
+		case 't': texture_path = optarg; break;
+		case 'h': cli_help_generate(); return CLI_EXIT_OK;
+		case ':': return cli_usage_error("generate", "option '%s' needs a value", argv[optind - 1]);
+		default: return cli_usage_error("generate", "unknown option '%s'", argv[optind - 1]);
+		}
+	}
+	if (optind >= argc)
+		return cli_usage_error("generate", "missing SPEC.json");
+	if (optind + 1 < argc)
+		return cli_usage_error("generate", "unexpected argument '%s'", argv[optind + 1]);
+	if (output_dir == NULL)
+		return cli_usage_error("generate", "missing -o DIR");
+
+	plume_error err = {0};
+	plume_texture *texture = NULL;
+	if (texture_path != NULL && plume_texture_load(texture_path, &texture, &err) != PLUME_OK)
+		return cli_fail(&err);
+	images.texture = texture;
+
+	plume_feather *feather = NULL;
+	cli_output output;
+	plume_status status = plume_spec_generate(argv[optind], &spec_options, &feather, &err);
+	if (status == PLUME_OK && (status = cli_output_begin(&output, output_dir, &err)) == PLUME_OK) {
+		status = cli_write_feather(&output, feather, "feather", formats, &images, &err);
+		if (status == PLUME_OK)
+			status = cli_output_commit(&output, &err);
+		else
+			cli_output_abort(&output);
+	}
+	plume_feather_destroy(feather);
+	plume_texture_destroy(texture);
+	if (status != PLUME_OK)
+		return cli_fail(&err);
+	return CLI_EXIT_OK;
+}

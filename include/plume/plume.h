@@ -1,0 +1,11 @@
+// plume — feathers: generation, simulation, rendering. Include this one header.
+#ifndef PLUME_H
+#define PLUME_H
+
+#include "plume/core.h"
+#include "plume/feather.h"
+#include "plume/io.h"
+#include "plume/model.h"
+#include "plume/render.h"
+
+#endif // PLUME_H

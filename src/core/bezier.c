@@ -1,0 +1,255 @@
+// Bézier curves of any degree: evaluation, derivatives, elevation, splitting,
+// arc length and arc-length sampling.
+//
+// Arc length integrates the speed |B'(t)| with an 8-point Gauss–Legendre rule,
+// refined adaptively. Sampling by arc length first tabulates the cumulative
+// length over a fixed partition, then solves each target length by Newton's
+// method inside its interval (safeguarded by bisection), so a table of n
+// samples costs O(n) quadratures instead of O(n) full-length integrals.
+#include <assert.h>
+#include <math.h>
+#include <string.h>
+
+#include "plume/core.h"
+
+plume_vec3 plume_bezier_eval(const plume_vec3 *points, int count, double t)
+{
+	assert(count >= 1 && count <= PLUME_BEZIER_MAX_POINTS);
+	if (count == 4) {
+		// The cubic is every barb's curve: Bernstein form without the triangle.
+		double s = 1.0 - t;
+		double b0 = s * s * s, b1 = 3.0 * s * s * t, b2 = 3.0 * s * t * t, b3 = t * t * t;
+		return (plume_vec3){b0 * points[0].x + b1 * points[1].x + b2 * points[2].x + b3 * points[3].x,
+							b0 * points[0].y + b1 * points[1].y + b2 * points[2].y + b3 * points[3].y,
+							b0 * points[0].z + b1 * points[1].z + b2 * points[2].z + b3 * points[3].z};
+	}
+	plume_vec3 work[PLUME_BEZIER_MAX_POINTS];
+	memcpy(work, points, (size_t)count * sizeof *points);
+	for (int level = count - 1; level > 0; --level)
+		for (int i = 0; i < level; ++i)
+			work[i] = plume_v3_lerp(work[i], work[i + 1], t);
+	return work[0];
+}
+
+void plume_bezier_hodograph(const plume_vec3 *points, int count, plume_vec3 *out)
+{
+	assert(count >= 2);
+	double degree = (double)(count - 1);
+	for (int i = 0; i + 1 < count; ++i)
+		out[i] = plume_v3_scale(plume_v3_sub(points[i + 1], points[i]), degree);
+}
+
+plume_vec3 plume_bezier_derivative(const plume_vec3 *points, int count, int order, double t)
+{
+	assert(count >= 1 && count <= PLUME_BEZIER_MAX_POINTS && order >= 0);
+	if (order >= count)
+		return plume_v3(0.0, 0.0, 0.0);
+	plume_vec3 work[PLUME_BEZIER_MAX_POINTS];
+	memcpy(work, points, (size_t)count * sizeof *points);
+	for (int k = 0; k < order; ++k) {
+		plume_bezier_hodograph(work, count, work); // in place: reads i + 1 before writing i
+		--count;
+	}
+	return plume_bezier_eval(work, count, t);
+}
+
+void plume_bezier_elevate(const plume_vec3 *points, int count, plume_vec3 *out)
+{
+	// q_0 = p_0, q_{n+1} = p_n, q_i = (i / (n+1)) p_{i-1} + (1 - i / (n+1)) p_i.
+	int n = count - 1;
+	plume_vec3 last = points[n];
+	plume_vec3 previous = points[0];
+	out[0] = points[0];
+	for (int i = 1; i <= n; ++i) {
+		plume_vec3 current = points[i];
+		double a = (double)i / (double)(n + 1);
+		out[i] = plume_v3_add(plume_v3_scale(previous, a), plume_v3_scale(current, 1.0 - a));
+		previous = current;
+	}
+	out[n + 1] = last;
+}
+
+void plume_bezier_split(const plume_vec3 *points, int count, double t, plume_vec3 *left, plume_vec3 *right)
+{
+	assert(count >= 1 && count <= PLUME_BEZIER_MAX_POINTS);
+	plume_vec3 work[PLUME_BEZIER_MAX_POINTS];
+	memcpy(work, points, (size_t)count * sizeof *points);
+	for (int level = count - 1; level >= 0; --level) {
+		left[count - 1 - level] = work[0];
+		right[level] = work[level];
+		for (int i = 0; i < level; ++i)
+			work[i] = plume_v3_lerp(work[i], work[i + 1], t);
+	}
+}
+
+// ---------------------------------------------------------------------------
+// Arc length
+
+static const double gl8_nodes[4] = {0.1834346424956498, 0.5255324099163290, 0.7966664774136267,
+									0.9602898564975363};
+static const double gl8_weights[4] = {0.3626837833783620, 0.3137066458778873, 0.2223810344533745,
+									  0.1012285362903763};
+
+// The speed |B'(t)| is the length of the hodograph, evaluated by de Casteljau.
+static double speed_at(const plume_vec3 *hodograph, int count, double t)
+{
+	return plume_v3_length(plume_bezier_eval(hodograph, count, t));
+}
+
+static double gauss8(const plume_vec3 *hodograph, int count, double a, double b)
+{
+	double mid = 0.5 * (a + b), half = 0.5 * (b - a), sum = 0.0;
+	for (int i = 0; i < 4; ++i)
+		sum += gl8_weights[i] * (speed_at(hodograph, count, mid - half * gl8_nodes[i]) +
+								 speed_at(hodograph, count, mid + half * gl8_nodes[i]));
+	return sum * half;
+}
+
+static double adaptive_length(const plume_vec3 *hodograph, int count, double a, double b, double whole,
+							  double tolerance, int depth)
+{
+	double mid = 0.5 * (a + b);
+	double left = gauss8(hodograph, count, a, mid), right = gauss8(hodograph, count, mid, b);
+	if (depth >= 30 || fabs(left + right - whole) <= tolerance)
+		return left + right;
+	return adaptive_length(hodograph, count, a, mid, left, 0.5 * tolerance, depth + 1) +
+		   adaptive_length(hodograph, count, mid, b, right, 0.5 * tolerance, depth + 1);
+}
+
+/// Writes the hodograph (a single zero point for a point curve); returns its count.
+static int hodograph_of(const plume_vec3 *points, int count, plume_vec3 *hodograph)
+{
+	assert(count >= 1 && count <= PLUME_BEZIER_MAX_POINTS);
+	if (count == 1) {
+		hodograph[0] = plume_v3(0.0, 0.0, 0.0);
+		return 1;
+	}
+	plume_bezier_hodograph(points, count, hodograph);
+	return count - 1;
+}
+
+static double control_polygon_length(const plume_vec3 *points, int count)
+{
+	double length = 0.0;
+	for (int i = 0; i + 1 < count; ++i)
+		length += plume_v3_distance(points[i], points[i + 1]);
+	return length;
+}
+
+static double curve_length(const plume_vec3 *hodograph, int count, double scale, double t0, double t1)
+{
+	// The control polygon bounds the length from above: it sets the absolute tolerance.
+	double tolerance = 1e-13 * (scale > 0.0 ? scale : 1.0);
+	return adaptive_length(hodograph, count, t0, t1, gauss8(hodograph, count, t0, t1), tolerance, 0);
+}
+
+double plume_bezier_length(const plume_vec3 *points, int count, double t0, double t1)
+{
+	plume_vec3 hodograph[PLUME_BEZIER_MAX_POINTS];
+	int hodograph_count = hodograph_of(points, count, hodograph);
+	return curve_length(hodograph, hodograph_count, control_polygon_length(points, count), t0, t1);
+}
+
+void plume_bezier_arc_init(plume_bezier_arc *arc, const plume_vec3 *points, int count)
+{
+	arc->hodograph_count = hodograph_of(points, count, arc->hodograph);
+	int intervals = 4 * count;
+	arc->intervals = intervals < 16 ? 16 : intervals;
+	double scale = control_polygon_length(points, count);
+	arc->cumulative[0] = 0.0;
+	for (int j = 0; j < arc->intervals; ++j) {
+		double a = (double)j / arc->intervals, b = (double)(j + 1) / arc->intervals;
+		arc->cumulative[j + 1] = arc->cumulative[j] + curve_length(arc->hodograph, arc->hodograph_count, scale, a, b);
+	}
+	arc->length = arc->cumulative[arc->intervals];
+}
+
+double plume_bezier_arc_param(const plume_bezier_arc *arc, double fraction)
+{
+	double total = arc->length;
+	if (total <= 0.0) // a point: any parameter is as good; keep them spread
+		return fraction <= 0.0 ? 0.0 : (fraction >= 1.0 ? 1.0 : fraction);
+	double target = fraction * total;
+	if (target <= 0.0)
+		return 0.0;
+	if (target >= total)
+		return 1.0;
+	int lo = 0, hi = arc->intervals;
+	while (hi - lo > 1) {
+		int mid = (lo + hi) / 2;
+		if (arc->cumulative[mid] <= target)
+			lo = mid;
+		else
+			hi = mid;
+	}
+	double a = (double)lo / arc->intervals, b = (double)(lo + 1) / arc->intervals;
+	double base = arc->cumulative[lo], span = arc->cumulative[lo + 1] - base;
+	double t = span > 0.0 ? a + (b - a) * (target - base) / span : a;
+	// Newton on f(t) = length(a, t) - (target - base), kept inside a shrinking bracket.
+	double lower = a, upper = b;
+	for (int iteration = 0; iteration < 60; ++iteration) {
+		double f = gauss8(arc->hodograph, arc->hodograph_count, a, t) - (target - base);
+		if (f > 0.0)
+			upper = t;
+		else
+			lower = t;
+		double speed = speed_at(arc->hodograph, arc->hodograph_count, t);
+		double next = speed > 0.0 ? t - f / speed : 0.5 * (lower + upper);
+		if (!(next > lower && next < upper))
+			next = 0.5 * (lower + upper);
+		if (fabs(next - t) <= 1e-15)
+			return next;
+		t = next;
+	}
+	return t;
+}
+
+double plume_bezier_param_at_length(const plume_vec3 *points, int count, double fraction)
+{
+	plume_bezier_arc arc;
+	plume_bezier_arc_init(&arc, points, count);
+	return plume_bezier_arc_param(&arc, fraction);
+}
+
+void plume_bezier_sample_by_length(const plume_vec3 *points, int count, int sample_count, double *params_out)
+{
+	assert(sample_count >= 2);
+	plume_bezier_arc arc;
+	plume_bezier_arc_init(&arc, points, count);
+	params_out[0] = 0.0;
+	for (int k = 1; k + 1 < sample_count; ++k)
+		params_out[k] = plume_bezier_arc_param(&arc, (double)k / (sample_count - 1));
+	params_out[sample_count - 1] = 1.0;
+}
+
+double plume_bezier_closest_param(const plume_vec3 *points, int count, plume_vec3 p)
+{
+	enum { SEARCH = 64 };
+	double best_t = 0.0, best = INFINITY;
+	for (int i = 0; i <= SEARCH; ++i) {
+		double t = (double)i / SEARCH;
+		double distance = plume_v3_distance(plume_bezier_eval(points, count, t), p);
+		if (distance < best) {
+			best = distance;
+			best_t = t;
+		}
+	}
+	double t = best_t;
+	for (int iteration = 0; iteration < 30; ++iteration) {
+		plume_vec3 offset = plume_v3_sub(plume_bezier_eval(points, count, t), p);
+		plume_vec3 d1 = plume_bezier_derivative(points, count, 1, t);
+		plume_vec3 d2 = plume_bezier_derivative(points, count, 2, t);
+		double f = plume_v3_dot(offset, d1), df = plume_v3_dot(d1, d1) + plume_v3_dot(offset, d2);
+		if (!(df > 0.0))
+			break;
+		double next = t - f / df;
+		next = next < 0.0 ? 0.0 : (next > 1.0 ? 1.0 : next);
+		if (fabs(next - t) < 1e-16)
+			break;
+		t = next;
+	}
+	// Newton may wander to a worse local minimum; keep the better of the two.
+	if (plume_v3_distance(plume_bezier_eval(points, count, t), p) > best)
+		t = best_t;
+	return t;
+}

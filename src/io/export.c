@@ -1,0 +1,80 @@
+// What the geometry exporters share: buffered atomic text files in the "C"
+// numeric locale, and the curves that make up one exported object.
+#define _POSIX_C_SOURCE 200809L
+#include "export.h"
+
+#include "../core/alloc.h"
+#include "../model/feather_internal.h"
+
+// Big enough that stdio writes in large blocks (the default is 4 KiB), small
+// enough not to matter next to the feather being written.
+enum { TEXT_BUFFER_SIZE = 1 << 20 };
+
+plume_status plume_text_open(plume_text_file *text, const char *path, plume_error *err)
+{
+	text->stream = NULL;
+	text->buffer = NULL;
+	text->c_locale = newlocale(LC_NUMERIC_MASK, "C", (locale_t)0);
+	if (text->c_locale == (locale_t)0)
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "%s: out of memory", path);
+	plume_status status = plume_atomic_open(&text->file, path, err);
+	if (status != PLUME_OK) {
+		freelocale(text->c_locale);
+		return status;
+	}
+	text->stream = text->file.stream;
+	// Without the buffer stdio still works, only with smaller writes.
+	text->buffer = plume_alloc(TEXT_BUFFER_SIZE);
+	if (text->buffer != NULL)
+		setvbuf(text->stream, text->buffer, _IOFBF, TEXT_BUFFER_SIZE);
+	text->saved_locale = uselocale(text->c_locale);
+	return PLUME_OK;
+}
+
+plume_status plume_text_close(plume_text_file *text, plume_status status, plume_error *err)
+{
+	uselocale(text->saved_locale);
+	freelocale(text->c_locale);
+	// The stream is closed (in commit or abort) before its buffer is freed.
+	if (status == PLUME_OK)
+		status = plume_atomic_commit(&text->file, err);
+	else
+		plume_atomic_abort(&text->file);
+	plume_free(text->buffer);
+	text->buffer = NULL;
+	text->stream = NULL;
+	return status;
+}
+
+int plume_curve_set_range(const plume_feather *feather, plume_curve_set set)
+{
+	return set == PLUME_CURVES_BARBULES ? feather->barbule_count : feather->barb_count;
+}
+
+bool plume_curve_set_get(const plume_feather *feather, plume_curve_set set, int i, plume_polyline *curve)
+{
+	if (set == PLUME_CURVES_BARBULES) {
+		*curve = plume_feather_barbule(feather, i).curve;
+	} else {
+		plume_barb barb = plume_feather_barb(feather, i);
+		if ((set == PLUME_CURVES_LEFT && barb.side != PLUME_SIDE_LEFT) ||
+			(set == PLUME_CURVES_RIGHT && barb.side != PLUME_SIDE_RIGHT))
+			return false;
+		*curve = barb.curve;
+	}
+	return curve->count >= 2;
+}
+
+void plume_curve_set_count(const plume_feather *feather, plume_curve_set set, int *curves, int64_t *points)
+{
+	*curves = 0;
+	*points = 0;
+	int range = plume_curve_set_range(feather, set);
+	plume_polyline curve;
+	for (int i = 0; i < range; ++i) {
+		if (plume_curve_set_get(feather, set, i, &curve)) {
+			++*curves;
+			*points += curve.count;
+		}
+	}
+}

@@ -1,0 +1,604 @@
+// JSON dump of a whole feather and its reader (schema: docs/feather-json.md).
+//
+// The writer prints the document's skeleton itself and lets jansson encode
+// one shaft, barb or number at a time, so that a 132 000-point feather never
+// sits in memory twice and the file has one barb per line (readable, and
+// friendly to diff). Doubles are printed with 17 significant digits
+// (JSON_REAL_PRECISION(17)), which is enough for strtod to give back the same
+// double, bit for bit; jansson prints them independently of the locale.
+//
+// The reader loads the document with jansson (JSON_REJECT_DUPLICATES, line and
+// column on syntax errors) and rebuilds the feather with the builders of
+// feather_internal.h, checking every key and array length on the way, so that
+// bad input gives a message with its JSON path and never a crash.
+#define _POSIX_C_SOURCE 200809L
+#include "export.h"
+
+#include <errno.h>
+#include <limits.h>
+#include <math.h>
+#include <stdarg.h>
+#include <string.h>
+
+#include <jansson.h>
+
+#include "../model/feather_internal.h"
+#include "plume/io.h"
+
+// The number arrays are read and written through double pointers with a stride.
+_Static_assert(sizeof(plume_vec3) == 3 * sizeof(double), "plume_vec3 must be three packed doubles");
+_Static_assert(sizeof(plume_vec2) == 2 * sizeof(double), "plume_vec2 must be two packed doubles");
+
+#define FORMAT_NAME "plume-feather"
+#define FORMAT_VERSION 1
+
+static const char *const side_names[] = {"left", "right"};              // plume_side
+static const char *const kind_names[] = {"distal", "proximal"};         // plume_barbule_kind
+
+// ---------------------------------------------------------------------------
+// Writing
+
+enum { DUMP_FLAGS = JSON_COMPACT | JSON_REAL_PRECISION(17) | JSON_ENCODE_ANY };
+
+/// Collects failures while a JSON value is built, so that building code reads
+/// straight through; json_object_set_new takes (and on failure frees) NULL or
+/// not, so a failed piece never leaks.
+typedef struct builder {
+	bool failed;
+	bool non_finite; ///< JSON has no NaN or infinity
+} builder;
+
+/// count items of components doubles each, item i at base + i * stride.
+static json_t *numbers(builder *b, const void *base, size_t stride, int components, int count)
+{
+	json_t *array = json_array();
+	if (array == NULL) {
+		b->failed = true;
+		return NULL;
+	}
+	for (int i = 0; i < count; ++i) {
+		const double *item = (const double *)((const char *)base + (size_t)i * stride);
+		for (int c = 0; c < components; ++c) {
+			if (!isfinite(item[c]))
+				b->non_finite = true;
+			if (json_array_append_new(array, json_real(item[c])) != 0) {
+				b->failed = true;
+				json_decref(array);
+				return NULL;
+			}
+		}
+	}
+	return array;
+}
+
+static void set(builder *b, json_t *object, const char *key, json_t *value)
+{
+	if (json_object_set_new(object, key, value) != 0)
+		b->failed = true;
+}
+
+/// The per-point arrays every curve has.
+static void set_polyline(builder *b, json_t *object, plume_polyline curve)
+{
+	set(b, object, "position", numbers(b, curve.points, sizeof *curve.points, 3, curve.count));
+	set(b, object, "normal", numbers(b, curve.normals, sizeof *curve.normals, 3, curve.count));
+	set(b, object, "arc_length", numbers(b, curve.arc_length, sizeof *curve.arc_length, 1, curve.count));
+	set(b, object, "width", numbers(b, curve.widths, sizeof *curve.widths, 1, curve.count));
+	set(b, object, "uv", numbers(b, curve.uv, sizeof *curve.uv, 2, curve.count));
+}
+
+static json_t *shaft_json(builder *b, const plume_feather *feather)
+{
+	plume_feather_info info = plume_feather_get_info(feather);
+	const plume_shaft_sample *shaft = plume_feather_shaft(feather);
+	int count = info.shaft_sample_count;
+	size_t stride = sizeof *shaft;
+	json_t *object = json_object();
+	set(b, object, "calamus_samples", json_integer(info.calamus_sample_count));
+	// With no samples the base pointers are never read.
+	set(b, object, "position", numbers(b, count > 0 ? &shaft->position : NULL, stride, 3, count));
+	set(b, object, "tangent", numbers(b, count > 0 ? &shaft->tangent : NULL, stride, 3, count));
+	set(b, object, "normal", numbers(b, count > 0 ? &shaft->normal : NULL, stride, 3, count));
+	set(b, object, "binormal", numbers(b, count > 0 ? &shaft->binormal : NULL, stride, 3, count));
+	set(b, object, "width", numbers(b, count > 0 ? &shaft->width : NULL, stride, 1, count));
+	set(b, object, "t", numbers(b, count > 0 ? &shaft->t : NULL, stride, 1, count));
+	return object;
+}
+
+static json_t *barb_json(builder *b, const plume_feather *feather, int index)
+{
+	plume_barb barb = plume_feather_barb(feather, index);
+	json_t *object = json_object();
+	set(b, object, "side", json_string(side_names[barb.side]));
+	set(b, object, "rachis_t", json_real(barb.rachis_t));
+	set(b, object, "segment", json_integer(barb.segment));
+	b->non_finite |= !isfinite(barb.rachis_t);
+	set_polyline(b, object, barb.curve);
+	json_t *barbules = json_array();
+	for (int j = 0; j < barb.barbule_count; ++j) {
+		plume_barbule barbule = plume_feather_barbule(feather, barb.barbule_first + j);
+		json_t *item = json_object();
+		set(b, item, "barb_s", json_real(barbule.barb_s));
+		set(b, item, "kind", json_string(kind_names[barbule.kind]));
+		b->non_finite |= !isfinite(barbule.barb_s);
+		set_polyline(b, item, barbule.curve);
+		if (json_array_append_new(barbules, item) != 0)
+			b->failed = true;
+	}
+	set(b, object, "barbules", barbules);
+	return object;
+}
+
+static void pad(FILE *stream, int level)
+{
+	for (int i = 0; i < level; ++i)
+		fputs("  ", stream);
+}
+
+/// Encodes a value built by the functions above (and frees it).
+static plume_status dump(FILE *stream, json_t *value, builder *b, const char *path, const char *what,
+						 plume_error *err)
+{
+	bool whole = value != NULL && !b->failed && !b->non_finite;
+	int result = whole ? json_dumpf(value, stream, DUMP_FLAGS) : -1;
+	json_decref(value);
+	if (b->non_finite)
+		return plume_error_set(err, PLUME_ERROR_NUMERIC, "%s: %s has a NaN or infinite number, which JSON cannot hold",
+							   path, what);
+	if (!whole)
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "%s: out of memory", path);
+	if (result != 0)
+		return plume_error_set(err, PLUME_ERROR_IO, "%s: write failed", path);
+	return PLUME_OK;
+}
+
+/// The members every feather object has ("shaft", "barbs", "afterfeather"),
+/// indented by level; the caller writes the braces.
+static plume_status write_members(FILE *stream, const plume_feather *feather, int level, const char *path,
+								  plume_error *err)
+{
+	builder b = {0};
+	pad(stream, level);
+	fputs("\"shaft\": ", stream);
+	plume_status status = dump(stream, shaft_json(&b, feather), &b, path, "the shaft", err);
+	fputs(",\n", stream);
+	pad(stream, level);
+	fputs("\"barbs\": [", stream);
+	int barb_count = plume_feather_get_info(feather).barb_count;
+	for (int i = 0; i < barb_count && status == PLUME_OK; ++i) {
+		fputs(i > 0 ? ",\n" : "\n", stream);
+		pad(stream, level + 1);
+		char what[64];
+		snprintf(what, sizeof what, "barb %d", i);
+		b = (builder){0};
+		status = dump(stream, barb_json(&b, feather, i), &b, path, what, err);
+	}
+	if (barb_count > 0) {
+		fputc('\n', stream);
+		pad(stream, level);
+	}
+	fputs("],\n", stream);
+	pad(stream, level);
+	fputs("\"afterfeather\": ", stream);
+	const plume_feather *after = plume_feather_afterfeather(feather);
+	if (after == NULL || status != PLUME_OK) {
+		fputs("null\n", stream);
+		return status;
+	}
+	fputs("{\n", stream);
+	pad(stream, level + 1);
+	fputs("\"t\": ", stream);
+	b = (builder){0};
+	double t = plume_feather_afterfeather_t(feather);
+	b.non_finite = !isfinite(t);
+	if ((status = dump(stream, json_real(t), &b, path, "the afterfeather's t", err)) != PLUME_OK)
+		return status;
+	fputs(",\n", stream);
+	pad(stream, level + 1);
+	fputs("\"feather\": {\n", stream);
+	status = write_members(stream, after, level + 2, path, err);
+	pad(stream, level + 1);
+	fputs("}\n", stream);
+	pad(stream, level);
+	fputs("}\n", stream);
+	return status;
+}
+
+/// The file nests each barb's barbules under it, so a feather can be written
+/// only when its barbules are grouped by barb, in order (feather.h promises
+/// this); anything else would not read back as the same feather.
+static bool barbules_grouped(const plume_feather *feather, int *bad_barb)
+{
+	plume_feather_info info = plume_feather_get_info(feather);
+	int next = 0;
+	for (int i = 0; i < info.barb_count; ++i) {
+		plume_barb barb = plume_feather_barb(feather, i);
+		if (barb.barbule_count == 0)
+			continue;
+		bool ok = barb.barbule_first == next && barb.barbule_count > 0 &&
+				  barb.barbule_count <= info.barbule_count - barb.barbule_first;
+		for (int j = 0; ok && j < barb.barbule_count; ++j)
+			ok = plume_feather_barbule(feather, next + j).barb == i;
+		if (!ok) {
+			*bad_barb = i;
+			return false;
+		}
+		next += barb.barbule_count;
+	}
+	if (next != info.barbule_count) {
+		*bad_barb = -1;
+		return false;
+	}
+	const plume_feather *after = plume_feather_afterfeather(feather);
+	return after == NULL || barbules_grouped(after, bad_barb);
+}
+
+plume_status plume_write_json(const plume_feather *feather, const char *path, plume_error *err)
+{
+	int bad_barb;
+	if (!barbules_grouped(feather, &bad_barb))
+		return plume_error_set(err, PLUME_ERROR_UNSUPPORTED,
+							   "%s: cannot write: the feather's barbules are not grouped by barb in order "
+							   "(first mismatch at barb %d)",
+							   path, bad_barb);
+	plume_text_file text;
+	plume_status status = plume_text_open(&text, path, err);
+	if (status != PLUME_OK)
+		return status;
+	fprintf(text.stream, "{\n  \"format\": \"%s\",\n  \"version\": %d,\n", FORMAT_NAME, FORMAT_VERSION);
+	status = write_members(text.stream, feather, 1, path, err);
+	fputs("}\n", text.stream);
+	return plume_text_close(&text, status, err);
+}
+
+// ---------------------------------------------------------------------------
+// Reading
+
+/// Where the reader is in the document, for messages: "$.barbs[3].position".
+typedef struct reader {
+	const char *file;
+	plume_error *err;
+	char path[512];
+	size_t length;
+} reader;
+
+/// Appends to the path; returns the length to restore with leave.
+static size_t enter(reader *r, const char *format, ...)
+#if defined(__GNUC__)
+	__attribute__((format(printf, 2, 3)))
+#endif
+	;
+
+static size_t enter(reader *r, const char *format, ...)
+{
+	size_t mark = r->length;
+	va_list args;
+	va_start(args, format);
+	int written = vsnprintf(r->path + r->length, sizeof r->path - r->length, format, args);
+	va_end(args);
+	if (written > 0)
+		r->length += (size_t)written < sizeof r->path - r->length ? (size_t)written : sizeof r->path - 1 - r->length;
+	return mark;
+}
+
+static void leave(reader *r, size_t mark)
+{
+	r->length = mark;
+	r->path[mark] = '\0';
+}
+
+static plume_status fail(reader *r, const char *format, ...)
+#if defined(__GNUC__)
+	__attribute__((format(printf, 2, 3)))
+#endif
+	;
+
+/// A schema error at the current path: "file: $.barbs[3].position: message".
+static plume_status fail(reader *r, const char *format, ...)
+{
+	char message[512];
+	va_list args;
+	va_start(args, format);
+	vsnprintf(message, sizeof message, format, args);
+	va_end(args);
+	return plume_error_set(r->err, PLUME_ERROR_SPEC, "%s: %s: %s", r->file, r->path, message);
+}
+
+/// A schema error at member key of the current path.
+static plume_status fail_at(reader *r, const char *key, const char *message)
+{
+	enter(r, ".%s", key);
+	return fail(r, "%s", message);
+}
+
+static plume_status out_of_memory(reader *r)
+{
+	return plume_error_set(r->err, PLUME_ERROR_MEMORY, "%s: out of memory", r->file);
+}
+
+static bool in_list(const char *key, const char *const *keys, size_t count)
+{
+	for (size_t i = 0; i < count; ++i)
+		if (strcmp(key, keys[i]) == 0)
+			return true;
+	return false;
+}
+
+/// value must be an object with exactly these keys (the format has no optional
+/// ones, so a misspelt key is reported rather than ignored).
+static plume_status check_object(reader *r, json_t *value, const char *what, const char *const *keys, size_t count)
+{
+	if (!json_is_object(value))
+		return fail(r, "expected an object (%s)", what);
+	const char *key;
+	json_t *member;
+	json_object_foreach(value, key, member) {
+		if (!in_list(key, keys, count))
+			return fail(r, "unknown key \"%s\"", key);
+	}
+	for (size_t i = 0; i < count; ++i)
+		if (json_object_get(value, keys[i]) == NULL)
+			return fail(r, "missing key \"%s\"", keys[i]);
+	return PLUME_OK;
+}
+
+static plume_status read_number(reader *r, json_t *object, const char *key, double *out)
+{
+	json_t *value = json_object_get(object, key);
+	if (!json_is_number(value))
+		return fail_at(r, key, "expected a number");
+	*out = json_number_value(value);
+	return PLUME_OK;
+}
+
+static plume_status read_int(reader *r, json_t *object, const char *key, json_int_t lo, json_int_t hi, int *out)
+{
+	json_t *value = json_object_get(object, key);
+	if (!json_is_integer(value))
+		return fail_at(r, key, "expected an integer");
+	json_int_t number = json_integer_value(value);
+	if (number < lo || number > hi) {
+		enter(r, ".%s", key);
+		return fail(r, "%" JSON_INTEGER_FORMAT " is out of range [%" JSON_INTEGER_FORMAT ", %" JSON_INTEGER_FORMAT "]",
+					number, lo, hi);
+	}
+	*out = (int)number;
+	return PLUME_OK;
+}
+
+/// One of two names; *out is 0 for the first, 1 for the second.
+static plume_status read_name(reader *r, json_t *object, const char *key, const char *const names[2], int *out)
+{
+	const char *text = json_string_value(json_object_get(object, key));
+	for (int i = 0; text != NULL && i < 2; ++i) {
+		if (strcmp(text, names[i]) == 0) {
+			*out = i;
+			return PLUME_OK;
+		}
+	}
+	enter(r, ".%s", key);
+	return fail(r, "expected \"%s\" or \"%s\"", names[0], names[1]);
+}
+
+/// The number of items in object[key], an array of components numbers per item.
+static plume_status read_count(reader *r, json_t *object, const char *key, int components, int *count)
+{
+	json_t *array = json_object_get(object, key);
+	size_t size = json_is_array(array) ? json_array_size(array) : 0;
+	if (!json_is_array(array) || size % (size_t)components != 0 || size / (size_t)components > INT_MAX) {
+		enter(r, ".%s", key);
+		if (components == 1)
+			return fail(r, "expected an array of numbers");
+		return fail(r, "expected an array of %dn numbers", components);
+	}
+	*count = (int)(size / (size_t)components);
+	return PLUME_OK;
+}
+
+/// Reads object[key], count items of components numbers each, into the doubles
+/// at base + i * stride (base is not touched when count is 0).
+static plume_status read_numbers(reader *r, json_t *object, const char *key, int components, int count, void *base,
+								 size_t stride)
+{
+	json_t *array = json_object_get(object, key);
+	size_t expected = (size_t)count * (size_t)components;
+	size_t mark = enter(r, ".%s", key);
+	if (!json_is_array(array))
+		return fail(r, "expected an array of %zu numbers (%d per point)", expected, components);
+	if (json_array_size(array) != expected)
+		return fail(r, "expected %zu numbers (%d per point, %d points), found %zu", expected, components, count,
+					json_array_size(array));
+	for (size_t k = 0; k < expected; ++k) {
+		json_t *value = json_array_get(array, k);
+		if (!json_is_number(value)) {
+			enter(r, "[%zu]", k);
+			return fail(r, "expected a number");
+		}
+		size_t item = k / (size_t)components, component = k % (size_t)components;
+		double *target = (double *)((char *)base + item * stride) + component;
+		*target = json_number_value(value);
+	}
+	leave(r, mark);
+	return PLUME_OK;
+}
+
+/// The per-point arrays of a barb or barbule, appended to the point pool.
+static plume_status read_polyline(reader *r, json_t *object, plume_feather *feather, plume_curve_range *range)
+{
+	int count = 0;
+	plume_status status = read_count(r, object, "position", 3, &count);
+	if (status != PLUME_OK)
+		return status;
+	if (count > INT_MAX / 2 - feather->point_count)
+		return fail_at(r, "position", "too many points");
+	int first = feather->point_count;
+	if (count > 0 && (first = plume_feather_add_points(feather, count)) < 0)
+		return out_of_memory(r);
+	*range = (plume_curve_range){first, count};
+	bool any = count > 0; // no pointer arithmetic on a pool that may still be NULL
+	if ((status = read_numbers(r, object, "position", 3, count, any ? (void *)(feather->points + first) : NULL,
+							   sizeof(plume_vec3))) != PLUME_OK ||
+		(status = read_numbers(r, object, "normal", 3, count, any ? (void *)(feather->normals + first) : NULL,
+							   sizeof(plume_vec3))) != PLUME_OK ||
+		(status = read_numbers(r, object, "arc_length", 1, count,
+							   any ? (void *)(feather->arc_length + first) : NULL, sizeof(double))) != PLUME_OK ||
+		(status = read_numbers(r, object, "width", 1, count, any ? (void *)(feather->widths + first) : NULL,
+							   sizeof(double))) != PLUME_OK ||
+		(status = read_numbers(r, object, "uv", 2, count, any ? (void *)(feather->uv + first) : NULL,
+							   sizeof(plume_vec2))) != PLUME_OK)
+		return status;
+	return PLUME_OK;
+}
+
+static plume_status read_shaft(reader *r, json_t *object, plume_feather *feather)
+{
+	static const char *const keys[] = {"calamus_samples", "position", "tangent", "normal", "binormal", "width", "t"};
+	plume_status status = check_object(r, object, "the shaft", keys, sizeof keys / sizeof keys[0]);
+	int count = 0;
+	if (status != PLUME_OK || (status = read_count(r, object, "position", 3, &count)) != PLUME_OK)
+		return status;
+	plume_shaft_sample *shaft = NULL;
+	if (count > 0 && (shaft = plume_feather_add_shaft(feather, count)) == NULL)
+		return out_of_memory(r);
+	size_t stride = sizeof(plume_shaft_sample);
+	if ((status = read_numbers(r, object, "position", 3, count, shaft ? &shaft->position : NULL, stride)) != PLUME_OK ||
+		(status = read_numbers(r, object, "tangent", 3, count, shaft ? &shaft->tangent : NULL, stride)) != PLUME_OK ||
+		(status = read_numbers(r, object, "normal", 3, count, shaft ? &shaft->normal : NULL, stride)) != PLUME_OK ||
+		(status = read_numbers(r, object, "binormal", 3, count, shaft ? &shaft->binormal : NULL, stride)) !=
+			PLUME_OK ||
+		(status = read_numbers(r, object, "width", 1, count, shaft ? &shaft->width : NULL, stride)) != PLUME_OK ||
+		(status = read_numbers(r, object, "t", 1, count, shaft ? &shaft->t : NULL, stride)) != PLUME_OK)
+		return status;
+	return read_int(r, object, "calamus_samples", 0, count, &feather->calamus_count);
+}
+
+static plume_status read_barbule(reader *r, json_t *object, plume_feather *feather, int barb)
+{
+	static const char *const keys[] = {"barb_s", "kind", "position", "normal", "arc_length", "width", "uv"};
+	plume_barbule_record record = {.barb = barb};
+	int kind = 0;
+	plume_status status = check_object(r, object, "a barbule", keys, sizeof keys / sizeof keys[0]);
+	if (status != PLUME_OK || (status = read_number(r, object, "barb_s", &record.barb_s)) != PLUME_OK ||
+		(status = read_name(r, object, "kind", kind_names, &kind)) != PLUME_OK ||
+		(status = read_polyline(r, object, feather, &record.curve)) != PLUME_OK)
+		return status;
+	record.kind = (plume_barbule_kind)kind;
+	return plume_feather_add_barbule(feather, &record) < 0 ? out_of_memory(r) : PLUME_OK;
+}
+
+static plume_status read_barb(reader *r, json_t *object, plume_feather *feather)
+{
+	static const char *const keys[] = {"side", "rachis_t", "segment", "position", "normal",
+									   "arc_length", "width", "uv", "barbules"};
+	plume_barb_record record = {0};
+	int side = 0;
+	plume_status status = check_object(r, object, "a barb", keys, sizeof keys / sizeof keys[0]);
+	if (status != PLUME_OK || (status = read_name(r, object, "side", side_names, &side)) != PLUME_OK ||
+		(status = read_number(r, object, "rachis_t", &record.rachis_t)) != PLUME_OK ||
+		(status = read_int(r, object, "segment", INT_MIN, INT_MAX, &record.segment)) != PLUME_OK ||
+		(status = read_polyline(r, object, feather, &record.curve)) != PLUME_OK)
+		return status;
+	record.side = (plume_side)side;
+
+	// Barbules are stored grouped by barb: this barb's start where the pool's end is now.
+	json_t *barbules = json_object_get(object, "barbules");
+	if (!json_is_array(barbules))
+		return fail_at(r, "barbules", "expected an array");
+	int index = feather->barb_count; // the barb's index once added below
+	record.barbule_first = feather->barbule_count;
+	size_t i;
+	json_t *item;
+	json_array_foreach(barbules, i, item) {
+		size_t mark = enter(r, ".barbules[%zu]", i);
+		if ((status = read_barbule(r, item, feather, index)) != PLUME_OK)
+			return status;
+		leave(r, mark);
+	}
+	record.barbule_count = feather->barbule_count - record.barbule_first;
+	return plume_feather_add_barb(feather, &record) < 0 ? out_of_memory(r) : PLUME_OK;
+}
+
+static plume_status read_feather(reader *r, json_t *object, plume_feather *feather, bool top)
+{
+	static const char *const top_keys[] = {"format", "version", "shaft", "barbs", "afterfeather"};
+	// A nested feather has the same keys less the two that name the format.
+	const char *const *keys = top ? top_keys : top_keys + 2;
+	size_t key_count = top ? 5 : 3;
+	plume_status status = check_object(r, object, "a feather", keys, key_count);
+	if (status != PLUME_OK)
+		return status;
+	if (top) {
+		const char *format = json_string_value(json_object_get(object, "format"));
+		if (format == NULL || strcmp(format, FORMAT_NAME) != 0)
+			return fail_at(r, "format", "expected \"" FORMAT_NAME "\"");
+		json_t *version = json_object_get(object, "version");
+		if (!json_is_integer(version) || json_integer_value(version) != FORMAT_VERSION) {
+			enter(r, ".version");
+			return fail(r, "unsupported version (this plume reads version %d)", FORMAT_VERSION);
+		}
+	}
+
+	size_t mark = enter(r, ".shaft");
+	if ((status = read_shaft(r, json_object_get(object, "shaft"), feather)) != PLUME_OK)
+		return status;
+	leave(r, mark);
+
+	json_t *barbs = json_object_get(object, "barbs");
+	if (!json_is_array(barbs))
+		return fail_at(r, "barbs", "expected an array");
+	size_t i;
+	json_t *item;
+	json_array_foreach(barbs, i, item) {
+		mark = enter(r, ".barbs[%zu]", i);
+		if ((status = read_barb(r, item, feather)) != PLUME_OK)
+			return status;
+		leave(r, mark);
+	}
+
+	json_t *after = json_object_get(object, "afterfeather");
+	if (json_is_null(after))
+		return PLUME_OK;
+	static const char *const after_keys[] = {"t", "feather"};
+	mark = enter(r, ".afterfeather");
+	if ((status = check_object(r, after, "the afterfeather, or null", after_keys, 2)) != PLUME_OK ||
+		(status = read_number(r, after, "t", &feather->afterfeather_t)) != PLUME_OK)
+		return status;
+	// Attached before it is filled, so that destroying the parent frees it on any error.
+	if ((feather->afterfeather = plume_feather_create_empty()) == NULL)
+		return out_of_memory(r);
+	enter(r, ".feather");
+	if ((status = read_feather(r, json_object_get(after, "feather"), feather->afterfeather, false)) != PLUME_OK)
+		return status;
+	leave(r, mark);
+	return PLUME_OK;
+}
+
+plume_status plume_read_json(const char *path, plume_feather **out, plume_error *err)
+{
+	*out = NULL;
+	FILE *file = fopen(path, "rb");
+	if (file == NULL)
+		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot read: %s", path, strerror(errno));
+	json_error_t error;
+	json_t *root = json_loadf(file, JSON_REJECT_DUPLICATES, &error);
+	int read_error = ferror(file) ? errno : 0; // e.g. EISDIR: fopen opens a folder, reading it fails
+	fclose(file);
+	if (root == NULL) {
+		if (read_error != 0)
+			return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot read: %s", path, strerror(read_error));
+		if (json_error_code(&error) == json_error_out_of_memory)
+			return plume_error_set(err, PLUME_ERROR_MEMORY, "%s: out of memory", path);
+		return plume_error_set(err, PLUME_ERROR_SYNTAX, "%s:%d:%d: %s", path, error.line, error.column, error.text);
+	}
+
+	reader r = {.file = path, .err = err, .path = "$", .length = 1};
+	plume_feather *feather = plume_feather_create_empty();
+	plume_status status = feather != NULL ? read_feather(&r, root, feather, true) : out_of_memory(&r);
+	json_decref(root);
+	if (status != PLUME_OK) {
+		plume_feather_destroy(feather);
+		return status;
+	}
+	*out = feather;
+	return PLUME_OK;
+}

@@ -1,0 +1,283 @@
+// JSON spec reading with paths in every message (see spec.h).
+#define _POSIX_C_SOURCE 200809L
+#include "spec.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+json_t *plume_spec_load(const char *path, plume_error *err)
+{
+	// jansson reports a missing file as a parse error at line -1; say it plainly.
+	FILE *file = fopen(path, "rb");
+	if (file == NULL) {
+		plume_error_set(err, PLUME_ERROR_IO, "%s: cannot read: %s", path, strerror(errno));
+		return NULL;
+	}
+	json_error_t error;
+	json_t *root = json_loadf(file, JSON_REJECT_DUPLICATES, &error);
+	fclose(file);
+	if (root == NULL)
+		plume_error_set(err, PLUME_ERROR_SYNTAX, "%s:%d:%d: %s", path, error.line, error.column, error.text);
+	return root;
+}
+
+plume_spec_reader plume_spec_reader_begin(const char *file, plume_error *err)
+{
+	return (plume_spec_reader){.file = file, .err = err, .status = PLUME_OK};
+}
+
+void plume_spec_fail(plume_spec_reader *reader, const char *path, const char *format, ...)
+{
+	if (reader->status != PLUME_OK)
+		return;
+	reader->status = PLUME_ERROR_SPEC;
+	if (reader->err == NULL)
+		return;
+	char message[768];
+	va_list args;
+	va_start(args, format);
+	vsnprintf(message, sizeof message, format, args);
+	va_end(args);
+	plume_error_set(reader->err, PLUME_ERROR_SPEC, "%.200s: %.200s: %s", reader->file, path, message);
+}
+
+void plume_spec_path(char *out, size_t size, const char *parent, const char *key)
+{
+	snprintf(out, size, "%s.%s", parent, key);
+}
+
+void plume_spec_index_path(char *out, size_t size, const char *parent, size_t index)
+{
+	snprintf(out, size, "%s[%zu]", parent, index);
+}
+
+// Levenshtein distance with one rolling row; keys are short.
+static size_t edit_distance(const char *a, const char *b)
+{
+	size_t n = strlen(b);
+	if (n > 63)
+		n = 63;
+	size_t row[64];
+	for (size_t j = 0; j <= n; ++j)
+		row[j] = j;
+	for (size_t i = 1; a[i - 1] != '\0'; ++i) {
+		size_t diagonal = row[0];
+		row[0] = i;
+		for (size_t j = 1; j <= n; ++j) {
+			size_t above = row[j];
+			size_t cost = a[i - 1] == b[j - 1] ? 0 : 1;
+			size_t best = diagonal + cost;
+			if (above + 1 < best)
+				best = above + 1;
+			if (row[j - 1] + 1 < best)
+				best = row[j - 1] + 1;
+			row[j] = best;
+			diagonal = above;
+		}
+	}
+	return row[n];
+}
+
+const char *plume_spec_nearest(const char *word, const char *const *allowed)
+{
+	const char *nearest = allowed[0];
+	size_t best = (size_t)-1;
+	for (const char *const *candidate = allowed; *candidate != NULL; ++candidate) {
+		size_t distance = edit_distance(word, *candidate);
+		if (distance < best) {
+			best = distance;
+			nearest = *candidate;
+		}
+	}
+	return nearest;
+}
+
+void plume_spec_check_keys(plume_spec_reader *reader, const json_t *object, const char *path,
+						   const char *const *allowed)
+{
+	if (reader->status != PLUME_OK)
+		return;
+	const char *key;
+	json_t *value;
+	json_object_foreach((json_t *)object, key, value)
+	{
+		bool known = false;
+		for (const char *const *candidate = allowed; *candidate != NULL && !known; ++candidate)
+			known = strcmp(key, *candidate) == 0;
+		if (!known) {
+			char child[512];
+			plume_spec_path(child, sizeof child, path, key);
+			plume_spec_fail(reader, child, "unknown key; did you mean \"%s\"?", plume_spec_nearest(key, allowed));
+			return;
+		}
+	}
+}
+
+static const char *type_name(const json_t *value)
+{
+	switch (json_typeof(value)) {
+	case JSON_OBJECT: return "an object";
+	case JSON_ARRAY: return "an array";
+	case JSON_STRING: return "a string";
+	case JSON_INTEGER: return "an integer";
+	case JSON_REAL: return "a number";
+	case JSON_TRUE:
+	case JSON_FALSE: return "a boolean";
+	case JSON_NULL: return "null";
+	}
+	return "a value";
+}
+
+/// The member, or NULL when absent or after an earlier failure.
+static const json_t *member(plume_spec_reader *reader, const json_t *object, const char *key)
+{
+	return reader->status == PLUME_OK ? json_object_get(object, key) : NULL;
+}
+
+static bool read_number(plume_spec_reader *reader, const json_t *value, const char *path, double *out)
+{
+	if (!json_is_number(value)) {
+		plume_spec_fail(reader, path, "expected a number, got %s", type_name(value));
+		return false;
+	}
+	*out = json_number_value(value);
+	return true;
+}
+
+bool plume_spec_number(plume_spec_reader *reader, const json_t *object, const char *path, const char *key, double *out)
+{
+	const json_t *value = member(reader, object, key);
+	if (value == NULL)
+		return false;
+	char child[512];
+	plume_spec_path(child, sizeof child, path, key);
+	return read_number(reader, value, child, out);
+}
+
+bool plume_spec_int(plume_spec_reader *reader, const json_t *object, const char *path, const char *key, int *out)
+{
+	const json_t *value = member(reader, object, key);
+	if (value == NULL)
+		return false;
+	char child[512];
+	plume_spec_path(child, sizeof child, path, key);
+	if (!json_is_integer(value)) {
+		plume_spec_fail(reader, child, "expected an integer, got %s", type_name(value));
+		return false;
+	}
+	json_int_t number = json_integer_value(value);
+	if (number < -2147483647 || number > 2147483647) {
+		plume_spec_fail(reader, child, "%lld is too large", (long long)number);
+		return false;
+	}
+	*out = (int)number;
+	return true;
+}
+
+bool plume_spec_uint64(plume_spec_reader *reader, const json_t *object, const char *path, const char *key,
+					   uint64_t *out)
+{
+	const json_t *value = member(reader, object, key);
+	if (value == NULL)
+		return false;
+	char child[512];
+	plume_spec_path(child, sizeof child, path, key);
+	if (!json_is_integer(value) || json_integer_value(value) < 0) {
+		plume_spec_fail(reader, child, "expected a non-negative integer, got %s", type_name(value));
+		return false;
+	}
+	*out = (uint64_t)json_integer_value(value);
+	return true;
+}
+
+bool plume_spec_bool(plume_spec_reader *reader, const json_t *object, const char *path, const char *key, bool *out)
+{
+	const json_t *value = member(reader, object, key);
+	if (value == NULL)
+		return false;
+	if (!json_is_boolean(value)) {
+		char child[512];
+		plume_spec_path(child, sizeof child, path, key);
+		plume_spec_fail(reader, child, "expected true or false, got %s", type_name(value));
+		return false;
+	}
+	*out = json_is_true(value);
+	return true;
+}
+
+bool plume_spec_string(plume_spec_reader *reader, const json_t *object, const char *path, const char *key,
+					   const char **out)
+{
+	const json_t *value = member(reader, object, key);
+	if (value == NULL)
+		return false;
+	if (!json_is_string(value)) {
+		char child[512];
+		plume_spec_path(child, sizeof child, path, key);
+		plume_spec_fail(reader, child, "expected a string, got %s", type_name(value));
+		return false;
+	}
+	*out = json_string_value(value);
+	return true;
+}
+
+bool plume_spec_points2(plume_spec_reader *reader, const json_t *object, const char *path, const char *key,
+						plume_vec2 *out, int count)
+{
+	const json_t *value = member(reader, object, key);
+	if (value == NULL)
+		return false;
+	char child[512];
+	plume_spec_path(child, sizeof child, path, key);
+	if (!json_is_array(value) || json_array_size(value) != (size_t)count) {
+		plume_spec_fail(reader, child, "expected an array of %d points [x, y] in metres", count);
+		return false;
+	}
+	plume_vec2 points[64];
+	for (int i = 0; i < count && i < 64; ++i) {
+		const json_t *point = json_array_get(value, (size_t)i);
+		char item[540];
+		plume_spec_index_path(item, sizeof item, child, (size_t)i);
+		if (!json_is_array(point) || json_array_size(point) != 2) {
+			plume_spec_fail(reader, item, "expected a point [x, y] in metres, got %s", type_name(point));
+			return false;
+		}
+		char coordinate[560];
+		plume_spec_index_path(coordinate, sizeof coordinate, item, 0);
+		if (!read_number(reader, json_array_get(point, 0), coordinate, &points[i].x))
+			return false;
+		plume_spec_index_path(coordinate, sizeof coordinate, item, 1);
+		if (!read_number(reader, json_array_get(point, 1), coordinate, &points[i].y))
+			return false;
+	}
+	memcpy(out, points, (size_t)count * sizeof *out);
+	return true;
+}
+
+static const json_t *typed_member(plume_spec_reader *reader, const json_t *object, const char *path, const char *key,
+								  json_type type, const char *expected)
+{
+	const json_t *value = member(reader, object, key);
+	if (value == NULL)
+		return NULL;
+	if (json_typeof(value) != type) {
+		char child[512];
+		plume_spec_path(child, sizeof child, path, key);
+		plume_spec_fail(reader, child, "expected %s, got %s", expected, type_name(value));
+		return NULL;
+	}
+	return value;
+}
+
+const json_t *plume_spec_object(plume_spec_reader *reader, const json_t *object, const char *path, const char *key)
+{
+	return typed_member(reader, object, path, key, JSON_OBJECT, "an object");
+}
+
+const json_t *plume_spec_array(plume_spec_reader *reader, const json_t *object, const char *path, const char *key)
+{
+	return typed_member(reader, object, path, key, JSON_ARRAY, "an array");
+}

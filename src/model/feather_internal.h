@@ -1,0 +1,74 @@
+// Private: the layout of plume_feather, for the library's generators and readers.
+//
+// All barb and barbule points live in one pool of parallel arrays; a curve is
+// a range [first, first + count) in the pool. Builders append with the
+// plume_feather_add_* functions and fill the returned ranges directly.
+#ifndef PLUME_FEATHER_INTERNAL_H
+#define PLUME_FEATHER_INTERNAL_H
+
+#include "plume/feather.h"
+
+typedef struct plume_curve_range {
+	int first;
+	int count;
+} plume_curve_range;
+
+typedef struct plume_barb_record {
+	plume_curve_range curve;
+	plume_side side;
+	double rachis_t;
+	int segment;
+	int barbule_first;
+	int barbule_count;
+} plume_barb_record;
+
+typedef struct plume_barbule_record {
+	plume_curve_range curve;
+	int barb;
+	double barb_s;
+	plume_barbule_kind kind;
+} plume_barbule_record;
+
+struct plume_feather {
+	plume_shaft_sample *shaft;
+	int shaft_count, shaft_capacity;
+	int calamus_count;
+
+	// point pool
+	plume_vec3 *points;
+	plume_vec3 *normals;
+	double *arc_length;
+	double *widths;
+	plume_vec2 *uv;
+	int point_count, point_capacity;
+
+	plume_barb_record *barbs;
+	int barb_count, barb_capacity;
+
+	plume_barbule_record *barbules;
+	int barbule_count, barbule_capacity;
+
+	plume_feather *afterfeather;
+	double afterfeather_t;
+};
+
+/// An empty feather, or NULL when memory runs out.
+plume_feather *plume_feather_create_empty(void);
+
+/// Appends count shaft samples (uninitialized); returns the first one or NULL.
+plume_shaft_sample *plume_feather_add_shaft(plume_feather *feather, int count);
+
+/// Appends count pool points (zeroed); returns the index of the first, or -1.
+int plume_feather_add_points(plume_feather *feather, int count);
+
+/// Appends a barb record; returns its index or -1.
+int plume_feather_add_barb(plume_feather *feather, const plume_barb_record *barb);
+
+/// Appends a barbule record; returns its index or -1.
+int plume_feather_add_barbule(plume_feather *feather, const plume_barbule_record *barbule);
+
+/// Fills arc_length for a range of the pool from its points, and uv.s as the
+/// arc-length fraction (0 at the first point, 1 at the last).
+void plume_feather_measure_curve(plume_feather *feather, plume_curve_range range);
+
+#endif
