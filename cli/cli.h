@@ -32,9 +32,9 @@ int cli_fail(const plume_error *err);
 /// Prints "plume: <command>: message" and a hint to the command's help; returns CLI_EXIT_USAGE.
 int cli_usage_error(const char *command, const char *format, ...)
 #if defined(__GNUC__)
-	__attribute__((format(printf, 2, 3)))
+    __attribute__((format(printf, 2, 3)))
 #endif
-	;
+    ;
 
 /// Parses "png,svg,obj"; false (and a usage message) on an unknown name.
 bool cli_parse_formats(const char *command, const char *list, unsigned *formats);
@@ -47,8 +47,8 @@ bool cli_parse_seed(const char *command, const char *text, uint64_t *seed);
 
 /// How a feather's images are drawn.
 typedef struct cli_image_options {
-	int width, height;              ///< 0: height 1200 and the width from the feather's aspect
-	const plume_texture *texture;   ///< NULL: the line style
+	int width, height;            ///< 0: height 1200 and the width from the feather's aspect
+	const plume_texture *texture; ///< NULL: the line style
 } cli_image_options;
 
 // A set of output files written all together or not at all: files go to a
@@ -70,7 +70,7 @@ void cli_output_abort(cli_output *output);
 
 /// Writes <stem>.<ext> for every format in the set into the staging folder.
 plume_status cli_write_feather(cli_output *output, const plume_feather *feather, const char *stem, unsigned formats,
-							   const cli_image_options *images, plume_error *err);
+                               const cli_image_options *images, plume_error *err);
 
 int cli_generate(int argc, char **argv);
 int cli_demo(int argc, char **argv);

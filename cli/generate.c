@@ -9,29 +9,32 @@
 void cli_help_generate(void)
 {
 	puts("Usage: plume generate SPEC.json -o DIR [options]\n"
-		 "\n"
-		 "Generates the feather that SPEC.json describes and writes DIR/feather.<ext>\n"
-		 "for each format. All files appear together, or none when anything fails.\n"
-		 "\n"
-		 "Options:\n"
-		 "  -o, --output DIR       output folder (created if missing)\n"
-		 "  -s, --seed N           random seed; overrides the spec's \"seed\" (default 1)\n"
-		 "  -f, --format LIST      comma-separated: png,svg,pdf,obj,usda,json (default: all)\n"
-		 "      --size WxH         image size in pixels (default: 1200 tall, width to fit)\n"
-		 "  -t, --texture IMAGE    colour the barbs from IMAGE (Franco & Walter 4.4) instead\n"
-		 "                         of the line style\n"
-		 "  -h, --help             this help\n"
-		 "\n"
-		 "Specs are described in docs/spec-franco-walter.md; examples/ has ready ones.");
+	     "\n"
+	     "Generates the feather that SPEC.json describes and writes DIR/feather.<ext>\n"
+	     "for each format. All files appear together, or none when anything fails.\n"
+	     "\n"
+	     "Options:\n"
+	     "  -o, --output DIR       output folder (created if missing)\n"
+	     "  -s, --seed N           random seed; overrides the spec's \"seed\" (default 1)\n"
+	     "  -f, --format LIST      comma-separated: png,svg,pdf,obj,usda,json (default: all)\n"
+	     "      --size WxH         image size in pixels (default: 1200 tall, width to fit)\n"
+	     "  -t, --texture IMAGE    colour the barbs from IMAGE (Franco & Walter 4.4) instead\n"
+	     "                         of the line style\n"
+	     "  -h, --help             this help\n"
+	     "\n"
+	     "Specs are described in docs/spec-franco-walter.md; examples/ has ready ones.");
 }
 
 int cli_generate(int argc, char **argv)
 {
 	static const struct option options[] = {
-		{"output", required_argument, NULL, 'o'}, {"seed", required_argument, NULL, 's'},
-		{"format", required_argument, NULL, 'f'}, {"size", required_argument, NULL, 'S'},
-		{"texture", required_argument, NULL, 't'}, {"help", no_argument, NULL, 'h'},
-		{NULL, 0, NULL, 0},
+	    {"output", required_argument, NULL, 'o'},
+	    {"seed", required_argument, NULL, 's'},
+	    {"format", required_argument, NULL, 'f'},
+	    {"size", required_argument, NULL, 'S'},
+	    {"texture", required_argument, NULL, 't'},
+	    {"help", no_argument, NULL, 'h'},
+	    {NULL, 0, NULL, 0},
 	};
 	const char *output_dir = NULL, *texture_path = NULL;
 	unsigned formats = CLI_FORMAT_ALL;

@@ -39,8 +39,8 @@ static const struct {
 	const char *name;
 	unsigned bit;
 } format_names[] = {
-	{"png", CLI_FORMAT_PNG}, {"svg", CLI_FORMAT_SVG},   {"pdf", CLI_FORMAT_PDF},
-	{"obj", CLI_FORMAT_OBJ}, {"usda", CLI_FORMAT_USDA}, {"json", CLI_FORMAT_JSON},
+    {"png", CLI_FORMAT_PNG}, {"svg", CLI_FORMAT_SVG},   {"pdf", CLI_FORMAT_PDF},
+    {"obj", CLI_FORMAT_OBJ}, {"usda", CLI_FORMAT_USDA}, {"json", CLI_FORMAT_JSON},
 };
 
 bool cli_parse_formats(const char *command, const char *list, unsigned *formats)
@@ -58,7 +58,7 @@ bool cli_parse_formats(const char *command, const char *list, unsigned *formats)
 		}
 		if (!known) {
 			cli_usage_error(command, "unknown format '%.*s' in --format; allowed: png, svg, pdf, obj, usda, json",
-							(int)length, cursor);
+			                (int)length, cursor);
 			return false;
 		}
 		cursor += length;
@@ -76,7 +76,7 @@ bool cli_parse_size(const char *command, const char *text, int *width, int *heig
 {
 	char tail;
 	if (sscanf(text, "%dx%d%c", width, height, &tail) != 2 || *width < 16 || *width > 16384 || *height < 16 ||
-		*height > 16384) {
+	    *height > 16384) {
 		cli_usage_error(command, "--size '%s' must be WxH in pixels, each in [16, 16384]", text);
 		return false;
 	}
@@ -140,11 +140,11 @@ plume_status cli_output_begin(cli_output *output, const char *dir, plume_error *
 		const char *slash = strrchr(output->dir, '/');
 		int parent = slash != NULL ? (int)(slash - output->dir + 1) : 0;
 		snprintf(output->stage, sizeof output->stage, "%.*s.%s.plume-staging-XXXXXX", parent, output->dir,
-				 output->dir + parent);
+		         output->dir + parent);
 	}
 	if (mkdtemp(output->stage) == NULL)
 		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write the output folder: %s", output->dir,
-							   strerror(errno));
+		                       strerror(errno));
 	return PLUME_OK;
 }
 
@@ -167,7 +167,7 @@ plume_status cli_output_commit(cli_output *output, plume_error *err)
 		chmod(output->stage, 0777 & ~mask);
 		if (rename(output->stage, output->dir) != 0) {
 			plume_error_set(err, PLUME_ERROR_IO, "%s: cannot create the output folder: %s", output->dir,
-							strerror(errno));
+			                strerror(errno));
 			cli_output_abort(output);
 			return PLUME_ERROR_IO;
 		}
@@ -216,14 +216,14 @@ static plume_render2d_def image_def(const plume_feather *feather, const cli_imag
 }
 
 plume_status cli_write_feather(cli_output *output, const plume_feather *feather, const char *stem, unsigned formats,
-							   const cli_image_options *images, plume_error *err)
+                               const cli_image_options *images, plume_error *err)
 {
 	static const struct {
 		unsigned bit;
 		const char *extension;
 	} order[] = {
-		{CLI_FORMAT_PNG, "png"}, {CLI_FORMAT_SVG, "svg"},   {CLI_FORMAT_PDF, "pdf"},
-		{CLI_FORMAT_OBJ, "obj"}, {CLI_FORMAT_USDA, "usda"}, {CLI_FORMAT_JSON, "json"},
+	    {CLI_FORMAT_PNG, "png"}, {CLI_FORMAT_SVG, "svg"},   {CLI_FORMAT_PDF, "pdf"},
+	    {CLI_FORMAT_OBJ, "obj"}, {CLI_FORMAT_USDA, "usda"}, {CLI_FORMAT_JSON, "json"},
 	};
 	plume_render2d_def def = image_def(feather, images);
 	for (size_t i = 0; i < sizeof order / sizeof order[0]; ++i) {

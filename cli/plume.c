@@ -12,16 +12,17 @@ typedef struct command {
 } command;
 
 static const command commands[] = {
-	{"generate", "generate a feather from a spec; write images and geometry", cli_generate, cli_help_generate},
-	{"demo", "generate the built-in feather end to end, no input needed", cli_demo, cli_help_demo},
+    {"generate", "generate a feather from a spec; write images and geometry", cli_generate, cli_help_generate},
+    {"demo", "generate the built-in feather end to end, no input needed", cli_demo, cli_help_demo},
 };
 enum { COMMAND_COUNT = sizeof commands / sizeof commands[0] };
 
 static void print_usage(FILE *stream)
 {
-	fprintf(stream, "plume %s — feathers: generation, simulation, rendering\n\n"
-					"Usage: plume COMMAND [options]\n\nCommands:\n",
-			PLUME_VERSION_STRING);
+	fprintf(stream,
+	        "plume %s — feathers: generation, simulation, rendering\n\n"
+	        "Usage: plume COMMAND [options]\n\nCommands:\n",
+	        PLUME_VERSION_STRING);
 	for (int i = 0; i < COMMAND_COUNT; ++i)
 		fprintf(stream, "  %-10s %s\n", commands[i].name, commands[i].summary);
 	fprintf(stream, "  %-10s %s\n\n", "help", "help on a command: plume help COMMAND");

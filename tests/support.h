@@ -28,12 +28,12 @@ int test_file_exists(const char *path);
 int test_count_entries(const char *path);
 
 /// Asserts that |a - b| <= tolerance, printing both on failure.
-#define assert_close(a, b, tolerance)                                                                          \
-	do {                                                                                                       \
-		double assert_close_a = (a), assert_close_b = (b);                                                     \
-		if (!(fabs(assert_close_a - assert_close_b) <= (tolerance)))                                           \
-			fail_msg("%s = %.17g, %s = %.17g, differ by %.3g > %.3g", #a, assert_close_a, #b, assert_close_b, \
-					 fabs(assert_close_a - assert_close_b), (double)(tolerance));                               \
+#define assert_close(a, b, tolerance)                                                                                  \
+	do {                                                                                                               \
+		double assert_close_a = (a), assert_close_b = (b);                                                             \
+		if (!(fabs(assert_close_a - assert_close_b) <= (tolerance)))                                                   \
+			fail_msg("%s = %.17g, %s = %.17g, differ by %.3g > %.3g", #a, assert_close_a, #b, assert_close_b,          \
+			         fabs(assert_close_a - assert_close_b), (double)(tolerance));                                      \
 	} while (0)
 
 #endif

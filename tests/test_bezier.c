@@ -9,9 +9,9 @@ static void test_eval_matches_bernstein_cubic(void **state)
 	plume_vec3 p[4] = {{0, 0, 0}, {1, 2, 0}, {3, 3, 1}, {4, 0, 2}};
 	for (int i = 0; i <= 100; ++i) {
 		double t = i / 100.0, s = 1 - t;
-		plume_vec3 expect = plume_v3_add(
-			plume_v3_add(plume_v3_scale(p[0], s * s * s), plume_v3_scale(p[1], 3 * s * s * t)),
-			plume_v3_add(plume_v3_scale(p[2], 3 * s * t * t), plume_v3_scale(p[3], t * t * t)));
+		plume_vec3 expect =
+		    plume_v3_add(plume_v3_add(plume_v3_scale(p[0], s * s * s), plume_v3_scale(p[1], 3 * s * s * t)),
+		                 plume_v3_add(plume_v3_scale(p[2], 3 * s * t * t), plume_v3_scale(p[3], t * t * t)));
 		plume_vec3 got = plume_bezier_eval(p, 4, t);
 		assert_close(got.x, expect.x, 1e-14);
 		assert_close(got.y, expect.y, 1e-14);
@@ -90,7 +90,7 @@ static void test_split_halves_cover_curve(void **state)
 		double u = i / 200.0;
 		assert_true(plume_v3_distance(plume_bezier_eval(left, 5, u), plume_bezier_eval(p, 5, at * u)) < 1e-14);
 		assert_true(plume_v3_distance(plume_bezier_eval(right, 5, u), plume_bezier_eval(p, 5, at + (1 - at) * u)) <
-					1e-14);
+		            1e-14);
 	}
 }
 
@@ -143,14 +143,14 @@ static void test_degenerate_point_curve(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-		cmocka_unit_test(test_eval_matches_bernstein_cubic),
-		cmocka_unit_test(test_eval_quadratic_is_parabola),
-		cmocka_unit_test(test_derivative_of_quintic_against_closed_form),
-		cmocka_unit_test(test_degree_elevation_keeps_curve),
-		cmocka_unit_test(test_split_halves_cover_curve),
-		cmocka_unit_test(test_length_of_line_and_quarter_circle),
-		cmocka_unit_test(test_sampling_by_arc_length_is_equal),
-		cmocka_unit_test(test_degenerate_point_curve),
+	    cmocka_unit_test(test_eval_matches_bernstein_cubic),
+	    cmocka_unit_test(test_eval_quadratic_is_parabola),
+	    cmocka_unit_test(test_derivative_of_quintic_against_closed_form),
+	    cmocka_unit_test(test_degree_elevation_keeps_curve),
+	    cmocka_unit_test(test_split_halves_cover_curve),
+	    cmocka_unit_test(test_length_of_line_and_quarter_circle),
+	    cmocka_unit_test(test_sampling_by_arc_length_is_equal),
+	    cmocka_unit_test(test_degenerate_point_curve),
 	};
 	return cmocka_run_group_tests_name("bezier", tests, NULL, NULL);
 }

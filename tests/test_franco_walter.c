@@ -98,7 +98,7 @@ static void test_every_barb_starts_on_the_rachis(void **state)
 		assert_true(plume_v3_distance(plume_bezier_eval(shaft, 4, t), root) < 1e-12);
 		// rachis_t is the root's arc-length fraction along the shaft.
 		assert_close(plume_bezier_length(shaft, 4, 0.0, t) / plume_bezier_length(shaft, 4, 0.0, 1.0), barb.rachis_t,
-					 1e-9);
+		             1e-9);
 	}
 	plume_feather_destroy(feather);
 }
@@ -258,7 +258,8 @@ static void test_uniform_shape_gives_one_relative_form(void **state)
 	// Segment 0 has U_f false: its barbs' forms differ.
 	plume_barb a = plume_feather_barb(feather, 0), b = plume_feather_barb(feather, 1);
 	for (int k = 0; k < a.curve.count; ++k)
-		spread_other_segment = fmax(spread_other_segment, plume_v3_distance(relative_point(&a, k), relative_point(&b, k)));
+		spread_other_segment =
+		    fmax(spread_other_segment, plume_v3_distance(relative_point(&a, k), relative_point(&b, k)));
 	assert_true(spread_other_segment > 1e-3);
 	plume_feather_destroy(feather);
 }
@@ -280,7 +281,7 @@ static void test_texture_coordinates_and_widths(void **state)
 			if (k > 0) {
 				assert_true(barb.curve.uv[k].x > barb.curve.uv[k - 1].x);
 				assert_close(barb.curve.arc_length[k] - barb.curve.arc_length[k - 1],
-							 plume_v3_distance(barb.curve.points[k], barb.curve.points[k - 1]), 1e-15);
+				             plume_v3_distance(barb.curve.points[k], barb.curve.points[k - 1]), 1e-15);
 			}
 		}
 	}
@@ -374,17 +375,17 @@ static void test_extreme_counts(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-		cmocka_unit_test(test_barb_counts_per_segment),
-		cmocka_unit_test(test_segment_boundary_follows_is),
-		cmocka_unit_test(test_every_barb_starts_on_the_rachis),
-		cmocka_unit_test(test_unperturbed_barbs_end_on_their_outline),
-		cmocka_unit_test(test_length_variation_stays_in_range),
-		cmocka_unit_test(test_symmetric_vanes_mirror),
-		cmocka_unit_test(test_uniform_shape_gives_one_relative_form),
-		cmocka_unit_test(test_texture_coordinates_and_widths),
-		cmocka_unit_test(test_same_seed_same_feather),
-		cmocka_unit_test(test_ranges_are_enforced),
-		cmocka_unit_test(test_extreme_counts),
+	    cmocka_unit_test(test_barb_counts_per_segment),
+	    cmocka_unit_test(test_segment_boundary_follows_is),
+	    cmocka_unit_test(test_every_barb_starts_on_the_rachis),
+	    cmocka_unit_test(test_unperturbed_barbs_end_on_their_outline),
+	    cmocka_unit_test(test_length_variation_stays_in_range),
+	    cmocka_unit_test(test_symmetric_vanes_mirror),
+	    cmocka_unit_test(test_uniform_shape_gives_one_relative_form),
+	    cmocka_unit_test(test_texture_coordinates_and_widths),
+	    cmocka_unit_test(test_same_seed_same_feather),
+	    cmocka_unit_test(test_ranges_are_enforced),
+	    cmocka_unit_test(test_extreme_counts),
 	};
 	return cmocka_run_group_tests_name("franco_walter", tests, NULL, NULL);
 }

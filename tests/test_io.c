@@ -39,7 +39,8 @@ static plume_curve_range small_curve(plume_feather *feather, int count, double s
 		feather->normals[first + i] = plume_v3(0.0, 4.9e-324, 1.0);
 		feather->arc_length[first + i] = sqrt(k);
 		feather->widths[first + i] = 1e-4 / (1.0 + k);
-		feather->uv[first + i] = (plume_vec2){count > 1 ? (double)i / (count - 1) : 0.0, 3.14159265358979323846 / (7.0 + seed)};
+		feather->uv[first + i] =
+		    (plume_vec2){count > 1 ? (double)i / (count - 1) : 0.0, 3.14159265358979323846 / (7.0 + seed)};
 	}
 	return (plume_curve_range){first, count};
 }
@@ -56,32 +57,44 @@ static plume_feather *small_feather(int depth)
 	assert_non_null(shaft);
 	for (int i = 0; i < 4; ++i) {
 		shaft[i] = (plume_shaft_sample){
-			.position = plume_v3(0.001 * i * i, 0.02 * i + depth, 0.0),
-			.tangent = plume_v3(0.0, 1.0, 0.0),
-			.normal = plume_v3(0.0, 0.0, 1.0),
-			.binormal = plume_v3(-1.0, 0.0, 0.0),
-			.width = 1e-3 * (4 - i) / 3.0,
-			.t = i / 3.0,
+		    .position = plume_v3(0.001 * i * i, 0.02 * i + depth, 0.0),
+		    .tangent = plume_v3(0.0, 1.0, 0.0),
+		    .normal = plume_v3(0.0, 0.0, 1.0),
+		    .binormal = plume_v3(-1.0, 0.0, 0.0),
+		    .width = 1e-3 * (4 - i) / 3.0,
+		    .t = i / 3.0,
 		};
 	}
 	feather->calamus_count = 1;
 	plume_curve_range barb_curves[3] = {small_curve(feather, 5, 1.0 + depth), small_curve(feather, 1, 2.0),
-										small_curve(feather, 3, 3.0)};
+	                                    small_curve(feather, 3, 3.0)};
 	plume_barb_record barbs[3] = {
-		{.curve = barb_curves[0], .side = PLUME_SIDE_LEFT, .rachis_t = 0.4, .segment = 0, .barbule_first = 0,
-		 .barbule_count = 2},
-		// An empty barb's barbule_first is not part of the feather (the reader rebuilds it as 2).
-		{.curve = barb_curves[1], .side = PLUME_SIDE_LEFT, .rachis_t = 0.7, .segment = 1, .barbule_first = 0,
-		 .barbule_count = 0},
-		{.curve = barb_curves[2], .side = PLUME_SIDE_RIGHT, .rachis_t = 1.0 / 3.0, .segment = -2, .barbule_first = 2,
-		 .barbule_count = 1},
+	    {.curve = barb_curves[0],
+	     .side = PLUME_SIDE_LEFT,
+	     .rachis_t = 0.4,
+	     .segment = 0,
+	     .barbule_first = 0,
+	     .barbule_count = 2},
+	    // An empty barb's barbule_first is not part of the feather (the reader rebuilds it as 2).
+	    {.curve = barb_curves[1],
+	     .side = PLUME_SIDE_LEFT,
+	     .rachis_t = 0.7,
+	     .segment = 1,
+	     .barbule_first = 0,
+	     .barbule_count = 0},
+	    {.curve = barb_curves[2],
+	     .side = PLUME_SIDE_RIGHT,
+	     .rachis_t = 1.0 / 3.0,
+	     .segment = -2,
+	     .barbule_first = 2,
+	     .barbule_count = 1},
 	};
 	for (int i = 0; i < 3; ++i)
 		assert_int_equal(plume_feather_add_barb(feather, barbs + i), i);
 	plume_barbule_record barbules[3] = {
-		{.curve = small_curve(feather, 2, 5.0), .barb = 0, .barb_s = 0.25, .kind = PLUME_BARBULE_DISTAL},
-		{.curve = small_curve(feather, 3, 6.0), .barb = 0, .barb_s = 0.75, .kind = PLUME_BARBULE_PROXIMAL},
-		{.curve = small_curve(feather, 2, 7.0), .barb = 2, .barb_s = 0.1, .kind = PLUME_BARBULE_DISTAL},
+	    {.curve = small_curve(feather, 2, 5.0), .barb = 0, .barb_s = 0.25, .kind = PLUME_BARBULE_DISTAL},
+	    {.curve = small_curve(feather, 3, 6.0), .barb = 0, .barb_s = 0.75, .kind = PLUME_BARBULE_PROXIMAL},
+	    {.curve = small_curve(feather, 2, 7.0), .barb = 2, .barb_s = 0.1, .kind = PLUME_BARBULE_DISTAL},
 	};
 	for (int i = 0; i < 3; ++i)
 		assert_int_equal(plume_feather_add_barbule(feather, barbules + i), i);
@@ -168,7 +181,7 @@ static void test_json_round_trip_small_with_barbules_and_afterfeathers(void **st
 	plume_barb barb = plume_feather_barb(copy, 0);
 	assert_int_equal(barb.barbule_count, 2);
 	assert_true(signbit(barb.curve.points[0].z) && barb.curve.points[0].z == 0.0); // -0 survived
-	assert_true(barb.curve.normals[0].y == 4.9e-324);                               // a subnormal too
+	assert_true(barb.curve.normals[0].y == 4.9e-324);                              // a subnormal too
 	assert_int_equal(plume_feather_barbule(copy, 2).barb, 2);
 	assert_int_equal(plume_feather_barbule(copy, 1).kind, PLUME_BARBULE_PROXIMAL);
 	const plume_feather *after = plume_feather_afterfeather(copy);
@@ -331,7 +344,7 @@ static void check_obj(const char *path, const plume_feather *feather, const char
 			int count = 0, previous = 0;
 			char *item_save = NULL;
 			for (char *item = strtok_r(line + 2, " ", &item_save); item != NULL;
-				 item = strtok_r(NULL, " ", &item_save)) {
+			     item = strtok_r(NULL, " ", &item_save)) {
 				int vi, ti;
 				assert_int_equal(sscanf(item, "%d/%d", &vi, &ti), 2);
 				assert_int_equal(vi, ti);
@@ -380,13 +393,13 @@ static void test_obj_parses_back_to_the_feather(void **state)
 	feather = small_feather(1);
 	write_ok(FORMAT_OBJ, feather, path);
 	static const char *const small_objects[] = {"shaft",
-												"left_vane",
-												"right_vane",
-												"barbules",
-												"afterfeather_shaft",
-												"afterfeather_left_vane",
-												"afterfeather_right_vane",
-												"afterfeather_barbules"};
+	                                            "left_vane",
+	                                            "right_vane",
+	                                            "barbules",
+	                                            "afterfeather_shaft",
+	                                            "afterfeather_left_vane",
+	                                            "afterfeather_right_vane",
+	                                            "afterfeather_barbules"};
 	check_obj(path, feather, small_objects, 8);
 	plume_feather_destroy(feather);
 
@@ -552,22 +565,22 @@ static void test_usda_counts_match(void **state)
 
 // A small valid document; the error tests each change one piece of it.
 static const char valid_document[] =
-	"{\"format\": \"plume-feather\", \"version\": 1,\n"
-	" \"shaft\": {\"calamus_samples\": 1, \"position\": [0, 0, 0, 0, 0.1, 0], \"tangent\": [0, 1, 0, 0, 1, 0],"
-	" \"normal\": [0, 0, 1, 0, 0, 1], \"binormal\": [-1, 0, 0, -1, 0, 0], \"width\": [0.002, 0.001], \"t\": [0, 1]},\n"
-	" \"barbs\": [\n"
-	"  {\"side\": \"left\", \"rachis_t\": 0.5, \"segment\": 0, \"position\": [0, 0.05, 0, -0.01, 0.06, 0],"
-	" \"normal\": [0, 0, 1, 0, 0, 1], \"arc_length\": [0, 0.0141], \"width\": [1e-4, 5e-5], \"uv\": [0, 0.5, 1, 0.5],"
-	" \"barbules\": []},\n"
-	"  {\"side\": \"right\", \"rachis_t\": 0.5, \"segment\": 1, \"position\": [0, 0.05, 0, 0.01, 0.06, 0],"
-	" \"normal\": [0, 0, 1, 0, 0, 1], \"arc_length\": [0, 0.0142], \"width\": [1e-4, 5e-5], \"uv\": [0, 0.5, 1, 0.5],"
-	" \"barbules\": [{\"barb_s\": 0.5, \"kind\": \"distal\", \"position\": [0.005, 0.055, 0, 0.006, 0.056, 0],"
-	" \"normal\": [0, 0, 1, 0, 0, 1], \"arc_length\": [0, 0.0014], \"width\": [1e-5, 1e-5], \"uv\": [0, 0, 1, 0]}]}\n"
-	" ],\n"
-	" \"afterfeather\": {\"t\": 0.15, \"feather\": {\"shaft\": {\"calamus_samples\": 0, \"position\": [],"
-	" \"tangent\": [], \"normal\": [], \"binormal\": [], \"width\": [], \"t\": []}, \"barbs\": [],"
-	" \"afterfeather\": null}}\n"
-	"}\n";
+    "{\"format\": \"plume-feather\", \"version\": 1,\n"
+    " \"shaft\": {\"calamus_samples\": 1, \"position\": [0, 0, 0, 0, 0.1, 0], \"tangent\": [0, 1, 0, 0, 1, 0],"
+    " \"normal\": [0, 0, 1, 0, 0, 1], \"binormal\": [-1, 0, 0, -1, 0, 0], \"width\": [0.002, 0.001], \"t\": [0, 1]},\n"
+    " \"barbs\": [\n"
+    "  {\"side\": \"left\", \"rachis_t\": 0.5, \"segment\": 0, \"position\": [0, 0.05, 0, -0.01, 0.06, 0],"
+    " \"normal\": [0, 0, 1, 0, 0, 1], \"arc_length\": [0, 0.0141], \"width\": [1e-4, 5e-5], \"uv\": [0, 0.5, 1, 0.5],"
+    " \"barbules\": []},\n"
+    "  {\"side\": \"right\", \"rachis_t\": 0.5, \"segment\": 1, \"position\": [0, 0.05, 0, 0.01, 0.06, 0],"
+    " \"normal\": [0, 0, 1, 0, 0, 1], \"arc_length\": [0, 0.0142], \"width\": [1e-4, 5e-5], \"uv\": [0, 0.5, 1, 0.5],"
+    " \"barbules\": [{\"barb_s\": 0.5, \"kind\": \"distal\", \"position\": [0.005, 0.055, 0, 0.006, 0.056, 0],"
+    " \"normal\": [0, 0, 1, 0, 0, 1], \"arc_length\": [0, 0.0014], \"width\": [1e-5, 1e-5], \"uv\": [0, 0, 1, 0]}]}\n"
+    " ],\n"
+    " \"afterfeather\": {\"t\": 0.15, \"feather\": {\"shaft\": {\"calamus_samples\": 0, \"position\": [],"
+    " \"tangent\": [], \"normal\": [], \"binormal\": [], \"width\": [], \"t\": []}, \"barbs\": [],"
+    " \"afterfeather\": null}}\n"
+    "}\n";
 
 /// valid_document with its only occurrence of `from` replaced by `to`, written to path.
 static void write_variant(const char *path, const char *from, const char *to)
@@ -641,30 +654,31 @@ static void test_read_json_errors(void **state)
 	// Schema: "path: $.json.path: what is wrong".
 	snprintf(message, sizeof message, "%s: $.barbs[1].position: expected an array of 3n numbers", path);
 	write_variant(path, "\"segment\": 1, \"position\": [0, 0.05, 0, 0.01, 0.06, 0]",
-				  "\"segment\": 1, \"position\": [0, 0.05, 0, 0.01]");
+	              "\"segment\": 1, \"position\": [0, 0.05, 0, 0.01]");
 	expect_read_error(path, PLUME_ERROR_SPEC, message, NULL);
 
 	static const struct {
 		const char *from, *to, *path, *what;
 	} cases[] = {
-		{"\"version\": 1", "\"version\": 2", "$.version:", "unsupported version"},
-		{"\"format\": \"plume-feather\"", "\"format\": \"feather\"", "$.format:", "plume-feather"},
-		{"\"side\": \"left\"", "\"side\": \"up\"", "$.barbs[0].side:", "\"left\" or \"right\""},
-		{"\"segment\": 0", "\"segment\": 0.5", "$.barbs[0].segment:", "integer"},
-		{"\"segment\": 0", "\"segment\": 0, \"colour\": 3", "$.barbs[0]:", "unknown key \"colour\""},
-		{"\"rachis_t\": 0.5, \"segment\": 0", "\"segment\": 0", "$.barbs[0]:", "missing key \"rachis_t\""},
-		{"\"arc_length\": [0, 0.0141]", "\"arc_length\": [0, 0.0141, 3]", "$.barbs[0].arc_length:", "found 3"},
-		{"\"position\": [0, 0.05, 0, -0.01", "\"position\": [0, 0.05, \"x\", -0.01", "$.barbs[0].position[2]:",
-		 "expected a number"},
-		{"\"kind\": \"distal\"", "\"kind\": 1", "$.barbs[1].barbules[0].kind:", "\"distal\" or \"proximal\""},
-		{"\"uv\": [0, 0, 1, 0]", "\"uv\": [0, 0, 1]", "$.barbs[1].barbules[0].uv:", "expected 4 numbers (2 per point, 2 points), found 3"},
-		{"\"calamus_samples\": 1", "\"calamus_samples\": 3", "$.shaft.calamus_samples:", "out of range [0, 2]"},
-		{"\"t\": [0, 1]", "\"t\": [0]", "$.shaft.t:", "expected 2 numbers"},
-		{"\"barbs\": [],", "\"barbs\": [7],", "$.afterfeather.feather.barbs[0]:", "expected an object"},
-		{"\"t\": 0.15", "\"t\": null", "$.afterfeather.t:", "expected a number"},
-		{"\"afterfeather\": null", "\"afterfeather\": null, \"format\": \"plume-feather\"", "$.afterfeather.feather:",
-		 "unknown key \"format\""},
-		{"\"barbules\": []", "\"barbules\": {}", "$.barbs[0].barbules:", "expected an array"},
+	    {"\"version\": 1", "\"version\": 2", "$.version:", "unsupported version"},
+	    {"\"format\": \"plume-feather\"", "\"format\": \"feather\"", "$.format:", "plume-feather"},
+	    {"\"side\": \"left\"", "\"side\": \"up\"", "$.barbs[0].side:", "\"left\" or \"right\""},
+	    {"\"segment\": 0", "\"segment\": 0.5", "$.barbs[0].segment:", "integer"},
+	    {"\"segment\": 0", "\"segment\": 0, \"colour\": 3", "$.barbs[0]:", "unknown key \"colour\""},
+	    {"\"rachis_t\": 0.5, \"segment\": 0", "\"segment\": 0", "$.barbs[0]:", "missing key \"rachis_t\""},
+	    {"\"arc_length\": [0, 0.0141]", "\"arc_length\": [0, 0.0141, 3]", "$.barbs[0].arc_length:", "found 3"},
+	    {"\"position\": [0, 0.05, 0, -0.01", "\"position\": [0, 0.05, \"x\", -0.01",
+	     "$.barbs[0].position[2]:", "expected a number"},
+	    {"\"kind\": \"distal\"", "\"kind\": 1", "$.barbs[1].barbules[0].kind:", "\"distal\" or \"proximal\""},
+	    {"\"uv\": [0, 0, 1, 0]", "\"uv\": [0, 0, 1]",
+	     "$.barbs[1].barbules[0].uv:", "expected 4 numbers (2 per point, 2 points), found 3"},
+	    {"\"calamus_samples\": 1", "\"calamus_samples\": 3", "$.shaft.calamus_samples:", "out of range [0, 2]"},
+	    {"\"t\": [0, 1]", "\"t\": [0]", "$.shaft.t:", "expected 2 numbers"},
+	    {"\"barbs\": [],", "\"barbs\": [7],", "$.afterfeather.feather.barbs[0]:", "expected an object"},
+	    {"\"t\": 0.15", "\"t\": null", "$.afterfeather.t:", "expected a number"},
+	    {"\"afterfeather\": null", "\"afterfeather\": null, \"format\": \"plume-feather\"",
+	     "$.afterfeather.feather:", "unknown key \"format\""},
+	    {"\"barbules\": []", "\"barbules\": {}", "$.barbs[0].barbules:", "expected an array"},
 	};
 	for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
 		write_variant(path, cases[i].from, cases[i].to);
@@ -744,15 +758,15 @@ static void test_failed_write_leaves_existing_file(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-		cmocka_unit_test(test_json_round_trip_hawk),
-		cmocka_unit_test(test_json_round_trip_small_with_barbules_and_afterfeathers),
-		cmocka_unit_test(test_json_refuses_ungrouped_barbules),
-		cmocka_unit_test(test_same_seed_same_bytes_other_seed_other_bytes),
-		cmocka_unit_test(test_obj_parses_back_to_the_feather),
-		cmocka_unit_test(test_usda_counts_match),
-		cmocka_unit_test(test_read_json_errors),
-		cmocka_unit_test(test_write_to_missing_folder_fails_and_creates_nothing),
-		cmocka_unit_test(test_failed_write_leaves_existing_file),
+	    cmocka_unit_test(test_json_round_trip_hawk),
+	    cmocka_unit_test(test_json_round_trip_small_with_barbules_and_afterfeathers),
+	    cmocka_unit_test(test_json_refuses_ungrouped_barbules),
+	    cmocka_unit_test(test_same_seed_same_bytes_other_seed_other_bytes),
+	    cmocka_unit_test(test_obj_parses_back_to_the_feather),
+	    cmocka_unit_test(test_usda_counts_match),
+	    cmocka_unit_test(test_read_json_errors),
+	    cmocka_unit_test(test_write_to_missing_folder_fails_and_creates_nothing),
+	    cmocka_unit_test(test_failed_write_leaves_existing_file),
 	};
 	return cmocka_run_group_tests_name("io", tests, NULL, NULL);
 }

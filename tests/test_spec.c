@@ -61,16 +61,17 @@ static void test_minimal_spec_is_the_default_feather(void **state)
 static void test_keys_reach_the_definition(void **state)
 {
 	(void)state;
-	const char *path = spec_file("full.json", "{\"model\": \"franco-walter\", \"seed\": 77,\n"
-											  " \"shaft\": [[0,0],[0,0.01],[0,0.02],[0,0.03]],\n"
-											  " \"left_outline\": [[0,0.01],[-0.01,0.012],[-0.01,0.02],[-0.005,0.03],[0,0.031]],\n"
-											  " \"calamus_fraction\": 0.3, \"second_segment_start\": 0.5,\n"
-											  " \"shaft_samples\": 12, \"barb_samples\": 7,\n"
-											  " \"shaft_width_base\": 0.001, \"shaft_width_tip\": 0.0002,\n"
-											  " \"barb_width_base\": 0.0001, \"barb_width_tip\": 0.00002,\n"
-											  " \"segments\": [{\"barb_count\": 3, \"length_variation\": 0.1, \"shape_variation\": 0.2,\n"
-											  "   \"symmetric_vanes\": false, \"uniform_shape\": false, \"uniform_length\": true},\n"
-											  "  {\"barb_count\": 5}]}");
+	const char *path = spec_file(
+	    "full.json", "{\"model\": \"franco-walter\", \"seed\": 77,\n"
+	                 " \"shaft\": [[0,0],[0,0.01],[0,0.02],[0,0.03]],\n"
+	                 " \"left_outline\": [[0,0.01],[-0.01,0.012],[-0.01,0.02],[-0.005,0.03],[0,0.031]],\n"
+	                 " \"calamus_fraction\": 0.3, \"second_segment_start\": 0.5,\n"
+	                 " \"shaft_samples\": 12, \"barb_samples\": 7,\n"
+	                 " \"shaft_width_base\": 0.001, \"shaft_width_tip\": 0.0002,\n"
+	                 " \"barb_width_base\": 0.0001, \"barb_width_tip\": 0.00002,\n"
+	                 " \"segments\": [{\"barb_count\": 3, \"length_variation\": 0.1, \"shape_variation\": 0.2,\n"
+	                 "   \"symmetric_vanes\": false, \"uniform_shape\": false, \"uniform_length\": true},\n"
+	                 "  {\"barb_count\": 5}]}");
 	plume_fw_def def;
 	uint64_t seed = 0;
 	plume_error err = {0};
@@ -119,7 +120,7 @@ static void test_syntax_error_names_line_and_column(void **state)
 	(void)state;
 	// The missing comma is on line 3.
 	expect_error("{\n  \"model\": \"franco-walter\",\n  \"seed\": 3\n  \"barb_samples\": 10\n}", PLUME_ERROR_SYNTAX,
-				 "spec.json:4:");
+	             "spec.json:4:");
 	expect_error("{\"model\": \"franco-walter\", \"seed\": 3, \"seed\": 4}", PLUME_ERROR_SYNTAX, "duplicate");
 	expect_error("", PLUME_ERROR_SYNTAX, "spec.json:");
 }
@@ -128,10 +129,11 @@ static void test_unknown_key_names_path_and_nearest(void **state)
 {
 	(void)state;
 	expect_error("{\"model\": \"franco-walter\", \"barb_sample\": 10}", PLUME_ERROR_SPEC,
-				 "$.barb_sample: unknown key; did you mean \"barb_samples\"?");
+	             "$.barb_sample: unknown key; did you mean \"barb_samples\"?");
 	expect_error("{\"model\": \"franco-walter\", \"segments\": [{}, {\"shape_varation\": 0.1}]}", PLUME_ERROR_SPEC,
-				 "$.segments[1].shape_varation: unknown key; did you mean \"shape_variation\"?");
-	expect_error("{\"model\": \"franco-waltr\"}", PLUME_ERROR_SPEC, "$.model: unknown model \"franco-waltr\"; did you mean \"franco-walter\"?");
+	             "$.segments[1].shape_varation: unknown key; did you mean \"shape_variation\"?");
+	expect_error("{\"model\": \"franco-waltr\"}", PLUME_ERROR_SPEC,
+	             "$.model: unknown model \"franco-waltr\"; did you mean \"franco-walter\"?");
 	expect_error("{\"seed\": 1}", PLUME_ERROR_SPEC, "$.model: missing");
 }
 
@@ -139,32 +141,32 @@ static void test_out_of_range_names_path_and_range(void **state)
 {
 	(void)state;
 	expect_error("{\"model\": \"franco-walter\", \"segments\": [{}, {\"barb_count\": 6000}]}", PLUME_ERROR_SPEC,
-				 "$.segments[1].barb_count is 6000, allowed [0, 5000]");
+	             "$.segments[1].barb_count is 6000, allowed [0, 5000]");
 	expect_error("{\"model\": \"franco-walter\", \"second_segment_start\": -0.5}", PLUME_ERROR_SPEC,
-				 "$.second_segment_start is -0.5, allowed [0, 1]");
+	             "$.second_segment_start is -0.5, allowed [0, 1]");
 	expect_error("{\"model\": \"franco-walter\", \"segments\": [{\"length_variation\": 2}, {}]}", PLUME_ERROR_SPEC,
-				 "$.segments[0].length_variation is 2, allowed [0, 1]");
+	             "$.segments[0].length_variation is 2, allowed [0, 1]");
 	expect_error("{\"model\": \"franco-walter\", \"barb_width_tip\": -1e-4}", PLUME_ERROR_SPEC,
-				 "$.barb_width_tip is -0.0001, must be a positive length");
+	             "$.barb_width_tip is -0.0001, must be a positive length");
 }
 
 static void test_wrong_types_name_path(void **state)
 {
 	(void)state;
 	expect_error("{\"model\": \"franco-walter\", \"barb_samples\": \"thirty\"}", PLUME_ERROR_SPEC,
-				 "$.barb_samples: expected an integer, got a string");
+	             "$.barb_samples: expected an integer, got a string");
 	expect_error("{\"model\": \"franco-walter\", \"barb_samples\": 30.5}", PLUME_ERROR_SPEC,
-				 "$.barb_samples: expected an integer, got a number");
+	             "$.barb_samples: expected an integer, got a number");
 	expect_error("{\"model\": \"franco-walter\", \"segments\": [{\"symmetric_vanes\": 1}, {}]}", PLUME_ERROR_SPEC,
-				 "$.segments[0].symmetric_vanes: expected true or false");
+	             "$.segments[0].symmetric_vanes: expected true or false");
 	expect_error("{\"model\": \"franco-walter\", \"shaft\": [[0,0],[0,1],[0,2]]}", PLUME_ERROR_SPEC,
-				 "$.shaft: expected an array of 4 points");
+	             "$.shaft: expected an array of 4 points");
 	expect_error("{\"model\": \"franco-walter\", \"shaft\": [[0,0],[0,1],[0,\"2\"],[0,3]]}", PLUME_ERROR_SPEC,
-				 "$.shaft[2][1]: expected a number, got a string");
+	             "$.shaft[2][1]: expected a number, got a string");
 	expect_error("{\"model\": \"franco-walter\", \"segments\": [{}]}", PLUME_ERROR_SPEC,
-				 "$.segments: expected 2 segments");
+	             "$.segments: expected 2 segments");
 	expect_error("{\"model\": \"franco-walter\", \"seed\": -3}", PLUME_ERROR_SPEC,
-				 "$.seed: expected a non-negative integer");
+	             "$.seed: expected a non-negative integer");
 	expect_error("[1, 2]", PLUME_ERROR_SPEC, "$: expected an object");
 }
 
@@ -196,15 +198,15 @@ static void test_every_preset_generates(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-		cmocka_unit_test(test_minimal_spec_is_the_default_feather),
-		cmocka_unit_test(test_keys_reach_the_definition),
-		cmocka_unit_test(test_seed_option_overrides_spec),
-		cmocka_unit_test(test_syntax_error_names_line_and_column),
-		cmocka_unit_test(test_unknown_key_names_path_and_nearest),
-		cmocka_unit_test(test_out_of_range_names_path_and_range),
-		cmocka_unit_test(test_wrong_types_name_path),
-		cmocka_unit_test(test_missing_file_is_an_io_error),
-		cmocka_unit_test(test_every_preset_generates),
+	    cmocka_unit_test(test_minimal_spec_is_the_default_feather),
+	    cmocka_unit_test(test_keys_reach_the_definition),
+	    cmocka_unit_test(test_seed_option_overrides_spec),
+	    cmocka_unit_test(test_syntax_error_names_line_and_column),
+	    cmocka_unit_test(test_unknown_key_names_path_and_nearest),
+	    cmocka_unit_test(test_out_of_range_names_path_and_range),
+	    cmocka_unit_test(test_wrong_types_name_path),
+	    cmocka_unit_test(test_missing_file_is_an_io_error),
+	    cmocka_unit_test(test_every_preset_generates),
 	};
 	return cmocka_run_group_tests_name("spec", tests, setup, teardown);
 }

@@ -46,9 +46,9 @@ const char *plume_status_name(plume_status status);
 /// Fills err (when not NULL) with status and a printf-style message; returns status.
 plume_status plume_error_set(plume_error *err, plume_status status, const char *format, ...)
 #if defined(__GNUC__)
-	__attribute__((format(printf, 3, 4)))
+    __attribute__((format(printf, 3, 4)))
 #endif
-	;
+    ;
 
 /// Prepends "prefix: " to an already filled message (used to add a file name).
 void plume_error_prefix(plume_error *err, const char *prefix);
@@ -79,15 +79,30 @@ typedef struct plume_vec3 {
 } plume_vec3;
 
 static inline plume_vec3 plume_v3(double x, double y, double z) { return (plume_vec3){x, y, z}; }
-static inline plume_vec3 plume_v3_add(plume_vec3 a, plume_vec3 b) { return (plume_vec3){a.x + b.x, a.y + b.y, a.z + b.z}; }
-static inline plume_vec3 plume_v3_sub(plume_vec3 a, plume_vec3 b) { return (plume_vec3){a.x - b.x, a.y - b.y, a.z - b.z}; }
+static inline plume_vec3 plume_v3_add(plume_vec3 a, plume_vec3 b)
+{
+	return (plume_vec3){a.x + b.x, a.y + b.y, a.z + b.z};
+}
+static inline plume_vec3 plume_v3_sub(plume_vec3 a, plume_vec3 b)
+{
+	return (plume_vec3){a.x - b.x, a.y - b.y, a.z - b.z};
+}
 static inline plume_vec3 plume_v3_scale(plume_vec3 a, double s) { return (plume_vec3){a.x * s, a.y * s, a.z * s}; }
 /// a + s b
-static inline plume_vec3 plume_v3_mad(plume_vec3 a, double s, plume_vec3 b) { return (plume_vec3){a.x + s * b.x, a.y + s * b.y, a.z + s * b.z}; }
+static inline plume_vec3 plume_v3_mad(plume_vec3 a, double s, plume_vec3 b)
+{
+	return (plume_vec3){a.x + s * b.x, a.y + s * b.y, a.z + s * b.z};
+}
 /// (1 - t) a + t b
-static inline plume_vec3 plume_v3_lerp(plume_vec3 a, plume_vec3 b, double t) { return (plume_vec3){a.x + t * (b.x - a.x), a.y + t * (b.y - a.y), a.z + t * (b.z - a.z)}; }
+static inline plume_vec3 plume_v3_lerp(plume_vec3 a, plume_vec3 b, double t)
+{
+	return (plume_vec3){a.x + t * (b.x - a.x), a.y + t * (b.y - a.y), a.z + t * (b.z - a.z)};
+}
 static inline double plume_v3_dot(plume_vec3 a, plume_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-static inline plume_vec3 plume_v3_cross(plume_vec3 a, plume_vec3 b) { return (plume_vec3){a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+static inline plume_vec3 plume_v3_cross(plume_vec3 a, plume_vec3 b)
+{
+	return (plume_vec3){a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
 double plume_v3_length(plume_vec3 a);
 double plume_v3_distance(plume_vec3 a, plume_vec3 b);
 /// a / |a|; the zero vector stays zero.
@@ -149,16 +164,18 @@ double plume_bezier_closest_param(const plume_vec3 *points, int count, plume_vec
 /// A curve's cumulative arc length over a fixed partition of [0, 1], for
 /// callers that look up many lengths on one curve. Plain data on the stack;
 /// fill with plume_bezier_arc_init, read the fields, do not change them.
+#define PLUME_BEZIER_ARC_INTERVALS 256
+
 typedef struct plume_bezier_arc {
 	plume_vec3 hodograph[PLUME_BEZIER_MAX_POINTS];
 	int hodograph_count;
-	int intervals;
-	double cumulative[4 * PLUME_BEZIER_MAX_POINTS + 1]; ///< length from 0 to interval j's start
-	double length;                                      ///< the whole curve's length
+	double cumulative[PLUME_BEZIER_ARC_INTERVALS + 1]; ///< length from 0 to t = j / intervals
+	double speed[PLUME_BEZIER_ARC_INTERVALS + 1];      ///< |B'(t)| at t = j / intervals
+	double length;                                     ///< the whole curve's length
 } plume_bezier_arc;
 
 void plume_bezier_arc_init(plume_bezier_arc *arc, const plume_vec3 *points, int count);
-/// Parameter where the length from t = 0 is fraction * arc->length (Newton, to 1e-15 in t).
+/// Parameter where the length from t = 0 is fraction * arc->length, to about 1e-15 in t.
 double plume_bezier_arc_param(const plume_bezier_arc *arc, double fraction);
 
 // ---------------------------------------------------------------------------

@@ -60,8 +60,8 @@ typedef struct plume_polyline {
 typedef struct plume_barb {
 	plume_polyline curve;
 	plume_side side;
-	double rachis_t;  ///< attachment: shaft arc-length fraction of the root
-	int segment;      ///< generator-specific group (Franco–Walter: 0 below I_s, 1 above)
+	double rachis_t;   ///< attachment: shaft arc-length fraction of the root
+	int segment;       ///< generator-specific group (Franco–Walter: 0 below I_s, 1 above)
 	int barbule_first; ///< index of its first barbule (see plume_feather_barbule)
 	int barbule_count;
 } plume_barb;
@@ -69,8 +69,8 @@ typedef struct plume_barb {
 /// One barbule: a small polyline attached to a barb.
 typedef struct plume_barbule {
 	plume_polyline curve;
-	int barb;          ///< index of the barb it grows from
-	double barb_s;     ///< arc-length fraction along that barb where it attaches
+	int barb;      ///< index of the barb it grows from
+	double barb_s; ///< arc-length fraction along that barb where it attaches
 	plume_barbule_kind kind;
 } plume_barbule;
 
@@ -82,10 +82,10 @@ typedef struct plume_feather_info {
 	int barb_count_left;
 	int barb_count_right;
 	int barbule_count;
-	int point_count;          ///< all barb and barbule points
+	int point_count; ///< all barb and barbule points
 	bool has_afterfeather;
-	double shaft_length;      ///< m
-	plume_vec3 bounds_min;    ///< axis-aligned bounds of everything, afterfeather included
+	double shaft_length;   ///< m
+	plume_vec3 bounds_min; ///< axis-aligned bounds of everything, afterfeather included
 	plume_vec3 bounds_max;
 } plume_feather_info;
 

@@ -98,7 +98,7 @@ typedef struct plume_spec_options {
 /// Reads a feather spec from path and generates it. Syntax errors read
 /// "path:line:column: ..."; value errors "path: $.key.path: ...".
 plume_status plume_spec_generate(const char *path, const plume_spec_options *options, plume_feather **out,
-								 plume_error *err);
+                                 plume_error *err);
 
 /// Reads a Franco–Walter spec into def and its seed (1 when absent).
 plume_status plume_fw_def_read(const char *path, plume_fw_def *def, uint64_t *seed, plume_error *err);

@@ -81,7 +81,7 @@ plume_render2d_def plume_render2d_default_def(void);
 /// Renders the feather (and its afterfeather) to path in the given format.
 /// The file appears whole or not at all.
 plume_status plume_render2d(const plume_feather *feather, const plume_render2d_def *def, plume_image_format format,
-							const char *path, plume_error *err);
+                            const char *path, plume_error *err);
 
 #ifdef __cplusplus
 }

@@ -19,7 +19,7 @@ plume_status plume_atomic_open(plume_atomic_file *file, const char *path, plume_
 	const char *slash = strrchr(path, '/');
 	int dir_length = slash != NULL ? (int)(slash - path + 1) : 0;
 	snprintf(file->tmp_path, sizeof file->tmp_path, "%.*s.%s.XXXXXX", dir_length, path,
-			 slash != NULL ? slash + 1 : path);
+	         slash != NULL ? slash + 1 : path);
 	int fd = mkstemp(file->tmp_path);
 	if (fd < 0)
 		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write: %s", path, strerror(errno));

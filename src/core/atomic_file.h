@@ -8,7 +8,7 @@
 #include "plume/core.h"
 
 typedef struct plume_atomic_file {
-	FILE *stream;         ///< write here (NULL for writers that need a path: use tmp_path)
+	FILE *stream; ///< write here (NULL for writers that need a path: use tmp_path)
 	char final_path[4096];
 	char tmp_path[4096];
 } plume_atomic_file;

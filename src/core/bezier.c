@@ -20,8 +20,15 @@ plume_vec3 plume_bezier_eval(const plume_vec3 *points, int count, double t)
 		double s = 1.0 - t;
 		double b0 = s * s * s, b1 = 3.0 * s * s * t, b2 = 3.0 * s * t * t, b3 = t * t * t;
 		return (plume_vec3){b0 * points[0].x + b1 * points[1].x + b2 * points[2].x + b3 * points[3].x,
-							b0 * points[0].y + b1 * points[1].y + b2 * points[2].y + b3 * points[3].y,
-							b0 * points[0].z + b1 * points[1].z + b2 * points[2].z + b3 * points[3].z};
+		                    b0 * points[0].y + b1 * points[1].y + b2 * points[2].y + b3 * points[3].y,
+		                    b0 * points[0].z + b1 * points[1].z + b2 * points[2].z + b3 * points[3].z};
+	}
+	if (count == 3) { // the hodograph of a cubic, in every arc-length quadrature
+		double s = 1.0 - t;
+		double b0 = s * s, b1 = 2.0 * s * t, b2 = t * t;
+		return (plume_vec3){b0 * points[0].x + b1 * points[1].x + b2 * points[2].x,
+		                    b0 * points[0].y + b1 * points[1].y + b2 * points[2].y,
+		                    b0 * points[0].z + b1 * points[1].z + b2 * points[2].z};
 	}
 	plume_vec3 work[PLUME_BEZIER_MAX_POINTS];
 	memcpy(work, points, (size_t)count * sizeof *points);
@@ -85,10 +92,8 @@ void plume_bezier_split(const plume_vec3 *points, int count, double t, plume_vec
 // ---------------------------------------------------------------------------
 // Arc length
 
-static const double gl8_nodes[4] = {0.1834346424956498, 0.5255324099163290, 0.7966664774136267,
-									0.9602898564975363};
-static const double gl8_weights[4] = {0.3626837833783620, 0.3137066458778873, 0.2223810344533745,
-									  0.1012285362903763};
+static const double gl8_nodes[4] = {0.1834346424956498, 0.5255324099163290, 0.7966664774136267, 0.9602898564975363};
+static const double gl8_weights[4] = {0.3626837833783620, 0.3137066458778873, 0.2223810344533745, 0.1012285362903763};
 
 // The speed |B'(t)| is the length of the hodograph, evaluated by de Casteljau.
 static double speed_at(const plume_vec3 *hodograph, int count, double t)
@@ -101,19 +106,19 @@ static double gauss8(const plume_vec3 *hodograph, int count, double a, double b)
 	double mid = 0.5 * (a + b), half = 0.5 * (b - a), sum = 0.0;
 	for (int i = 0; i < 4; ++i)
 		sum += gl8_weights[i] * (speed_at(hodograph, count, mid - half * gl8_nodes[i]) +
-								 speed_at(hodograph, count, mid + half * gl8_nodes[i]));
+		                         speed_at(hodograph, count, mid + half * gl8_nodes[i]));
 	return sum * half;
 }
 
 static double adaptive_length(const plume_vec3 *hodograph, int count, double a, double b, double whole,
-							  double tolerance, int depth)
+                              double tolerance, int depth)
 {
 	double mid = 0.5 * (a + b);
 	double left = gauss8(hodograph, count, a, mid), right = gauss8(hodograph, count, mid, b);
 	if (depth >= 30 || fabs(left + right - whole) <= tolerance)
 		return left + right;
 	return adaptive_length(hodograph, count, a, mid, left, 0.5 * tolerance, depth + 1) +
-		   adaptive_length(hodograph, count, mid, b, right, 0.5 * tolerance, depth + 1);
+	       adaptive_length(hodograph, count, mid, b, right, 0.5 * tolerance, depth + 1);
 }
 
 /// Writes the hodograph (a single zero point for a point curve); returns its count.
@@ -153,19 +158,44 @@ double plume_bezier_length(const plume_vec3 *points, int count, double t0, doubl
 void plume_bezier_arc_init(plume_bezier_arc *arc, const plume_vec3 *points, int count)
 {
 	arc->hodograph_count = hodograph_of(points, count, arc->hodograph);
-	int intervals = 4 * count;
-	arc->intervals = intervals < 16 ? 16 : intervals;
 	double scale = control_polygon_length(points, count);
+	const int intervals = PLUME_BEZIER_ARC_INTERVALS;
 	arc->cumulative[0] = 0.0;
-	for (int j = 0; j < arc->intervals; ++j) {
-		double a = (double)j / arc->intervals, b = (double)(j + 1) / arc->intervals;
-		arc->cumulative[j + 1] = arc->cumulative[j] + curve_length(arc->hodograph, arc->hodograph_count, scale, a, b);
+	for (int j = 0; j <= intervals; ++j) {
+		double a = (double)j / intervals;
+		arc->speed[j] = speed_at(arc->hodograph, arc->hodograph_count, a);
+		if (j < intervals)
+			arc->cumulative[j + 1] = arc->cumulative[j] + curve_length(arc->hodograph, arc->hodograph_count, scale, a,
+			                                                           (double)(j + 1) / intervals);
 	}
-	arc->length = arc->cumulative[arc->intervals];
+	arc->length = arc->cumulative[intervals];
+}
+
+/// First guess inside interval j: invert the cubic Hermite interpolant of the
+/// length (values and speeds at both ends), whose error is O(h^4).
+static double hermite_guess(const plume_bezier_arc *arc, int j, double target)
+{
+	const double h = 1.0 / PLUME_BEZIER_ARC_INTERVALS;
+	double span = arc->cumulative[j + 1] - arc->cumulative[j];
+	double goal = target - arc->cumulative[j];
+	double d0 = arc->speed[j] * h, d1 = arc->speed[j + 1] * h;
+	double u = goal / span;
+	for (int iteration = 0; iteration < 4; ++iteration) {
+		// H(u) = span (3u^2 - 2u^3) + d0 (u - 2u^2 + u^3) + d1 (u^3 - u^2)
+		double u2 = u * u, u3 = u2 * u;
+		double value = span * (3 * u2 - 2 * u3) + d0 * (u - 2 * u2 + u3) + d1 * (u3 - u2);
+		double slope = span * (6 * u - 6 * u2) + d0 * (1 - 4 * u + 3 * u2) + d1 * (3 * u2 - 2 * u);
+		if (!(slope > 0.0))
+			break;
+		double next = u - (value - goal) / slope;
+		u = next < 0.0 ? 0.0 : (next > 1.0 ? 1.0 : next);
+	}
+	return ((double)j + u) * h;
 }
 
 double plume_bezier_arc_param(const plume_bezier_arc *arc, double fraction)
 {
+	const int intervals = PLUME_BEZIER_ARC_INTERVALS;
 	double total = arc->length;
 	if (total <= 0.0) // a point: any parameter is as good; keep them spread
 		return fraction <= 0.0 ? 0.0 : (fraction >= 1.0 ? 1.0 : fraction);
@@ -174,7 +204,7 @@ double plume_bezier_arc_param(const plume_bezier_arc *arc, double fraction)
 		return 0.0;
 	if (target >= total)
 		return 1.0;
-	int lo = 0, hi = arc->intervals;
+	int lo = 0, hi = intervals;
 	while (hi - lo > 1) {
 		int mid = (lo + hi) / 2;
 		if (arc->cumulative[mid] <= target)
@@ -182,10 +212,13 @@ double plume_bezier_arc_param(const plume_bezier_arc *arc, double fraction)
 		else
 			hi = mid;
 	}
-	double a = (double)lo / arc->intervals, b = (double)(lo + 1) / arc->intervals;
-	double base = arc->cumulative[lo], span = arc->cumulative[lo + 1] - base;
-	double t = span > 0.0 ? a + (b - a) * (target - base) / span : a;
-	// Newton on f(t) = length(a, t) - (target - base), kept inside a shrinking bracket.
+	double a = (double)lo / intervals, b = (double)(lo + 1) / intervals;
+	double base = arc->cumulative[lo];
+	double t = arc->cumulative[lo + 1] > base ? hermite_guess(arc, lo, target) : a;
+	// Newton on f(t) = length(a, t) - (target - base), kept inside a shrinking
+	// bracket. The Hermite guess is within about 1e-10 of the root, so one step
+	// usually lands to rounding: a step below 1e-9 leaves an error of order
+	// step^2 and is accepted without another quadrature.
 	double lower = a, upper = b;
 	for (int iteration = 0; iteration < 60; ++iteration) {
 		double f = gauss8(arc->hodograph, arc->hodograph_count, a, t) - (target - base);
@@ -194,11 +227,12 @@ double plume_bezier_arc_param(const plume_bezier_arc *arc, double fraction)
 		else
 			lower = t;
 		double speed = speed_at(arc->hodograph, arc->hodograph_count, t);
-		double next = speed > 0.0 ? t - f / speed : 0.5 * (lower + upper);
+		double step = speed > 0.0 ? f / speed : INFINITY;
+		if (fabs(step) <= 1e-9)
+			return t - step;
+		double next = t - step;
 		if (!(next > lower && next < upper))
 			next = 0.5 * (lower + upper);
-		if (fabs(next - t) <= 1e-15)
-			return next;
 		t = next;
 	}
 	return t;

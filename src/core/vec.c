@@ -36,15 +36,15 @@ plume_mat3 plume_m3_transpose(plume_mat3 a)
 plume_vec3 plume_m3_apply(plume_mat3 a, plume_vec3 v)
 {
 	return (plume_vec3){a.m[0][0] * v.x + a.m[0][1] * v.y + a.m[0][2] * v.z,
-						a.m[1][0] * v.x + a.m[1][1] * v.y + a.m[1][2] * v.z,
-						a.m[2][0] * v.x + a.m[2][1] * v.y + a.m[2][2] * v.z};
+	                    a.m[1][0] * v.x + a.m[1][1] * v.y + a.m[1][2] * v.z,
+	                    a.m[2][0] * v.x + a.m[2][1] * v.y + a.m[2][2] * v.z};
 }
 
 double plume_m3_det(plume_mat3 a)
 {
 	return a.m[0][0] * (a.m[1][1] * a.m[2][2] - a.m[1][2] * a.m[2][1]) -
-		   a.m[0][1] * (a.m[1][0] * a.m[2][2] - a.m[1][2] * a.m[2][0]) +
-		   a.m[0][2] * (a.m[1][0] * a.m[2][1] - a.m[1][1] * a.m[2][0]);
+	       a.m[0][1] * (a.m[1][0] * a.m[2][2] - a.m[1][2] * a.m[2][0]) +
+	       a.m[0][2] * (a.m[1][0] * a.m[2][1] - a.m[1][1] * a.m[2][0]);
 }
 
 plume_mat3 plume_m3_rotation(plume_vec3 axis, double angle)
@@ -53,6 +53,6 @@ plume_mat3 plume_m3_rotation(plume_vec3 axis, double angle)
 	double c = cos(angle), s = sin(angle), v = 1.0 - c;
 	double x = axis.x, y = axis.y, z = axis.z;
 	return (plume_mat3){{{c + v * x * x, v * x * y - s * z, v * x * z + s * y},
-						 {v * x * y + s * z, c + v * y * y, v * y * z - s * x},
-						 {v * x * z - s * y, v * y * z + s * x, c + v * z * z}}};
+	                     {v * x * y + s * z, c + v * y * y, v * y * z - s * x},
+	                     {v * x * z - s * y, v * y * z + s * x, c + v * z * z}}};
 }

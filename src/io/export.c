@@ -58,7 +58,7 @@ bool plume_curve_set_get(const plume_feather *feather, plume_curve_set set, int 
 	} else {
 		plume_barb barb = plume_feather_barb(feather, i);
 		if ((set == PLUME_CURVES_LEFT && barb.side != PLUME_SIDE_LEFT) ||
-			(set == PLUME_CURVES_RIGHT && barb.side != PLUME_SIDE_RIGHT))
+		    (set == PLUME_CURVES_RIGHT && barb.side != PLUME_SIDE_RIGHT))
 			return false;
 		*curve = barb.curve;
 	}

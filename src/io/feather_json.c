@@ -32,8 +32,8 @@ _Static_assert(sizeof(plume_vec2) == 2 * sizeof(double), "plume_vec2 must be two
 #define FORMAT_NAME "plume-feather"
 #define FORMAT_VERSION 1
 
-static const char *const side_names[] = {"left", "right"};              // plume_side
-static const char *const kind_names[] = {"distal", "proximal"};         // plume_barbule_kind
+static const char *const side_names[] = {"left", "right"};      // plume_side
+static const char *const kind_names[] = {"distal", "proximal"}; // plume_barbule_kind
 
 // ---------------------------------------------------------------------------
 // Writing
@@ -136,15 +136,14 @@ static void pad(FILE *stream, int level)
 }
 
 /// Encodes a value built by the functions above (and frees it).
-static plume_status dump(FILE *stream, json_t *value, builder *b, const char *path, const char *what,
-						 plume_error *err)
+static plume_status dump(FILE *stream, json_t *value, builder *b, const char *path, const char *what, plume_error *err)
 {
 	bool whole = value != NULL && !b->failed && !b->non_finite;
 	int result = whole ? json_dumpf(value, stream, DUMP_FLAGS) : -1;
 	json_decref(value);
 	if (b->non_finite)
 		return plume_error_set(err, PLUME_ERROR_NUMERIC, "%s: %s has a NaN or infinite number, which JSON cannot hold",
-							   path, what);
+		                       path, what);
 	if (!whole)
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "%s: out of memory", path);
 	if (result != 0)
@@ -155,7 +154,7 @@ static plume_status dump(FILE *stream, json_t *value, builder *b, const char *pa
 /// The members every feather object has ("shaft", "barbs", "afterfeather"),
 /// indented by level; the caller writes the braces.
 static plume_status write_members(FILE *stream, const plume_feather *feather, int level, const char *path,
-								  plume_error *err)
+                                  plume_error *err)
 {
 	builder b = {0};
 	pad(stream, level);
@@ -216,7 +215,7 @@ static bool barbules_grouped(const plume_feather *feather, int *bad_barb)
 		if (barb.barbule_count == 0)
 			continue;
 		bool ok = barb.barbule_first == next && barb.barbule_count > 0 &&
-				  barb.barbule_count <= info.barbule_count - barb.barbule_first;
+		          barb.barbule_count <= info.barbule_count - barb.barbule_first;
 		for (int j = 0; ok && j < barb.barbule_count; ++j)
 			ok = plume_feather_barbule(feather, next + j).barb == i;
 		if (!ok) {
@@ -238,9 +237,9 @@ plume_status plume_write_json(const plume_feather *feather, const char *path, pl
 	int bad_barb;
 	if (!barbules_grouped(feather, &bad_barb))
 		return plume_error_set(err, PLUME_ERROR_UNSUPPORTED,
-							   "%s: cannot write: the feather's barbules are not grouped by barb in order "
-							   "(first mismatch at barb %d)",
-							   path, bad_barb);
+		                       "%s: cannot write: the feather's barbules are not grouped by barb in order "
+		                       "(first mismatch at barb %d)",
+		                       path, bad_barb);
 	plume_text_file text;
 	plume_status status = plume_text_open(&text, path, err);
 	if (status != PLUME_OK)
@@ -265,9 +264,9 @@ typedef struct reader {
 /// Appends to the path; returns the length to restore with leave.
 static size_t enter(reader *r, const char *format, ...)
 #if defined(__GNUC__)
-	__attribute__((format(printf, 2, 3)))
+    __attribute__((format(printf, 2, 3)))
 #endif
-	;
+    ;
 
 static size_t enter(reader *r, const char *format, ...)
 {
@@ -289,9 +288,9 @@ static void leave(reader *r, size_t mark)
 
 static plume_status fail(reader *r, const char *format, ...)
 #if defined(__GNUC__)
-	__attribute__((format(printf, 2, 3)))
+    __attribute__((format(printf, 2, 3)))
 #endif
-	;
+    ;
 
 /// A schema error at the current path: "file: $.barbs[3].position: message".
 static plume_status fail(reader *r, const char *format, ...)
@@ -332,7 +331,7 @@ static plume_status check_object(reader *r, json_t *value, const char *what, con
 		return fail(r, "expected an object (%s)", what);
 	const char *key;
 	json_t *member;
-	json_object_foreach(value, key, member) {
+	json_object_foreach (value, key, member) {
 		if (!in_list(key, keys, count))
 			return fail(r, "unknown key \"%s\"", key);
 	}
@@ -360,7 +359,7 @@ static plume_status read_int(reader *r, json_t *object, const char *key, json_in
 	if (number < lo || number > hi) {
 		enter(r, ".%s", key);
 		return fail(r, "%" JSON_INTEGER_FORMAT " is out of range [%" JSON_INTEGER_FORMAT ", %" JSON_INTEGER_FORMAT "]",
-					number, lo, hi);
+		            number, lo, hi);
 	}
 	*out = (int)number;
 	return PLUME_OK;
@@ -398,7 +397,7 @@ static plume_status read_count(reader *r, json_t *object, const char *key, int c
 /// Reads object[key], count items of components numbers each, into the doubles
 /// at base + i * stride (base is not touched when count is 0).
 static plume_status read_numbers(reader *r, json_t *object, const char *key, int components, int count, void *base,
-								 size_t stride)
+                                 size_t stride)
 {
 	json_t *array = json_object_get(object, key);
 	size_t expected = (size_t)count * (size_t)components;
@@ -407,7 +406,7 @@ static plume_status read_numbers(reader *r, json_t *object, const char *key, int
 		return fail(r, "expected an array of %zu numbers (%d per point)", expected, components);
 	if (json_array_size(array) != expected)
 		return fail(r, "expected %zu numbers (%d per point, %d points), found %zu", expected, components, count,
-					json_array_size(array));
+		            json_array_size(array));
 	for (size_t k = 0; k < expected; ++k) {
 		json_t *value = json_array_get(array, k);
 		if (!json_is_number(value)) {
@@ -437,15 +436,15 @@ static plume_status read_polyline(reader *r, json_t *object, plume_feather *feat
 	*range = (plume_curve_range){first, count};
 	bool any = count > 0; // no pointer arithmetic on a pool that may still be NULL
 	if ((status = read_numbers(r, object, "position", 3, count, any ? (void *)(feather->points + first) : NULL,
-							   sizeof(plume_vec3))) != PLUME_OK ||
-		(status = read_numbers(r, object, "normal", 3, count, any ? (void *)(feather->normals + first) : NULL,
-							   sizeof(plume_vec3))) != PLUME_OK ||
-		(status = read_numbers(r, object, "arc_length", 1, count,
-							   any ? (void *)(feather->arc_length + first) : NULL, sizeof(double))) != PLUME_OK ||
-		(status = read_numbers(r, object, "width", 1, count, any ? (void *)(feather->widths + first) : NULL,
-							   sizeof(double))) != PLUME_OK ||
-		(status = read_numbers(r, object, "uv", 2, count, any ? (void *)(feather->uv + first) : NULL,
-							   sizeof(plume_vec2))) != PLUME_OK)
+	                           sizeof(plume_vec3))) != PLUME_OK ||
+	    (status = read_numbers(r, object, "normal", 3, count, any ? (void *)(feather->normals + first) : NULL,
+	                           sizeof(plume_vec3))) != PLUME_OK ||
+	    (status = read_numbers(r, object, "arc_length", 1, count, any ? (void *)(feather->arc_length + first) : NULL,
+	                           sizeof(double))) != PLUME_OK ||
+	    (status = read_numbers(r, object, "width", 1, count, any ? (void *)(feather->widths + first) : NULL,
+	                           sizeof(double))) != PLUME_OK ||
+	    (status = read_numbers(r, object, "uv", 2, count, any ? (void *)(feather->uv + first) : NULL,
+	                           sizeof(plume_vec2))) != PLUME_OK)
 		return status;
 	return PLUME_OK;
 }
@@ -462,12 +461,11 @@ static plume_status read_shaft(reader *r, json_t *object, plume_feather *feather
 		return out_of_memory(r);
 	size_t stride = sizeof(plume_shaft_sample);
 	if ((status = read_numbers(r, object, "position", 3, count, shaft ? &shaft->position : NULL, stride)) != PLUME_OK ||
-		(status = read_numbers(r, object, "tangent", 3, count, shaft ? &shaft->tangent : NULL, stride)) != PLUME_OK ||
-		(status = read_numbers(r, object, "normal", 3, count, shaft ? &shaft->normal : NULL, stride)) != PLUME_OK ||
-		(status = read_numbers(r, object, "binormal", 3, count, shaft ? &shaft->binormal : NULL, stride)) !=
-			PLUME_OK ||
-		(status = read_numbers(r, object, "width", 1, count, shaft ? &shaft->width : NULL, stride)) != PLUME_OK ||
-		(status = read_numbers(r, object, "t", 1, count, shaft ? &shaft->t : NULL, stride)) != PLUME_OK)
+	    (status = read_numbers(r, object, "tangent", 3, count, shaft ? &shaft->tangent : NULL, stride)) != PLUME_OK ||
+	    (status = read_numbers(r, object, "normal", 3, count, shaft ? &shaft->normal : NULL, stride)) != PLUME_OK ||
+	    (status = read_numbers(r, object, "binormal", 3, count, shaft ? &shaft->binormal : NULL, stride)) != PLUME_OK ||
+	    (status = read_numbers(r, object, "width", 1, count, shaft ? &shaft->width : NULL, stride)) != PLUME_OK ||
+	    (status = read_numbers(r, object, "t", 1, count, shaft ? &shaft->t : NULL, stride)) != PLUME_OK)
 		return status;
 	return read_int(r, object, "calamus_samples", 0, count, &feather->calamus_count);
 }
@@ -479,8 +477,8 @@ static plume_status read_barbule(reader *r, json_t *object, plume_feather *feath
 	int kind = 0;
 	plume_status status = check_object(r, object, "a barbule", keys, sizeof keys / sizeof keys[0]);
 	if (status != PLUME_OK || (status = read_number(r, object, "barb_s", &record.barb_s)) != PLUME_OK ||
-		(status = read_name(r, object, "kind", kind_names, &kind)) != PLUME_OK ||
-		(status = read_polyline(r, object, feather, &record.curve)) != PLUME_OK)
+	    (status = read_name(r, object, "kind", kind_names, &kind)) != PLUME_OK ||
+	    (status = read_polyline(r, object, feather, &record.curve)) != PLUME_OK)
 		return status;
 	record.kind = (plume_barbule_kind)kind;
 	return plume_feather_add_barbule(feather, &record) < 0 ? out_of_memory(r) : PLUME_OK;
@@ -488,15 +486,15 @@ static plume_status read_barbule(reader *r, json_t *object, plume_feather *feath
 
 static plume_status read_barb(reader *r, json_t *object, plume_feather *feather)
 {
-	static const char *const keys[] = {"side", "rachis_t", "segment", "position", "normal",
-									   "arc_length", "width", "uv", "barbules"};
+	static const char *const keys[] = {"side",       "rachis_t", "segment", "position", "normal",
+	                                   "arc_length", "width",    "uv",      "barbules"};
 	plume_barb_record record = {0};
 	int side = 0;
 	plume_status status = check_object(r, object, "a barb", keys, sizeof keys / sizeof keys[0]);
 	if (status != PLUME_OK || (status = read_name(r, object, "side", side_names, &side)) != PLUME_OK ||
-		(status = read_number(r, object, "rachis_t", &record.rachis_t)) != PLUME_OK ||
-		(status = read_int(r, object, "segment", INT_MIN, INT_MAX, &record.segment)) != PLUME_OK ||
-		(status = read_polyline(r, object, feather, &record.curve)) != PLUME_OK)
+	    (status = read_number(r, object, "rachis_t", &record.rachis_t)) != PLUME_OK ||
+	    (status = read_int(r, object, "segment", INT_MIN, INT_MAX, &record.segment)) != PLUME_OK ||
+	    (status = read_polyline(r, object, feather, &record.curve)) != PLUME_OK)
 		return status;
 	record.side = (plume_side)side;
 
@@ -508,7 +506,7 @@ static plume_status read_barb(reader *r, json_t *object, plume_feather *feather)
 	record.barbule_first = feather->barbule_count;
 	size_t i;
 	json_t *item;
-	json_array_foreach(barbules, i, item) {
+	json_array_foreach (barbules, i, item) {
 		size_t mark = enter(r, ".barbules[%zu]", i);
 		if ((status = read_barbule(r, item, feather, index)) != PLUME_OK)
 			return status;
@@ -548,7 +546,7 @@ static plume_status read_feather(reader *r, json_t *object, plume_feather *feath
 		return fail_at(r, "barbs", "expected an array");
 	size_t i;
 	json_t *item;
-	json_array_foreach(barbs, i, item) {
+	json_array_foreach (barbs, i, item) {
 		mark = enter(r, ".barbs[%zu]", i);
 		if ((status = read_barb(r, item, feather)) != PLUME_OK)
 			return status;
@@ -561,7 +559,7 @@ static plume_status read_feather(reader *r, json_t *object, plume_feather *feath
 	static const char *const after_keys[] = {"t", "feather"};
 	mark = enter(r, ".afterfeather");
 	if ((status = check_object(r, after, "the afterfeather, or null", after_keys, 2)) != PLUME_OK ||
-		(status = read_number(r, after, "t", &feather->afterfeather_t)) != PLUME_OK)
+	    (status = read_number(r, after, "t", &feather->afterfeather_t)) != PLUME_OK)
 		return status;
 	// Attached before it is filled, so that destroying the parent frees it on any error.
 	if ((feather->afterfeather = plume_feather_create_empty()) == NULL)

@@ -12,8 +12,6 @@
 #define _POSIX_C_SOURCE 200809L
 #include "export.h"
 
-#include <string.h>
-
 #include "plume/io.h"
 
 /// Object names grow by this prefix at each afterfeather level.
@@ -42,7 +40,7 @@ static void write_shaft(FILE *stream, const plume_feather *feather, const char *
 /// then one "l" per curve. Every vertex has exactly one texture coordinate, so
 /// the v and vt indices are the same number.
 static void write_curves(FILE *stream, const plume_feather *feather, plume_curve_set set, const char *prefix,
-						 const char *name, long long *next)
+                         const char *name, long long *next)
 {
 	int curves;
 	int64_t points;
@@ -96,14 +94,14 @@ plume_status plume_write_obj(const plume_feather *feather, const char *path, plu
 		return status;
 	plume_feather_info info = plume_feather_get_info(feather);
 	fprintf(text.stream,
-			"# plume %s: a feather as polylines (l v/vt ...)\n"
-			"# units: metres; the shaft runs along +y, the vanes lie near z = 0, +z is the front\n"
-			"# texture coordinates: barbs s = arc-length fraction from the rachis, t = shaft fraction of the root;"
-			" shaft s = 0, t = shaft fraction\n"
-			"# %d shaft samples, %d barbs (%d left, %d right), %d barbules, %d barb and barbule points, "
-			"afterfeather: %s\n",
-			PLUME_VERSION_STRING, info.shaft_sample_count, info.barb_count, info.barb_count_left,
-			info.barb_count_right, info.barbule_count, info.point_count, info.has_afterfeather ? "yes" : "no");
+	        "# plume %s: a feather as polylines (l v/vt ...)\n"
+	        "# units: metres; the shaft runs along +y, the vanes lie near z = 0, +z is the front\n"
+	        "# texture coordinates: barbs s = arc-length fraction from the rachis, t = shaft fraction of the root;"
+	        " shaft s = 0, t = shaft fraction\n"
+	        "# %d shaft samples, %d barbs (%d left, %d right), %d barbules, %d barb and barbule points, "
+	        "afterfeather: %s\n",
+	        PLUME_VERSION_STRING, info.shaft_sample_count, info.barb_count, info.barb_count_left, info.barb_count_right,
+	        info.barbule_count, info.point_count, info.has_afterfeather ? "yes" : "no");
 	long long next = 1; // OBJ indices are 1-based and count across objects
 	write_feather(text.stream, feather, "", &next);
 	return plume_text_close(&text, PLUME_OK, err);

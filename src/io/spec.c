@@ -96,14 +96,13 @@ const char *plume_spec_nearest(const char *word, const char *const *allowed)
 }
 
 void plume_spec_check_keys(plume_spec_reader *reader, const json_t *object, const char *path,
-						   const char *const *allowed)
+                           const char *const *allowed)
 {
 	if (reader->status != PLUME_OK)
 		return;
 	const char *key;
 	json_t *value;
-	json_object_foreach((json_t *)object, key, value)
-	{
+	json_object_foreach ((json_t *)object, key, value) {
 		bool known = false;
 		for (const char *const *candidate = allowed; *candidate != NULL && !known; ++candidate)
 			known = strcmp(key, *candidate) == 0;
@@ -178,7 +177,7 @@ bool plume_spec_int(plume_spec_reader *reader, const json_t *object, const char 
 }
 
 bool plume_spec_uint64(plume_spec_reader *reader, const json_t *object, const char *path, const char *key,
-					   uint64_t *out)
+                       uint64_t *out)
 {
 	const json_t *value = member(reader, object, key);
 	if (value == NULL)
@@ -209,7 +208,7 @@ bool plume_spec_bool(plume_spec_reader *reader, const json_t *object, const char
 }
 
 bool plume_spec_string(plume_spec_reader *reader, const json_t *object, const char *path, const char *key,
-					   const char **out)
+                       const char **out)
 {
 	const json_t *value = member(reader, object, key);
 	if (value == NULL)
@@ -225,7 +224,7 @@ bool plume_spec_string(plume_spec_reader *reader, const json_t *object, const ch
 }
 
 bool plume_spec_points2(plume_spec_reader *reader, const json_t *object, const char *path, const char *key,
-						plume_vec2 *out, int count)
+                        plume_vec2 *out, int count)
 {
 	const json_t *value = member(reader, object, key);
 	if (value == NULL)
@@ -258,7 +257,7 @@ bool plume_spec_points2(plume_spec_reader *reader, const json_t *object, const c
 }
 
 static const json_t *typed_member(plume_spec_reader *reader, const json_t *object, const char *path, const char *key,
-								  json_type type, const char *expected)
+                                  json_type type, const char *expected)
 {
 	const json_t *value = member(reader, object, key);
 	if (value == NULL)

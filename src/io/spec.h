@@ -32,14 +32,14 @@ plume_spec_reader plume_spec_reader_begin(const char *file, plume_error *err);
 /// Records an error at path ("file: path: message").
 void plume_spec_fail(plume_spec_reader *reader, const char *path, const char *format, ...)
 #if defined(__GNUC__)
-	__attribute__((format(printf, 3, 4)))
+    __attribute__((format(printf, 3, 4)))
 #endif
-	;
+    ;
 
 /// Fails on the first key of object not in allowed (NULL-terminated), naming
 /// the nearest allowed key.
 void plume_spec_check_keys(plume_spec_reader *reader, const json_t *object, const char *path,
-						   const char *const *allowed);
+                           const char *const *allowed);
 
 /// Writes "parent.key" into out (the JSON path of a child).
 void plume_spec_path(char *out, size_t size, const char *parent, const char *key);
@@ -53,14 +53,14 @@ void plume_spec_index_path(char *out, size_t size, const char *parent, size_t in
 bool plume_spec_number(plume_spec_reader *reader, const json_t *object, const char *path, const char *key, double *out);
 bool plume_spec_int(plume_spec_reader *reader, const json_t *object, const char *path, const char *key, int *out);
 bool plume_spec_uint64(plume_spec_reader *reader, const json_t *object, const char *path, const char *key,
-					   uint64_t *out);
+                       uint64_t *out);
 bool plume_spec_bool(plume_spec_reader *reader, const json_t *object, const char *path, const char *key, bool *out);
 /// A string; *out points into the JSON tree.
 bool plume_spec_string(plume_spec_reader *reader, const json_t *object, const char *path, const char *key,
-					   const char **out);
+                       const char **out);
 /// An array of exactly count points [x, y].
 bool plume_spec_points2(plume_spec_reader *reader, const json_t *object, const char *path, const char *key,
-						plume_vec2 *out, int count);
+                        plume_vec2 *out, int count);
 /// An object member (NULL when absent); fails when present but not an object.
 const json_t *plume_spec_object(plume_spec_reader *reader, const json_t *object, const char *path, const char *key);
 /// An array member (NULL when absent); fails when present but not an array.

@@ -21,7 +21,7 @@ plume_status plume_fw_def_read(const char *path, plume_fw_def *def, uint64_t *se
 }
 
 plume_status plume_spec_generate(const char *path, const plume_spec_options *options, plume_feather **out,
-								 plume_error *err)
+                                 plume_error *err)
 {
 	*out = NULL;
 	json_t *root = plume_spec_load(path, err);
@@ -46,7 +46,7 @@ plume_status plume_spec_generate(const char *path, const plume_spec_options *opt
 		}
 	} else if (status == PLUME_OK) {
 		plume_spec_fail(&reader, "$.model", "unknown model \"%s\"; did you mean \"%s\"? (known: franco-walter)", model,
-						plume_spec_nearest(model, model_names));
+		                plume_spec_nearest(model, model_names));
 		status = reader.status;
 	}
 	json_decref(root);

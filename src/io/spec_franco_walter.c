@@ -5,15 +5,26 @@
 #include "spec_models.h"
 
 static const char *const top_keys[] = {
-	"model",          "seed",         "shaft",           "left_outline",     "right_outline",
-	"calamus_fraction", "segments",   "second_segment_start", "shaft_samples", "barb_samples",
-	"shaft_width_base", "shaft_width_tip", "barb_width_base", "barb_width_tip", "description",
-	NULL,
+    "model",
+    "seed",
+    "shaft",
+    "left_outline",
+    "right_outline",
+    "calamus_fraction",
+    "segments",
+    "second_segment_start",
+    "shaft_samples",
+    "barb_samples",
+    "shaft_width_base",
+    "shaft_width_tip",
+    "barb_width_base",
+    "barb_width_tip",
+    "description",
+    NULL,
 };
 
 static const char *const segment_keys[] = {
-	"barb_count",   "length_variation", "shape_variation", "symmetric_vanes",
-	"uniform_shape", "uniform_length",  NULL,
+    "barb_count", "length_variation", "shape_variation", "symmetric_vanes", "uniform_shape", "uniform_length", NULL,
 };
 
 static void read_segment(plume_spec_reader *reader, const json_t *object, const char *path, plume_fw_segment *segment)
@@ -32,7 +43,7 @@ static void read_segment(plume_spec_reader *reader, const json_t *object, const 
 }
 
 plume_status plume_fw_def_from_json(const char *file, const json_t *root, plume_fw_def *def, uint64_t *seed,
-									plume_error *err)
+                                    plume_error *err)
 {
 	*def = plume_fw_default_def();
 	*seed = 1;
@@ -60,8 +71,8 @@ plume_status plume_fw_def_from_json(const char *file, const json_t *root, plume_
 	if (segments != NULL) {
 		if (json_array_size(segments) != 2) {
 			plume_spec_fail(&reader, "$.segments",
-							"expected 2 segments (below and above second_segment_start), got %zu",
-							json_array_size(segments));
+			                "expected 2 segments (below and above second_segment_start), got %zu",
+			                json_array_size(segments));
 		}
 		for (size_t i = 0; i < 2 && reader.status == PLUME_OK; ++i) {
 			char path[64];

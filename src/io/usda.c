@@ -126,7 +126,7 @@ typedef enum point_data { POINT_POSITION, POINT_NORMAL, POINT_WIDTH, POINT_UV } 
 /// One per-point array of every curve in the set, a curve per line (USD text
 /// allows line breaks inside arrays; one line per curve keeps files readable).
 static void write_point_data(FILE *stream, const plume_feather *feather, plume_curve_set set, int depth,
-							 point_data data)
+                             point_data data)
 {
 	int range = plume_curve_set_range(feather, set);
 	bool first = true;
@@ -176,8 +176,7 @@ static void write_curve_data(FILE *stream, const plume_feather *feather, plume_c
 }
 
 /// One BasisCurves prim with every curve of the set, as oriented ribbons.
-static void write_curves(FILE *stream, const plume_feather *feather, plume_curve_set set, const char *name,
-						 int depth)
+static void write_curves(FILE *stream, const plume_feather *feather, plume_curve_set set, const char *name, int depth)
 {
 	int curves;
 	int64_t points;
@@ -226,10 +225,10 @@ static void write_curves(FILE *stream, const plume_feather *feather, plume_curve
 		const char *name;
 		bool barbs; // a barb attribute (else a barbule one)
 	} uniform_data[] = {
-		{CURVE_SIDE, "side", true},
-		{CURVE_SEGMENT, "segment", true},
-		{CURVE_KIND, "kind", false},
-		{CURVE_BARB, "barb", false},
+	    {CURVE_SIDE, "side", true},
+	    {CURVE_SEGMENT, "segment", true},
+	    {CURVE_KIND, "kind", false},
+	    {CURVE_BARB, "barb", false},
 	};
 	for (size_t k = 0; k < sizeof uniform_data / sizeof uniform_data[0]; ++k) {
 		if (uniform_data[k].barbs != (set != PLUME_CURVES_BARBULES))
@@ -247,7 +246,7 @@ static void write_curves(FILE *stream, const plume_feather *feather, plume_curve
 /// root is the asset (a component model); an afterfeather records where it
 /// attaches in a custom attribute, plume:attach_t (shaft fraction of its parent).
 static void write_feather(FILE *stream, const plume_feather *feather, const char *name, bool root, double attach_t,
-						  int depth)
+                          int depth)
 {
 	indent(stream, depth);
 	fprintf(stream, "def Xform \"%s\"", name);
@@ -283,16 +282,16 @@ plume_status plume_write_usda(const plume_feather *feather, const char *path, pl
 		return status;
 	plume_feather_info info = plume_feather_get_info(feather);
 	fprintf(text.stream,
-			"#usda 1.0\n"
-			"(\n"
-			"    defaultPrim = \"feather\"\n"
-			"    doc = \"\"\"plume %s: a feather as curves. %d shaft samples, %d barbs (%d left, %d right), "
-			"%d barbules, %d barb and barbule points, afterfeather: %s.\"\"\"\n"
-			"    metersPerUnit = 1\n"
-			"    upAxis = \"Y\"\n"
-			")\n\n",
-			PLUME_VERSION_STRING, info.shaft_sample_count, info.barb_count, info.barb_count_left,
-			info.barb_count_right, info.barbule_count, info.point_count, info.has_afterfeather ? "yes" : "no");
+	        "#usda 1.0\n"
+	        "(\n"
+	        "    defaultPrim = \"feather\"\n"
+	        "    doc = \"\"\"plume %s: a feather as curves. %d shaft samples, %d barbs (%d left, %d right), "
+	        "%d barbules, %d barb and barbule points, afterfeather: %s.\"\"\"\n"
+	        "    metersPerUnit = 1\n"
+	        "    upAxis = \"Y\"\n"
+	        ")\n\n",
+	        PLUME_VERSION_STRING, info.shaft_sample_count, info.barb_count, info.barb_count_left, info.barb_count_right,
+	        info.barbule_count, info.point_count, info.has_afterfeather ? "yes" : "no");
 	write_feather(text.stream, feather, "feather", true, 0.0, 0);
 	return plume_text_close(&text, PLUME_OK, err);
 }

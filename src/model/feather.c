@@ -48,23 +48,32 @@ static int resize(void **array, int capacity, size_t item_size)
 	return 0;
 }
 
+int plume_feather_reserve_points(plume_feather *feather, int capacity)
+{
+	if (capacity <= feather->point_capacity)
+		return 0;
+	// Five parallel arrays share one capacity.
+	if (resize((void **)&feather->points, capacity, sizeof *feather->points) != 0 ||
+	    resize((void **)&feather->normals, capacity, sizeof *feather->normals) != 0 ||
+	    resize((void **)&feather->arc_length, capacity, sizeof *feather->arc_length) != 0 ||
+	    resize((void **)&feather->widths, capacity, sizeof *feather->widths) != 0 ||
+	    resize((void **)&feather->uv, capacity, sizeof *feather->uv) != 0)
+		return -1; // arrays already grown keep their contents; capacity stays the smallest
+	feather->point_capacity = capacity;
+	return 0;
+}
+
 int plume_feather_add_points(plume_feather *feather, int count)
 {
 	int needed = feather->point_count + count;
 	if (count == 0)
 		return feather->point_count;
 	if (needed > feather->point_capacity) {
-		// Five parallel arrays share one capacity.
 		int capacity = feather->point_capacity > 0 ? feather->point_capacity : 256;
 		while (capacity < needed)
 			capacity *= 2;
-		if (resize((void **)&feather->points, capacity, sizeof *feather->points) != 0 ||
-			resize((void **)&feather->normals, capacity, sizeof *feather->normals) != 0 ||
-			resize((void **)&feather->arc_length, capacity, sizeof *feather->arc_length) != 0 ||
-			resize((void **)&feather->widths, capacity, sizeof *feather->widths) != 0 ||
-			resize((void **)&feather->uv, capacity, sizeof *feather->uv) != 0)
-			return -1; // arrays already grown keep their contents; capacity stays the smallest
-		feather->point_capacity = capacity;
+		if (plume_feather_reserve_points(feather, capacity) != 0)
+			return -1;
 	}
 	int first = feather->point_count;
 	memset(feather->points + first, 0, (size_t)count * sizeof *feather->points);
@@ -111,12 +120,12 @@ void plume_feather_measure_curve(plume_feather *feather, plume_curve_range range
 static plume_polyline polyline_view(const plume_feather *feather, plume_curve_range range)
 {
 	return (plume_polyline){
-		.count = range.count,
-		.points = feather->points + range.first,
-		.normals = feather->normals + range.first,
-		.arc_length = feather->arc_length + range.first,
-		.widths = feather->widths + range.first,
-		.uv = feather->uv + range.first,
+	    .count = range.count,
+	    .points = feather->points + range.first,
+	    .normals = feather->normals + range.first,
+	    .arc_length = feather->arc_length + range.first,
+	    .widths = feather->widths + range.first,
+	    .uv = feather->uv + range.first,
 	};
 }
 
@@ -134,12 +143,12 @@ plume_feather_info plume_feather_get_info(const plume_feather *feather)
 {
 	assert(feather != NULL);
 	plume_feather_info info = {
-		.shaft_sample_count = feather->shaft_count,
-		.calamus_sample_count = feather->calamus_count,
-		.barb_count = feather->barb_count,
-		.barbule_count = feather->barbule_count,
-		.point_count = feather->point_count,
-		.has_afterfeather = feather->afterfeather != NULL,
+	    .shaft_sample_count = feather->shaft_count,
+	    .calamus_sample_count = feather->calamus_count,
+	    .barb_count = feather->barb_count,
+	    .barbule_count = feather->barbule_count,
+	    .point_count = feather->point_count,
+	    .has_afterfeather = feather->afterfeather != NULL,
 	};
 	for (int i = 0; i < feather->barb_count; ++i) {
 		if (feather->barbs[i].side == PLUME_SIDE_LEFT)
@@ -176,12 +185,12 @@ plume_barb plume_feather_barb(const plume_feather *feather, int i)
 	assert(i >= 0 && i < feather->barb_count);
 	const plume_barb_record *record = feather->barbs + i;
 	return (plume_barb){
-		.curve = polyline_view(feather, record->curve),
-		.side = record->side,
-		.rachis_t = record->rachis_t,
-		.segment = record->segment,
-		.barbule_first = record->barbule_first,
-		.barbule_count = record->barbule_count,
+	    .curve = polyline_view(feather, record->curve),
+	    .side = record->side,
+	    .rachis_t = record->rachis_t,
+	    .segment = record->segment,
+	    .barbule_first = record->barbule_first,
+	    .barbule_count = record->barbule_count,
 	};
 }
 
@@ -190,10 +199,10 @@ plume_barbule plume_feather_barbule(const plume_feather *feather, int i)
 	assert(i >= 0 && i < feather->barbule_count);
 	const plume_barbule_record *record = feather->barbules + i;
 	return (plume_barbule){
-		.curve = polyline_view(feather, record->curve),
-		.barb = record->barb,
-		.barb_s = record->barb_s,
-		.kind = record->kind,
+	    .curve = polyline_view(feather, record->curve),
+	    .barb = record->barb,
+	    .barb_s = record->barb_s,
+	    .kind = record->kind,
 	};
 }
 
@@ -215,10 +224,10 @@ static bool same_curve(const plume_feather *a, plume_curve_range p, const plume_
 		return true;
 	size_t n = (size_t)p.count;
 	return same_bytes(a->points + p.first, b->points + q.first, n * sizeof *a->points) &&
-		   same_bytes(a->normals + p.first, b->normals + q.first, n * sizeof *a->normals) &&
-		   same_bytes(a->arc_length + p.first, b->arc_length + q.first, n * sizeof *a->arc_length) &&
-		   same_bytes(a->widths + p.first, b->widths + q.first, n * sizeof *a->widths) &&
-		   same_bytes(a->uv + p.first, b->uv + q.first, n * sizeof *a->uv);
+	       same_bytes(a->normals + p.first, b->normals + q.first, n * sizeof *a->normals) &&
+	       same_bytes(a->arc_length + p.first, b->arc_length + q.first, n * sizeof *a->arc_length) &&
+	       same_bytes(a->widths + p.first, b->widths + q.first, n * sizeof *a->widths) &&
+	       same_bytes(a->uv + p.first, b->uv + q.first, n * sizeof *a->uv);
 }
 
 // Equality is that of what the views show, bit for bit (so -0 differs from 0
@@ -231,33 +240,33 @@ bool plume_feather_equal(const plume_feather *a, const plume_feather *b)
 {
 	if (a == NULL || b == NULL)
 		return a == b;
-	if (a->shaft_count != b->shaft_count || a->calamus_count != b->calamus_count ||
-		a->barb_count != b->barb_count || a->barbule_count != b->barbule_count)
+	if (a->shaft_count != b->shaft_count || a->calamus_count != b->calamus_count || a->barb_count != b->barb_count ||
+	    a->barbule_count != b->barbule_count)
 		return false;
 	if (a->afterfeather != NULL && b->afterfeather != NULL &&
-		!same_bytes(&a->afterfeather_t, &b->afterfeather_t, sizeof a->afterfeather_t))
+	    !same_bytes(&a->afterfeather_t, &b->afterfeather_t, sizeof a->afterfeather_t))
 		return false;
 	// Records are compared field by field: struct padding is not data.
 	for (int i = 0; i < a->shaft_count; ++i) {
 		const plume_shaft_sample *p = a->shaft + i, *q = b->shaft + i;
 		if (!same_bytes(&p->position, &q->position, sizeof p->position) ||
-			!same_bytes(&p->tangent, &q->tangent, sizeof p->tangent) ||
-			!same_bytes(&p->normal, &q->normal, sizeof p->normal) ||
-			!same_bytes(&p->binormal, &q->binormal, sizeof p->binormal) ||
-			!same_bytes(&p->width, &q->width, sizeof p->width) || !same_bytes(&p->t, &q->t, sizeof p->t))
+		    !same_bytes(&p->tangent, &q->tangent, sizeof p->tangent) ||
+		    !same_bytes(&p->normal, &q->normal, sizeof p->normal) ||
+		    !same_bytes(&p->binormal, &q->binormal, sizeof p->binormal) ||
+		    !same_bytes(&p->width, &q->width, sizeof p->width) || !same_bytes(&p->t, &q->t, sizeof p->t))
 			return false;
 	}
 	for (int i = 0; i < a->barb_count; ++i) {
 		const plume_barb_record *p = a->barbs + i, *q = b->barbs + i;
 		if (p->side != q->side || !same_bytes(&p->rachis_t, &q->rachis_t, sizeof p->rachis_t) ||
-			p->segment != q->segment || p->barbule_count != q->barbule_count ||
-			(p->barbule_count > 0 && p->barbule_first != q->barbule_first) || !same_curve(a, p->curve, b, q->curve))
+		    p->segment != q->segment || p->barbule_count != q->barbule_count ||
+		    (p->barbule_count > 0 && p->barbule_first != q->barbule_first) || !same_curve(a, p->curve, b, q->curve))
 			return false;
 	}
 	for (int i = 0; i < a->barbule_count; ++i) {
 		const plume_barbule_record *p = a->barbules + i, *q = b->barbules + i;
 		if (p->barb != q->barb || !same_bytes(&p->barb_s, &q->barb_s, sizeof p->barb_s) || p->kind != q->kind ||
-			!same_curve(a, p->curve, b, q->curve))
+		    !same_curve(a, p->curve, b, q->curve))
 			return false;
 	}
 	return plume_feather_equal(a->afterfeather, b->afterfeather);

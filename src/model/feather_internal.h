@@ -58,6 +58,10 @@ plume_feather *plume_feather_create_empty(void);
 /// Appends count shaft samples (uninitialized); returns the first one or NULL.
 plume_shaft_sample *plume_feather_add_shaft(plume_feather *feather, int count);
 
+/// Makes room for capacity pool points in all, so that later appends do not
+/// move the pool. Returns 0, or -1 when memory runs out.
+int plume_feather_reserve_points(plume_feather *feather, int capacity);
+
 /// Appends count pool points (zeroed); returns the index of the first, or -1.
 int plume_feather_add_points(plume_feather *feather, int count);
 

@@ -26,33 +26,33 @@ plume_fw_def plume_fw_default_def(void)
 	// A 0.2 m hawk contour feather: Table 2's "Hawk Feather" rows, with a gently
 	// curved shaft and a vane widest below its middle, the outer (left) vane narrower.
 	return (plume_fw_def){
-		.shaft = {{0.0, 0.0}, {0.0015, 0.07}, {0.005, 0.14}, {0.004, 0.2}},
-		.left_outline = {{-0.003, 0.045}, {-0.024, 0.06}, {-0.03, 0.15}, {-0.022, 0.21}, {0.004, 0.205}},
-		.right_outline = {{0.003, 0.045}, {0.03, 0.06}, {0.04, 0.15}, {0.03, 0.215}, {0.004, 0.205}},
-		.mirror_right_outline = false,
-		.calamus_fraction = 0.15,
-		.segments =
-			{
-				{.barb_count = 200,
-				 .length_variation = 0.2,
-				 .shape_variation = 0.3,
-				 .symmetric_vanes = false,
-				 .uniform_shape = false,
-				 .uniform_length = false},
-				{.barb_count = 2000,
-				 .length_variation = 0.03,
-				 .shape_variation = 0.2,
-				 .symmetric_vanes = true,
-				 .uniform_shape = true,
-				 .uniform_length = false},
-			},
-		.second_segment_start = 0.2,
-		.shaft_samples = 100,
-		.barb_samples = 30,
-		.shaft_width_base = 3e-3,
-		.shaft_width_tip = 4e-4,
-		.barb_width_base = 1.5e-4,
-		.barb_width_tip = 3e-5,
+	    .shaft = {{0.0, 0.0}, {0.0015, 0.07}, {0.005, 0.14}, {0.004, 0.2}},
+	    .left_outline = {{-0.003, 0.045}, {-0.024, 0.06}, {-0.03, 0.15}, {-0.022, 0.21}, {0.004, 0.205}},
+	    .right_outline = {{0.003, 0.045}, {0.03, 0.06}, {0.04, 0.15}, {0.03, 0.215}, {0.004, 0.205}},
+	    .mirror_right_outline = false,
+	    .calamus_fraction = 0.15,
+	    .segments =
+	        {
+	            {.barb_count = 200,
+	             .length_variation = 0.2,
+	             .shape_variation = 0.3,
+	             .symmetric_vanes = false,
+	             .uniform_shape = false,
+	             .uniform_length = false},
+	            {.barb_count = 2000,
+	             .length_variation = 0.03,
+	             .shape_variation = 0.2,
+	             .symmetric_vanes = true,
+	             .uniform_shape = true,
+	             .uniform_length = false},
+	        },
+	    .second_segment_start = 0.2,
+	    .shaft_samples = 100,
+	    .barb_samples = 30,
+	    .shaft_width_base = 3e-3,
+	    .shaft_width_tip = 4e-4,
+	    .barb_width_base = 1.5e-4,
+	    .barb_width_tip = 3e-5,
 	};
 }
 
@@ -86,11 +86,13 @@ plume_status plume_fw_def_validate(const plume_fw_def *def, plume_error *err)
 {
 	plume_status status;
 	if ((status = check_points(def->shaft, 4, "shaft", err)) != PLUME_OK ||
-		(status = check_points(def->left_outline, 5, "left_outline", err)) != PLUME_OK ||
-		(!def->mirror_right_outline && (status = check_points(def->right_outline, 5, "right_outline", err)) != PLUME_OK))
+	    (status = check_points(def->left_outline, 5, "left_outline", err)) != PLUME_OK ||
+	    (!def->mirror_right_outline &&
+	     (status = check_points(def->right_outline, 5, "right_outline", err)) != PLUME_OK))
 		return status;
 	if (def->shaft[0].x == def->shaft[3].x && def->shaft[0].y == def->shaft[3].y)
-		return plume_error_set(err, PLUME_ERROR_SPEC, "$.shaft starts and ends at the same point; the shaft needs a length");
+		return plume_error_set(err, PLUME_ERROR_SPEC,
+		                       "$.shaft starts and ends at the same point; the shaft needs a length");
 	for (int s = 0; s < 2; ++s) {
 		const plume_fw_segment *segment = def->segments + s;
 		char path[64];
@@ -105,13 +107,13 @@ plume_status plume_fw_def_validate(const plume_fw_def *def, plume_error *err)
 			return status;
 	}
 	if ((status = check_range(def->second_segment_start, 0.0, 1.0, "$.second_segment_start", err)) != PLUME_OK ||
-		(status = check_range(def->calamus_fraction, 0.0, 0.95, "$.calamus_fraction", err)) != PLUME_OK ||
-		(status = check_range(def->shaft_samples, 2, 100000, "$.shaft_samples", err)) != PLUME_OK ||
-		(status = check_range(def->barb_samples, 2, 1000, "$.barb_samples", err)) != PLUME_OK ||
-		(status = check_positive(def->shaft_width_base, "$.shaft_width_base", err)) != PLUME_OK ||
-		(status = check_positive(def->shaft_width_tip, "$.shaft_width_tip", err)) != PLUME_OK ||
-		(status = check_positive(def->barb_width_base, "$.barb_width_base", err)) != PLUME_OK ||
-		(status = check_positive(def->barb_width_tip, "$.barb_width_tip", err)) != PLUME_OK)
+	    (status = check_range(def->calamus_fraction, 0.0, 0.95, "$.calamus_fraction", err)) != PLUME_OK ||
+	    (status = check_range(def->shaft_samples, 2, 100000, "$.shaft_samples", err)) != PLUME_OK ||
+	    (status = check_range(def->barb_samples, 2, 1000, "$.barb_samples", err)) != PLUME_OK ||
+	    (status = check_positive(def->shaft_width_base, "$.shaft_width_base", err)) != PLUME_OK ||
+	    (status = check_positive(def->shaft_width_tip, "$.shaft_width_tip", err)) != PLUME_OK ||
+	    (status = check_positive(def->barb_width_base, "$.barb_width_base", err)) != PLUME_OK ||
+	    (status = check_positive(def->barb_width_tip, "$.barb_width_tip", err)) != PLUME_OK)
 		return status;
 	return PLUME_OK;
 }
@@ -192,12 +194,13 @@ static plume_status build_shaft(plume_feather *feather, const plume_fw_def *def,
 
 /// Appends one barb at vane fraction q on the given side.
 static plume_status build_barb(plume_feather *feather, const plume_fw_def *def, const fw_geometry *geometry,
-							   plume_side side, int segment_index, double q, const barb_draw *draw)
+                               plume_side side, int segment_index, double q, const barb_draw *draw)
 {
 	const plume_fw_segment *segment = def->segments + segment_index;
 	double rachis_t = def->calamus_fraction + (1.0 - def->calamus_fraction) * q;
 	plume_vec3 p0 = plume_bezier_eval(geometry->shaft, 4, plume_bezier_arc_param(&geometry->shaft_arc, rachis_t));
-	plume_vec3 tip = plume_bezier_eval(geometry->outline[side], 5, plume_bezier_arc_param(&geometry->outline_arc[side], q));
+	plume_vec3 tip =
+	    plume_bezier_eval(geometry->outline[side], 5, plume_bezier_arc_param(&geometry->outline_arc[side], q));
 
 	plume_vec3 p3 = plume_v3_mad(p0, 1.0 + draw->r, plume_v3_sub(tip, p0));
 	double d = plume_v3_distance(p0, p3);
@@ -206,8 +209,10 @@ static plume_status build_barb(plume_feather *feather, const plume_fw_def *def, 
 	double scale = d * segment->shape_variation;
 	plume_vec3 control[4];
 	control[0] = p0;
-	control[1] = plume_v3_add(p0, plume_v3_add(plume_v3_scale(x, draw->u1 * scale), plume_v3_scale(y, draw->u2 * scale)));
-	control[2] = plume_v3_add(p3, plume_v3_add(plume_v3_scale(x, draw->u4 * scale), plume_v3_scale(y, draw->u3 * scale)));
+	control[1] =
+	    plume_v3_add(p0, plume_v3_add(plume_v3_scale(x, draw->u1 * scale), plume_v3_scale(y, draw->u2 * scale)));
+	control[2] =
+	    plume_v3_add(p3, plume_v3_add(plume_v3_scale(x, draw->u4 * scale), plume_v3_scale(y, draw->u3 * scale)));
 	control[3] = p3;
 
 	int count = def->barb_samples;
@@ -230,12 +235,12 @@ static plume_status build_barb(plume_feather *feather, const plume_fw_def *def, 
 		feather->widths[first + i] = def->barb_width_base + s * (def->barb_width_tip - def->barb_width_base);
 	}
 	plume_barb_record record = {
-		.curve = range,
-		.side = side,
-		.rachis_t = rachis_t,
-		.segment = segment_index,
-		.barbule_first = 0,
-		.barbule_count = 0,
+	    .curve = range,
+	    .side = side,
+	    .rachis_t = rachis_t,
+	    .segment = segment_index,
+	    .barbule_first = 0,
+	    .barbule_count = 0,
 	};
 	return plume_feather_add_barb(feather, &record) < 0 ? PLUME_ERROR_MEMORY : PLUME_OK;
 }
@@ -253,8 +258,8 @@ plume_status plume_fw_generate(const plume_fw_def *def, uint64_t seed, plume_fea
 	for (int i = 0; i < 5; ++i) {
 		geometry.outline[PLUME_SIDE_LEFT][i] = lift(def->left_outline[i]);
 		geometry.outline[PLUME_SIDE_RIGHT][i] =
-			def->mirror_right_outline ? mirror_across(lift(def->left_outline[i]), geometry.shaft[0], geometry.shaft[3])
-									  : lift(def->right_outline[i]);
+		    def->mirror_right_outline ? mirror_across(lift(def->left_outline[i]), geometry.shaft[0], geometry.shaft[3])
+		                              : lift(def->right_outline[i]);
 	}
 	plume_bezier_arc_init(&geometry.shaft_arc, geometry.shaft, 4);
 	for (int side = 0; side < 2; ++side)
@@ -266,15 +271,14 @@ plume_status plume_fw_generate(const plume_fw_def *def, uint64_t seed, plume_fea
 
 	int barbs_per_vane = def->segments[0].barb_count + def->segments[1].barb_count;
 	// One reservation up front so that the point pool never moves while barbs are built.
-	if (plume_feather_add_points(feather, 2 * barbs_per_vane * def->barb_samples) < 0 ||
-		(status = build_shaft(feather, def, &geometry)) != PLUME_OK)
+	if (plume_feather_reserve_points(feather, 2 * barbs_per_vane * def->barb_samples) != 0 ||
+	    (status = build_shaft(feather, def, &geometry)) != PLUME_OK)
 		goto fail;
-	feather->point_count = 0;
 
 	// Random values are drawn segment by segment, barb by barb, left vane then
 	// right (unless S_v shares them), so a seed fixes every barb.
 	plume_rng rng = plume_rng_seed(seed);
-	barb_draw (*draws)[2] = plume_alloc((size_t)(barbs_per_vane > 0 ? barbs_per_vane : 1) * sizeof *draws);
+	barb_draw(*draws)[2] = plume_alloc((size_t)(barbs_per_vane > 0 ? barbs_per_vane : 1) * sizeof *draws);
 	if (draws == NULL)
 		goto fail;
 	double fractions[2][2] = {{0.0, def->second_segment_start}, {def->second_segment_start, 1.0}};
