@@ -137,6 +137,16 @@ static void test_unperturbed_barbs_end_on_their_outline(void **state)
 	plume_feather_destroy(feather);
 }
 
+/// A straight barb's length over the distance from its root to its unscaled tip
+/// on the outline: the factor 1 + r that F_pv drew.
+static double length_ratio(const plume_barb *barb, const plume_fw_def *def, const plume_vec3 *outline)
+{
+	plume_vec3 root = barb->curve.points[0], tip = barb->curve.points[barb->curve.count - 1];
+	double q = (barb->rachis_t - def->calamus_fraction) / (1.0 - def->calamus_fraction);
+	plume_vec3 edge = plume_bezier_eval(outline, 5, plume_bezier_param_at_length(outline, 5, q));
+	return plume_v3_distance(root, tip) / plume_v3_distance(root, edge);
+}
+
 static void test_length_variation_stays_in_range(void **state)
 {
 	(void)state;
@@ -156,11 +166,7 @@ static void test_length_variation_stays_in_range(void **state)
 		plume_barb barb = plume_feather_barb(feather, i);
 		if (barb.side != PLUME_SIDE_LEFT)
 			continue;
-		// The unscaled tip is the outline point where the scaled barb's line meets it.
-		plume_vec3 root = barb.curve.points[0], tip = barb.curve.points[barb.curve.count - 1];
-		double q = (barb.rachis_t - def.calamus_fraction) / (1.0 - def.calamus_fraction);
-		plume_vec3 edge = plume_bezier_eval(outline, 5, plume_bezier_param_at_length(outline, 5, q));
-		double ratio = plume_v3_distance(root, tip) / plume_v3_distance(root, edge);
+		double ratio = length_ratio(&barb, &def, outline);
 		lo = fmin(lo, ratio);
 		hi = fmax(hi, ratio);
 	}
@@ -175,10 +181,7 @@ static void test_length_variation_stays_in_range(void **state)
 		plume_barb barb = plume_feather_barb(feather, i);
 		if (barb.side != PLUME_SIDE_LEFT)
 			continue;
-		plume_vec3 root = barb.curve.points[0], tip = barb.curve.points[barb.curve.count - 1];
-		double q = (barb.rachis_t - def.calamus_fraction) / (1.0 - def.calamus_fraction);
-		plume_vec3 edge = plume_bezier_eval(outline, 5, plume_bezier_param_at_length(outline, 5, q));
-		double ratio = plume_v3_distance(root, tip) / plume_v3_distance(root, edge);
+		double ratio = length_ratio(&barb, &def, outline);
 		if (first < 0.0)
 			first = ratio;
 		assert_close(ratio, first, 1e-9);
