@@ -17,6 +17,7 @@
 #include "core/alloc.h"
 #include "core/atomic_file.h"
 #include "plume/render.h"
+#include "render/cairo_png.h"
 
 plume_render2d_def plume_render2d_default_def(void)
 {
@@ -476,21 +477,9 @@ static plume_status render_png(const plume_feather *feather, const plume_render2
 		return cairo_failure(path, PLUME_IMAGE_PNG, status, NULL, err);
 	}
 	cairo_surface_flush(surface);
-
-	plume_atomic_file file;
-	plume_status result = plume_atomic_open(&file, path, err);
-	if (result != PLUME_OK) {
-		cairo_surface_destroy(surface);
-		return result;
-	}
-	stream_closure closure = {.stream = file.stream};
-	status = cairo_surface_write_to_png_stream(surface, write_to_stream, &closure);
+	plume_status result = plume_cairo_write_png(surface, path, err);
 	cairo_surface_destroy(surface);
-	if (status != CAIRO_STATUS_SUCCESS) {
-		plume_atomic_abort(&file);
-		return cairo_failure(path, PLUME_IMAGE_PNG, status, &closure, err);
-	}
-	return plume_atomic_commit(&file, err);
+	return result;
 }
 
 /// A fixed date for the PDF's metadata: Cairo otherwise stamps the current

@@ -12,8 +12,8 @@
 #include <stb_image.h>
 
 #include "core/alloc.h"
-#include "core/atomic_file.h"
 #include "plume/render.h"
+#include "render/cairo_png.h"
 
 struct plume_texture {
 	int width;
@@ -162,22 +162,6 @@ plume_color plume_texture_sample_vane(const plume_texture *texture, plume_side s
 	return (plume_color){p[0] / 255.0, p[1] / 255.0, p[2] / 255.0, p[3] / 255.0};
 }
 
-typedef struct stream_closure {
-	FILE *stream;
-	int error; ///< errno of the first failed write, 0 when none failed
-} stream_closure;
-
-static cairo_status_t write_to_stream(void *closure, const unsigned char *data, unsigned int length)
-{
-	stream_closure *target = closure;
-	if (fwrite(data, 1, length, target->stream) != length) {
-		if (target->error == 0)
-			target->error = errno != 0 ? errno : EIO;
-		return CAIRO_STATUS_WRITE_ERROR;
-	}
-	return CAIRO_STATUS_SUCCESS;
-}
-
 /// Straight 8-bit channel times alpha, rounded: Cairo's ARGB32 is premultiplied.
 static uint32_t premultiply(uint8_t channel, uint8_t alpha) { return ((uint32_t)channel * alpha + 127u) / 255u; }
 
@@ -206,20 +190,7 @@ plume_status plume_texture_write_png(const plume_texture *texture, const char *p
 		}
 	}
 	cairo_surface_mark_dirty(surface);
-
-	plume_atomic_file file;
-	plume_status status = plume_atomic_open(&file, path, err);
-	if (status != PLUME_OK) {
-		cairo_surface_destroy(surface);
-		return status;
-	}
-	stream_closure closure = {file.stream, 0};
-	cairo_status = cairo_surface_write_to_png_stream(surface, write_to_stream, &closure);
+	plume_status status = plume_cairo_write_png(surface, path, err);
 	cairo_surface_destroy(surface);
-	if (cairo_status != CAIRO_STATUS_SUCCESS) {
-		plume_atomic_abort(&file);
-		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write PNG: %s", path,
-		                       closure.error != 0 ? strerror(closure.error) : cairo_status_to_string(cairo_status));
-	}
-	return plume_atomic_commit(&file, err);
+	return status;
 }
