@@ -73,9 +73,19 @@ plume_status cli_write_feather(cli_output *output, const plume_feather *feather,
                                const cli_image_options *images, plume_error *err);
 
 int cli_generate(int argc, char **argv);
+int cli_grow(int argc, char **argv);
+int cli_coat(int argc, char **argv);
+int cli_simulate(int argc, char **argv);
+int cli_render(int argc, char **argv);
+int cli_lab(int argc, char **argv);
 int cli_demo(int argc, char **argv);
 
 void cli_help_generate(void);
+void cli_help_grow(void);
+void cli_help_coat(void);
+void cli_help_simulate(void);
+void cli_help_render(void);
+void cli_help_lab(void);
 void cli_help_demo(void);
 
 #endif

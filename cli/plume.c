@@ -13,6 +13,11 @@ typedef struct command {
 
 static const command commands[] = {
     {"generate", "generate a feather from a spec; write images and geometry", cli_generate, cli_help_generate},
+    {"grow", "write a feather's growth or unfurling sequence, frame by frame", cli_grow, cli_help_grow},
+    {"coat", "cover a surface with feathers from a coat spec", cli_coat, cli_help_coat},
+    {"simulate", "simulate a feather as an anisotropic shell from a scene spec", cli_simulate, cli_help_simulate},
+    {"render", "ray-trace a feather, a coat or a simulation", cli_render, cli_help_render},
+    {"lab", "virtual lab: traction tests, calibration, studies", cli_lab, cli_help_lab},
     {"demo", "generate the built-in feather end to end, no input needed", cli_demo, cli_help_demo},
 };
 enum { COMMAND_COUNT = sizeof commands / sizeof commands[0] };

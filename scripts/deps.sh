@@ -3,7 +3,8 @@
 # As root: apt-get installs them. Otherwise: prints the exact command and fails.
 set -euo pipefail
 
-packages=(build-essential cmake pkg-config libcairo2-dev libjansson-dev libstb-dev libcmocka-dev)
+packages=(build-essential cmake pkg-config libcairo2-dev libjansson-dev libstb-dev libcmocka-dev
+	libsuitesparse-dev libembree-dev libqhull-dev libplplot-dev)
 
 missing=()
 for package in "${packages[@]}"; do

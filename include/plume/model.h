@@ -88,11 +88,27 @@ plume_status plume_fw_generate(const plume_fw_def *def, uint64_t seed, plume_fea
 // ---------------------------------------------------------------------------
 // Specs: JSON files with a "model" key naming the generator.
 
-/// Options for plume_spec_generate.
+/// Which development stage plume_spec_generate builds.
+typedef enum plume_stage_kind {
+	/// The finished feather (default).
+	PLUME_STAGE_FULL = 0,
+	/// A growth stage: stage 0 is the start of growth, 1 the finished feather
+	/// (Streit–Heidrich 4.2.4; Zhang–Kanai t_curr over the growth period).
+	PLUME_STAGE_GROWTH,
+	/// An unfurling stage (Zhang–Kanai IV-B): stage is the weight w, 0 the helix in the follicle.
+	PLUME_STAGE_UNFURL,
+} plume_stage_kind;
+
+/// Options for plume_spec_generate. Zero-initialised options mean: the spec's
+/// seed, the finished feather.
 typedef struct plume_spec_options {
 	/// Overrides the spec's "seed" key when seed_given is true.
 	uint64_t seed;
 	bool seed_given;
+	/// Development stage to build; a model without that kind of stage fails with PLUME_ERROR_UNSUPPORTED.
+	plume_stage_kind stage_kind;
+	/// Stage in [0, 1] for PLUME_STAGE_GROWTH and PLUME_STAGE_UNFURL.
+	double stage;
 } plume_spec_options;
 
 /// Reads a feather spec from path and generates it. Syntax errors read

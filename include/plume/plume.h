@@ -5,7 +5,9 @@
 #include "plume/core.h"
 #include "plume/feather.h"
 #include "plume/io.h"
+#include "plume/mesh.h"
 #include "plume/model.h"
 #include "plume/render.h"
+#include "plume/sim.h"
 
 #endif // PLUME_H

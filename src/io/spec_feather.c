@@ -4,7 +4,19 @@
 #include "spec.h"
 #include "spec_models.h"
 
-static const char *const model_names[] = {"franco-walter", NULL};
+typedef struct model_entry {
+	const char *name;
+	plume_spec_generate_fn generate;
+} model_entry;
+
+static const model_entry models[] = {
+    {"franco-walter", plume_fw_spec_generate},
+    {"streit-heidrich", plume_sh_spec_generate},
+    {"zhang-kanai", plume_zk_spec_generate},
+};
+enum { MODEL_COUNT = sizeof models / sizeof models[0] };
+static const char *const model_names[] = {"franco-walter", "streit-heidrich", "zhang-kanai", NULL};
+#define MODEL_LIST "franco-walter, streit-heidrich, zhang-kanai"
 
 plume_status plume_fw_def_read(const char *path, plume_fw_def *def, uint64_t *seed, plume_error *err)
 {
@@ -20,6 +32,24 @@ plume_status plume_fw_def_read(const char *path, plume_fw_def *def, uint64_t *se
 	return status;
 }
 
+plume_status plume_fw_spec_generate(const char *file, const json_t *root, const plume_spec_options *options,
+                                    plume_feather **out, plume_error *err)
+{
+	if (options != NULL && options->stage_kind != PLUME_STAGE_FULL)
+		return plume_error_set(err, PLUME_ERROR_UNSUPPORTED,
+		                       "%s: the franco-walter model has no growth or unfurling stages "
+		                       "(streit-heidrich and zhang-kanai do)",
+		                       file);
+	plume_fw_def def;
+	uint64_t seed;
+	plume_status status = plume_fw_def_from_json(file, root, &def, &seed, err);
+	if (status != PLUME_OK)
+		return status;
+	if (options != NULL && options->seed_given)
+		seed = options->seed;
+	return plume_fw_generate(&def, seed, out, err);
+}
+
 plume_status plume_spec_generate(const char *path, const plume_spec_options *options, plume_feather **out,
                                  plume_error *err)
 {
@@ -32,22 +62,21 @@ plume_status plume_spec_generate(const char *path, const plume_spec_options *opt
 	if (!json_is_object(root))
 		plume_spec_fail(&reader, "$", "expected an object with a \"model\" key");
 	else if (!plume_spec_string(&reader, root, "$", "model", &model) && reader.status == PLUME_OK)
-		plume_spec_fail(&reader, "$.model", "missing; a spec names its generator (one of: franco-walter)");
+		plume_spec_fail(&reader, "$.model", "missing; a spec names its generator (one of: " MODEL_LIST ")");
 
 	plume_status status = reader.status;
-	if (status == PLUME_OK && strcmp(model, "franco-walter") == 0) {
-		plume_fw_def def;
-		uint64_t seed;
-		status = plume_fw_def_from_json(path, root, &def, &seed, err);
-		if (status == PLUME_OK) {
-			if (options != NULL && options->seed_given)
-				seed = options->seed;
-			status = plume_fw_generate(&def, seed, out, err);
+	if (status == PLUME_OK) {
+		const model_entry *entry = NULL;
+		for (int i = 0; i < MODEL_COUNT && entry == NULL; ++i)
+			if (strcmp(model, models[i].name) == 0)
+				entry = models + i;
+		if (entry != NULL) {
+			status = entry->generate(path, root, options, out, err);
+		} else {
+			plume_spec_fail(&reader, "$.model", "unknown model \"%s\"; did you mean \"%s\"? (known: " MODEL_LIST ")",
+			                model, plume_spec_nearest(model, model_names));
+			status = reader.status;
 		}
-	} else if (status == PLUME_OK) {
-		plume_spec_fail(&reader, "$.model", "unknown model \"%s\"; did you mean \"%s\"? (known: franco-walter)", model,
-		                plume_spec_nearest(model, model_names));
-		status = reader.status;
 	}
 	json_decref(root);
 	return status;

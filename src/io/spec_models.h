@@ -11,4 +11,17 @@
 plume_status plume_fw_def_from_json(const char *file, const json_t *root, plume_fw_def *def, uint64_t *seed,
                                     plume_error *err);
 
+/// Each generator's spec entry point: reads the parsed spec (root is an object
+/// whose "model" names this generator), applies options (seed override,
+/// development stage) and generates. file names the spec in error messages.
+typedef plume_status (*plume_spec_generate_fn)(const char *file, const json_t *root, const plume_spec_options *options,
+                                               plume_feather **out, plume_error *err);
+
+plume_status plume_fw_spec_generate(const char *file, const json_t *root, const plume_spec_options *options,
+                                    plume_feather **out, plume_error *err);
+plume_status plume_sh_spec_generate(const char *file, const json_t *root, const plume_spec_options *options,
+                                    plume_feather **out, plume_error *err);
+plume_status plume_zk_spec_generate(const char *file, const json_t *root, const plume_spec_options *options,
+                                    plume_feather **out, plume_error *err);
+
 #endif

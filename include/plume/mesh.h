@@ -1,0 +1,148 @@
+// plume meshes: the triangle shells the simulator deforms.
+//
+// A plume_mesh is plain data: the caller reads its arrays directly. It keeps
+// two rest states: `reference`, the flat material coordinates in the feather
+// plane that the membrane energy measures strain against, and `rest`, the 3D
+// shape of the feather at rest whose curvature is the bending energy's rest
+// curvature (Jouve thesis 6.2-6.3). Meshes are made from a plume_feather
+// (its rachis and barbs are the guides), from explicit guides, or by the lab's
+// sample builders; plume_mesh_create gives empty arrays for any other builder.
+#ifndef PLUME_MESH_H
+#define PLUME_MESH_H
+
+#include "plume/core.h"
+#include "plume/feather.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/// Material of a face.
+typedef enum plume_material_id {
+	PLUME_MATERIAL_VANE = 0,
+	PLUME_MATERIAL_RACHIS = 1,
+} plume_material_id;
+
+/// A named set of vertices, for handles and measurements.
+typedef struct plume_vertex_group {
+	char name[32];
+	int count;
+	int *vertices;
+} plume_vertex_group;
+
+typedef struct plume_mesh {
+	int vertex_count;
+	int face_count;
+	/// Material coordinates in the reference plane, m (vertex_count).
+	plume_vec2 *reference;
+	/// 3D rest shape, m (vertex_count). Equal to (reference, 0) for a flat feather.
+	plume_vec3 *rest;
+	/// Texture coordinates carried over from the feather (vertex_count).
+	plume_vec2 *uv;
+	/// Three vertex indices per face, counter-clockwise in the reference plane (3 * face_count).
+	int *faces;
+	/// Per face: index into the simulation's material table. Feathers use
+	/// plume_material_id (vane 0, rachis 1); the lab's band samples use their own indices.
+	unsigned char *material;
+	/// Per face: barb direction in the reference plane, radians from the +x axis,
+	/// in [0, pi). Rachis faces keep the rachis direction (unused by isotropic materials).
+	double *barb_angle;
+	/// Per face: local index k (0..2) of the edge (faces[3f+k], faces[3f+(k+1)%3]) that lies on a barb
+	/// guide, or -1 when the face has none (rachis faces, unaligned meshes).
+	signed char *barb_edge;
+	/// Unique barb-aligned edges, two vertex indices each (2 * barb_edge_count): the edges the
+	/// inextensibility constraint holds at their reference length.
+	int barb_edge_count;
+	int *barb_edges;
+	int group_count;
+	plume_vertex_group *groups;
+} plume_mesh;
+
+/// Parameters of the barb-aligned mesher (Jouve thesis 6.2, paper Figure 7).
+typedef struct plume_mesh_def {
+	/// e: target edge length, m, > 0. Default 5e-3 (thesis Table 6.1).
+	double edge_length;
+	/// w_b: rachis band width at the base, m, > 0. Default: the feather's shaft width at the base of the vane.
+	/// A value <= 0 means "take it from the feather".
+	double rachis_width_base;
+	/// w_e: rachis band width at the tip, m. <= 0 means "take it from the feather".
+	double rachis_width_tip;
+	/// Keep the bare calamus below the vane as rachis faces. Default true.
+	bool include_calamus;
+} plume_mesh_def;
+
+plume_mesh_def plume_mesh_default_def(void);
+
+/// What the mesher measured.
+typedef struct plume_mesh_report {
+	/// Smallest interior angle over all faces, radians.
+	double min_angle;
+	/// Fraction of vane faces with an edge on a barb guide; the aligned mesher always reaches 1.
+	double aligned_fraction;
+	/// Input barbs that crossed a neighbour and were left out of the guide set.
+	int guides_dropped;
+	/// Guides the mesher used, per vane (left, right).
+	int guide_count[2];
+} plume_mesh_report;
+
+/// Meshes a generated feather: the shaft is the rachis centre line, the barbs are
+/// the barb guides. The feather's 3D shape is the rest shape; its projection on
+/// the feather plane is the reference. report may be NULL.
+plume_status plume_mesh_from_feather(const plume_feather *feather, const plume_mesh_def *def, plume_mesh **out,
+                                     plume_mesh_report *report, plume_error *err);
+
+/// Explicit guides in the feather plane (thesis 6.2: boundary, rachis spline, barb guide splines).
+typedef struct plume_mesh_guides {
+	/// Closed boundary polygon of the feather, counter-clockwise, m.
+	int boundary_count;
+	const plume_vec2 *boundary;
+	/// Rachis centre line, base first (a polyline; pass a sampled spline).
+	int rachis_count;
+	const plume_vec2 *rachis;
+	/// Barb guides: guide_count polylines, each from its root near the rachis outward,
+	/// stored back to back in guide_points with guide_offsets[i]..guide_offsets[i+1].
+	int guide_count;
+	const int *guide_offsets;
+	const plume_vec2 *guide_points;
+} plume_mesh_guides;
+
+plume_status plume_mesh_from_guides(const plume_mesh_guides *guides, const plume_mesh_def *def, plume_mesh **out,
+                                    plume_mesh_report *report, plume_error *err);
+
+/// Allocates a mesh with zeroed arrays of the given sizes (barb_edges, groups empty).
+/// The builder fills them. Returns NULL when out of memory.
+plume_mesh *plume_mesh_create(int vertex_count, int face_count);
+
+/// Adds a vertex group (copies the indices). Names are at most 31 bytes.
+plume_status plume_mesh_add_group(plume_mesh *mesh, const char *name, const int *vertices, int count,
+                                  plume_error *err);
+
+/// Rebuilds barb_edges from the faces' barb_edge marks (unique edges, sorted).
+plume_status plume_mesh_collect_barb_edges(plume_mesh *mesh, plume_error *err);
+
+/// The group with that name, or NULL.
+const plume_vertex_group *plume_mesh_find_group(const plume_mesh *mesh, const char *name);
+
+/// Minimum angle and aligned fraction of any mesh.
+plume_mesh_report plume_mesh_measure(const plume_mesh *mesh);
+
+void plume_mesh_destroy(plume_mesh *mesh);
+
+/// Reads a triangle mesh from Wavefront OBJ: v, vt and f lines (f with v, v/vt,
+/// v//vn or v/vt/vn; negative indices allowed; other lines ignored). rest holds
+/// the positions, reference their (x, y), uv the texture coordinates when every
+/// face vertex has one (else zero). Faces get material 0, barb_edge -1. A face
+/// that is not a triangle, an index out of range or no faces at all is an error
+/// naming the file and line.
+plume_status plume_mesh_read_obj(const char *path, plume_mesh **out, plume_error *err);
+
+/// Writes the mesh with the given vertex positions (rest when positions is NULL)
+/// as Wavefront OBJ with UVs and one group per material, atomically.
+plume_status plume_mesh_write_obj(const plume_mesh *mesh, const plume_vec3 *positions, const char *path,
+                                  plume_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif // PLUME_MESH_H

@@ -1,0 +1,162 @@
+// plume simulation: a feather as a strongly anisotropic elastic shell
+// (Jouve et al. 2024, sections 5-7; Jouve thesis chapters 4 and 6).
+//
+// A plume_sim owns a copy of what it needs from a plume_mesh, the current
+// positions and velocities, and the sparse solver. Each step minimises the
+// implicit-Euler incremental potential with Newton's method; statics is the
+// same minimisation without inertia. Barb-aligned edges can be held at their
+// reference length as hard constraints (paper section 6).
+#ifndef PLUME_SIM_H
+#define PLUME_SIM_H
+
+#include "plume/core.h"
+#include "plume/mesh.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+enum { PLUME_MAX_MATERIALS = 8 };
+
+typedef enum plume_material_kind {
+	/// Orthotropic St-Venant-Kirchhoff, zero Poisson ratio (paper eq. 5, thesis A.2).
+	PLUME_MATERIAL_ORTHOTROPIC = 0,
+	/// Isotropic St-Venant-Kirchhoff (plane stress) with a Poisson ratio.
+	PLUME_MATERIAL_ISOTROPIC = 1,
+} plume_material_kind;
+
+/// One material of the shell. Faces pick theirs through plume_mesh.material.
+typedef struct plume_material {
+	plume_material_kind kind;
+	/// Orthotropic moduli, Pa, in the barb frame (v along the barb, w across).
+	/// E_vv is the stiffness along the barbs when barb_constraint is false; with
+	/// the constraint it is replaced by E_ww (paper footnote 3).
+	double E_vv;
+	double E_ww;
+	double E_vw;
+	/// Isotropic Young's modulus, Pa, and Poisson ratio in [0, 0.5).
+	double youngs_modulus;
+	double poisson_ratio;
+	/// Shell thickness, m, > 0.
+	double thickness;
+	/// Mass per unit reference area, kg/m^2, >= 0.
+	double surface_density;
+	/// Hold every barb-aligned edge of these faces at its reference length (eps_vv = 0).
+	bool barb_constraint;
+	/// Bending moduli, N m (thesis eq. 6.4): `bending_along` for an edge parallel to the
+	/// barbs (a hinge that keeps the barbs straight; soft), `bending_across` for an edge
+	/// across them (bends the barbs; stiff). Isotropic materials use bending_along for both
+	/// when bending_across is negative.
+	double bending_along;
+	double bending_across;
+	/// Kikuuwe coefficient kappa, Pa (thesis eq. 6.6); 0 disables the compression term.
+	double compression_coefficient;
+} plume_material;
+
+/// The vane of thesis Table 6.1 with the inextensibility constraint: E_ww = 4.80e4 Pa,
+/// E_vw = E_ww (provisional until the lab's calibration), thickness 1.2e-4 m (mean of
+/// Table 3.1), 2.6e-2 kg/m^2, bending 1e-7 / 2.5e-4 N m, kappa 5.04e7.
+plume_material plume_material_vane(void);
+/// The rachis of thesis Table 6.1: isotropic, E = 34 MPa, nu = 0.49, thickness 1.2e-2 m, 0.54 kg/m^2.
+plume_material plume_material_rachis(void);
+
+/// Newton solver settings (thesis Table 6.1).
+typedef struct plume_solver_def {
+	/// Converged when the Newton decrement and the free gradient norm, both relative to the
+	/// problem's force scale, fall below this. Default 1e-7.
+	double tolerance;
+	/// Newton iterations per solve. Default 50.
+	int max_iterations;
+	/// Halvings of the step before a failed step is retried with substeps. Default 4
+	/// (up to 16 substeps).
+	int max_substep_halvings;
+} plume_solver_def;
+
+typedef struct plume_sim_def {
+	/// Material table indexed by plume_mesh.material. Default: [vane, rachis].
+	plume_material materials[PLUME_MAX_MATERIALS];
+	int material_count;
+	/// m/s^2. Default (0, -9.81, 0).
+	plume_vec3 gravity;
+	/// Linear aerodynamic drag per unit area, kg/(m^2 s): force -c A (v . n) n on each vertex's
+	/// share of area A. Default 0.
+	double drag;
+	/// Time step, s, > 0. Default 0.011 (thesis Table 6.1).
+	double time_step;
+	/// Include the bending energy. Default true.
+	bool bending;
+	/// Fix every vertex's z: in-plane problems (the lab's samples). Default false.
+	bool planar;
+	plume_solver_def solver;
+} plume_sim_def;
+
+plume_sim_def plume_sim_default_def(void);
+
+/// Checks materials and settings; messages name the field as a JSON path of a scene
+/// ("$.materials.vane.thickness is -1, allowed > 0").
+plume_status plume_sim_def_validate(const plume_sim_def *def, int mesh_material_count, plume_error *err);
+
+typedef struct plume_sim plume_sim;
+
+/// Copies what it needs from mesh (the mesh may be destroyed afterwards).
+plume_status plume_sim_create(const plume_mesh *mesh, const plume_sim_def *def, plume_sim **out, plume_error *err);
+void plume_sim_destroy(plume_sim *sim);
+
+/// Dirichlet handles: the group's vertices follow rest + motion. A vertex may be in one handle.
+/// Returns the handle index, or -1 with err set (unknown group).
+int plume_sim_add_handle(plume_sim *sim, const char *group, plume_error *err);
+/// Moves a handle rigidly: each vertex goes to rotation * (rest - pivot) + pivot + translation.
+void plume_sim_set_handle(plume_sim *sim, int handle, plume_vec3 translation, plume_mat3 rotation, plume_vec3 pivot);
+
+/// What one solve did.
+typedef struct plume_solve_report {
+	bool converged;
+	int newton_iterations;
+	/// Substeps the step needed (1 when the first try converged).
+	int substeps;
+	/// Free-DOF gradient norm at the end, N.
+	double gradient_norm;
+	/// Potential at the end, J (elastic + gravity, plus inertia for a step).
+	double energy;
+	/// Largest |l - L| / L over barb-aligned edges.
+	double max_barb_strain;
+	/// Seconds in assembly, factorisation and solve.
+	double seconds_assembly;
+	double seconds_factor;
+	double seconds_solve;
+} plume_solve_report;
+
+/// Minimises the elastic + gravity potential with the handles where they are.
+/// Returns PLUME_ERROR_NUMERIC when it did not converge: the positions are then
+/// the last iterate (finite), and report says so.
+plume_status plume_sim_solve_static(plume_sim *sim, plume_solve_report *report, plume_error *err);
+
+/// One implicit-Euler step of def.time_step; handles must be set for the end of the step.
+/// A step that does not converge is retried with substeps (handles interpolated linearly);
+/// if that fails too, the state is left as before the step and PLUME_ERROR_NUMERIC returned.
+plume_status plume_sim_step(plume_sim *sim, plume_solve_report *report, plume_error *err);
+
+int plume_sim_vertex_count(const plume_sim *sim);
+const plume_vec3 *plume_sim_positions(const plume_sim *sim);
+const plume_vec3 *plume_sim_velocities(const plume_sim *sim);
+double plume_sim_time(const plume_sim *sim);
+
+/// Sum over a group's vertices of the force the shell exerts on the handle that holds them
+/// (the reaction: minus the elastic force on those vertices), N. Unknown group: returns false.
+bool plume_sim_group_reaction(const plume_sim *sim, const char *group, plume_vec3 *force);
+
+/// Energies at the current state, J.
+typedef struct plume_sim_energies {
+	double membrane;
+	double bending;
+	double compression;
+	double gravity;
+	double kinetic;
+} plume_sim_energies;
+plume_sim_energies plume_sim_energy(const plume_sim *sim);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif // PLUME_SIM_H
