@@ -72,8 +72,25 @@ void cli_output_abort(cli_output *output);
 plume_status cli_write_feather(cli_output *output, const plume_feather *feather, const char *stem, unsigned formats,
                                const cli_image_options *images, plume_error *err);
 
+/// Ray-traced frames of a simulation at barb level: the feather's barbs embedded in
+/// the rest shell and carried by it (include/plume/embed.h), one camera for the sequence.
+typedef struct cli_barb_renderer {
+	plume_barb_embedding *embedding;
+	plume_raytrace_def def;
+} cli_barb_renderer;
+
+/// Frames the box [lo, hi] (the whole sequence's reach) in a width x height image.
+plume_status cli_barb_renderer_begin(cli_barb_renderer *renderer, const plume_feather *feather,
+                                     const plume_mesh *mesh, plume_vec3 lo, plume_vec3 hi, int width, int height,
+                                     int spp, plume_error *err);
+/// Renders the feather carried by the shell at positions to path (PNG).
+plume_status cli_barb_renderer_frame(const cli_barb_renderer *renderer, const plume_vec3 *positions,
+                                     const char *path, plume_error *err);
+void cli_barb_renderer_end(cli_barb_renderer *renderer);
+
 int cli_generate(int argc, char **argv);
 int cli_grow(int argc, char **argv);
+int cli_mesh(int argc, char **argv);
 int cli_coat(int argc, char **argv);
 int cli_simulate(int argc, char **argv);
 int cli_render(int argc, char **argv);
@@ -82,6 +99,7 @@ int cli_demo(int argc, char **argv);
 
 void cli_help_generate(void);
 void cli_help_grow(void);
+void cli_help_mesh(void);
 void cli_help_coat(void);
 void cli_help_simulate(void);
 void cli_help_render(void);

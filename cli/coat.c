@@ -1,17 +1,150 @@
-// PLACEHOLDER: replaced by `plume coat` (issue in progress).
+// plume coat COAT.json -o DIR [--seed S] [--format LIST] [--size WxH] [--style lines|strips] [--stage G]
+#define _POSIX_C_SOURCE 200809L
+#include <errno.h>
+#include <getopt.h>
 #include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
 
 #include "cli.h"
-
-int cli_coat(int argc, char **argv)
-{
-	(void)argc;
-	(void)argv;
-	fprintf(stderr, "plume coat: not built yet\n");
-	return CLI_EXIT_FAILURE;
-}
+#include "plume/coat.h"
 
 void cli_help_coat(void)
 {
-	printf("plume coat: not built yet\n");
+	puts("Usage: plume coat COAT.json -o DIR [options]\n"
+	     "\n"
+	     "Covers a surface with feathers (Streit & Heidrich 4.4): follicles laid out on a\n"
+	     "plane, a sphere or an OBJ triangle mesh, key feathers at chosen follicles, every\n"
+	     "other feather interpolated from them. Writes DIR/coat.obj and DIR/coat.usda\n"
+	     "(one curve object per feather, bottom to top) and DIR/coat.png (the coat seen\n"
+	     "from +z). All files appear together, or none when anything fails.\n"
+	     "\n"
+	     "Options:\n"
+	     "  -o, --output DIR       output folder (created if missing)\n"
+	     "  -s, --seed N           random seed; overrides the coat's \"seed\" (default 1)\n"
+	     "  -f, --format LIST      comma-separated: png,svg,pdf,obj,usda (default: png,obj,usda)\n"
+	     "      --size WxH         image size in pixels (default 1200x1200)\n"
+	     "      --style STYLE      lines (default) or strips: barbs as alpha-faded triangle\n"
+	     "                         strips (Streit & Heidrich 4.3.1)\n"
+	     "      --stage G          grow every feather to stage G in [0, 1] (default 1)\n"
+	     "  -h, --help             this help\n"
+	     "\n"
+	     "Coat specs are described in docs/coats.md; examples/coats/ has ready ones.");
+}
+
+static bool parse_stage(const char *text, double *stage)
+{
+	char *end;
+	errno = 0;
+	double value = strtod(text, &end);
+	if (errno != 0 || end == text || *end != '\0' || !(value >= 0.0 && value <= 1.0)) {
+		cli_usage_error("coat", "--stage '%s' must be a number in [0, 1]", text);
+		return false;
+	}
+	*stage = value;
+	return true;
+}
+
+static plume_status write_coat(cli_output *output, const plume_coat *coat, unsigned formats,
+                               const plume_render2d_def *image, plume_error *err)
+{
+	static const struct {
+		unsigned bit;
+		const char *name;
+		plume_image_format format;
+	} images[] = {{CLI_FORMAT_PNG, "coat.png", PLUME_IMAGE_PNG},
+	              {CLI_FORMAT_SVG, "coat.svg", PLUME_IMAGE_SVG},
+	              {CLI_FORMAT_PDF, "coat.pdf", PLUME_IMAGE_PDF}};
+	char path[4352];
+	plume_status status = PLUME_OK;
+	if ((formats & CLI_FORMAT_OBJ) != 0 &&
+	    (status = plume_coat_write_obj(coat, cli_output_path(output, "coat.obj", path, sizeof path), err)) != PLUME_OK)
+		return status;
+	if ((formats & CLI_FORMAT_USDA) != 0 &&
+	    (status = plume_coat_write_usda(coat, cli_output_path(output, "coat.usda", path, sizeof path), err)) !=
+	        PLUME_OK)
+		return status;
+	for (size_t i = 0; i < sizeof images / sizeof images[0]; ++i)
+		if ((formats & images[i].bit) != 0 &&
+		    (status = plume_coat_render2d(coat, image, images[i].format,
+		                                  cli_output_path(output, images[i].name, path, sizeof path), err)) != PLUME_OK)
+			return status;
+	return PLUME_OK;
+}
+
+int cli_coat(int argc, char **argv)
+{
+	static const struct option options[] = {
+	    {"output", required_argument, NULL, 'o'}, {"seed", required_argument, NULL, 's'},
+	    {"format", required_argument, NULL, 'f'}, {"size", required_argument, NULL, 'S'},
+	    {"style", required_argument, NULL, 'y'},  {"stage", required_argument, NULL, 'g'},
+	    {"help", no_argument, NULL, 'h'},         {NULL, 0, NULL, 0},
+	};
+	const char *output_dir = NULL;
+	unsigned formats = CLI_FORMAT_PNG | CLI_FORMAT_OBJ | CLI_FORMAT_USDA;
+	plume_spec_options spec_options = {.seed = 0, .seed_given = false};
+	plume_render2d_def image = plume_render2d_default_def();
+	image.width = image.height = 1200;
+	int option;
+	optind = 1;
+	opterr = 0;
+	while ((option = getopt_long(argc, argv, ":o:s:f:h", options, NULL)) != -1) {
+		switch (option) {
+		case 'o': output_dir = optarg; break;
+		case 's':
+			if (!cli_parse_seed("coat", optarg, &spec_options.seed))
+				return CLI_EXIT_USAGE;
+			spec_options.seed_given = true;
+			break;
+		case 'f':
+			if (!cli_parse_formats("coat", optarg, &formats))
+				return CLI_EXIT_USAGE;
+			if ((formats & CLI_FORMAT_JSON) != 0)
+				return cli_usage_error("coat", "--format json is for single feathers; a coat writes png, svg, pdf, "
+				                               "obj, usda");
+			break;
+		case 'S':
+			if (!cli_parse_size("coat", optarg, &image.width, &image.height))
+				return CLI_EXIT_USAGE;
+			break;
+		case 'y':
+			if (strcmp(optarg, "lines") == 0)
+				image.style = PLUME_STYLE_LINES;
+			else if (strcmp(optarg, "strips") == 0)
+				image.style = PLUME_STYLE_STRIPS;
+			else
+				return cli_usage_error("coat", "--style '%s': allowed lines, strips", optarg);
+			break;
+		case 'g':
+			if (!parse_stage(optarg, &spec_options.stage))
+				return CLI_EXIT_USAGE;
+			spec_options.stage_kind = PLUME_STAGE_GROWTH;
+			break;
+		case 'h': cli_help_coat(); return CLI_EXIT_OK;
+		case ':': return cli_usage_error("coat", "option '%s' needs a value", argv[optind - 1]);
+		default: return cli_usage_error("coat", "unknown option '%s'", argv[optind - 1]);
+		}
+	}
+	if (optind >= argc)
+		return cli_usage_error("coat", "missing COAT.json");
+	if (optind + 1 < argc)
+		return cli_usage_error("coat", "unexpected argument '%s'", argv[optind + 1]);
+	if (output_dir == NULL)
+		return cli_usage_error("coat", "missing -o DIR");
+
+	plume_error err = {0};
+	plume_coat *coat = NULL;
+	cli_output output;
+	plume_status status = plume_coat_spec_generate(argv[optind], &spec_options, &coat, &err);
+	if (status == PLUME_OK && (status = cli_output_begin(&output, output_dir, &err)) == PLUME_OK) {
+		status = write_coat(&output, coat, formats, &image, &err);
+		if (status == PLUME_OK)
+			status = cli_output_commit(&output, &err);
+		else
+			cli_output_abort(&output);
+	}
+	plume_coat_destroy(coat);
+	if (status != PLUME_OK)
+		return cli_fail(&err);
+	return CLI_EXIT_OK;
 }

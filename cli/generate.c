@@ -6,12 +6,34 @@
 
 #include "cli.h"
 
+/// Writes the generator's diagnostics (plume_feather_summary) to
+/// <staging>/summary.json and prints them on stdout: a model that could not do
+/// everything it was asked (Zhang–Kanai barbs that did not snap) says so.
+static plume_status write_summary(cli_output *output, const plume_feather *feather, plume_error *err)
+{
+	const char *summary = plume_feather_summary(feather);
+	if (summary == NULL)
+		return PLUME_OK;
+	char path[4352];
+	cli_output_path(output, "summary.json", path, sizeof path);
+	FILE *file = fopen(path, "wb");
+	bool written = file != NULL && fprintf(file, "%s\n", summary) >= 0;
+	if (file != NULL && fclose(file) != 0)
+		written = false;
+	if (!written)
+		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write the summary", path);
+	printf("summary: %s\n", summary);
+	return PLUME_OK;
+}
+
 void cli_help_generate(void)
 {
 	puts("Usage: plume generate SPEC.json -o DIR [options]\n"
 	     "\n"
 	     "Generates the feather that SPEC.json describes and writes DIR/feather.<ext>\n"
 	     "for each format. All files appear together, or none when anything fails.\n"
+	     "A generator that reports diagnostics (zhang-kanai: barbs that did not snap)\n"
+	     "also writes DIR/summary.json and prints it.\n"
 	     "\n"
 	     "Options:\n"
 	     "  -o, --output DIR       output folder (created if missing)\n"
@@ -22,7 +44,8 @@ void cli_help_generate(void)
 	     "                         of the line style\n"
 	     "  -h, --help             this help\n"
 	     "\n"
-	     "Specs are described in docs/spec-franco-walter.md; examples/ has ready ones.");
+	     "Specs are described in docs/spec-franco-walter.md and docs/spec-zhang-kanai.md;\n"
+	     "examples/ has ready ones.");
 }
 
 int cli_generate(int argc, char **argv)
@@ -83,6 +106,8 @@ int cli_generate(int argc, char **argv)
 	plume_status status = plume_spec_generate(argv[optind], &spec_options, &feather, &err);
 	if (status == PLUME_OK && (status = cli_output_begin(&output, output_dir, &err)) == PLUME_OK) {
 		status = cli_write_feather(&output, feather, "feather", formats, &images, &err);
+		if (status == PLUME_OK)
+			status = write_summary(&output, feather, &err);
 		if (status == PLUME_OK)
 			status = cli_output_commit(&output, &err);
 		else

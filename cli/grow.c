@@ -1,17 +1,201 @@
-// PLACEHOLDER: replaced by `plume grow` (issue in progress).
+// plume grow SPEC.json -o DIR --frames N [--unfurl] [--seed S] [--format LIST] [--size WxH]
+#define _POSIX_C_SOURCE 200809L
+#include <errno.h>
+#include <getopt.h>
 #include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
 
 #include "cli.h"
 
-int cli_grow(int argc, char **argv)
-{
-	(void)argc;
-	(void)argv;
-	fprintf(stderr, "plume grow: not built yet\n");
-	return CLI_EXIT_FAILURE;
-}
+/// More frames than this is a typing mistake rather than an animation.
+#define MAX_FRAMES 10000
 
 void cli_help_grow(void)
 {
-	printf("plume grow: not built yet\n");
+	puts("Usage: plume grow SPEC.json -o DIR --frames N [options]\n"
+	     "\n"
+	     "Writes N stages of a feather's development: DIR/frame-0000.<ext> is the start\n"
+	     "and DIR/frame-<N-1>.<ext> the finished feather (stage i / (N - 1); one frame is\n"
+	     "the finished feather). Growth follows the model's own schedule: streit-heidrich\n"
+	     "4.2.4 (shaft, then barbs, then the sheath opening from the tip), zhang-kanai's\n"
+	     "growth period. All files appear together, or none when anything fails.\n"
+	     "\n"
+	     "Options:\n"
+	     "  -o, --output DIR       output folder (created if missing)\n"
+	     "  -n, --frames N         number of frames, [1, 10000]\n"
+	     "  -u, --unfurl           unfurling stages instead of growth (zhang-kanai)\n"
+	     "  -s, --seed N           random seed; overrides the spec's \"seed\" (default 1)\n"
+	     "  -f, --format LIST      comma-separated: png,svg,pdf,obj,usda,json (default: png,obj,usda)\n"
+	     "      --size WxH         image size in pixels (default: 1200 tall, width to fit);\n"
+	     "                         every frame shares one framing, so the feather grows in it\n"
+	     "      --style STYLE      lines (default) or strips (alpha-faded triangle strips)\n"
+	     "  -h, --help             this help\n"
+	     "\n"
+	     "Example: plume grow examples/streit-heidrich/contour.json -o growth --frames 5");
+}
+
+static bool parse_frames(const char *text, int *frames)
+{
+	char *end;
+	errno = 0;
+	long value = strtol(text, &end, 10);
+	if (errno != 0 || end == text || *end != '\0' || value < 1 || value > MAX_FRAMES) {
+		cli_usage_error("grow", "--frames '%s' must be an integer in [1, %d]", text, MAX_FRAMES);
+		return false;
+	}
+	*frames = (int)value;
+	return true;
+}
+
+static double frame_stage(int i, int frames) { return frames > 1 ? (double)i / (frames - 1) : 1.0; }
+
+/// The union of every frame's bounds in the feather plane, so that all frames share one framing and the
+/// feather is seen to grow.
+static plume_status frame_bounds(const char *spec, plume_spec_options options, int frames, plume_vec2 *lo,
+                                 plume_vec2 *hi, plume_error *err)
+{
+	*lo = (plume_vec2){1e300, 1e300};
+	*hi = (plume_vec2){-1e300, -1e300};
+	for (int i = 0; i < frames; ++i) {
+		options.stage = frame_stage(i, frames);
+		plume_feather *feather = NULL;
+		plume_status status = plume_spec_generate(spec, &options, &feather, err);
+		if (status != PLUME_OK)
+			return status;
+		plume_feather_info info = plume_feather_get_info(feather);
+		lo->x = info.bounds_min.x < lo->x ? info.bounds_min.x : lo->x;
+		lo->y = info.bounds_min.y < lo->y ? info.bounds_min.y : lo->y;
+		hi->x = info.bounds_max.x > hi->x ? info.bounds_max.x : hi->x;
+		hi->y = info.bounds_max.y > hi->y ? info.bounds_max.y : hi->y;
+		plume_feather_destroy(feather);
+	}
+	return PLUME_OK;
+}
+
+/// Generates and writes every frame into the staged output: images with one shared view, geometry with
+/// cli_write_feather.
+static plume_status write_frames(cli_output *output, const char *spec, plume_spec_options options, int frames,
+                                 unsigned formats, plume_render2d_def image, plume_error *err)
+{
+	static const struct {
+		unsigned bit;
+		const char *extension;
+		plume_image_format format;
+	} images[] = {{CLI_FORMAT_PNG, "png", PLUME_IMAGE_PNG},
+	              {CLI_FORMAT_SVG, "svg", PLUME_IMAGE_SVG},
+	              {CLI_FORMAT_PDF, "pdf", PLUME_IMAGE_PDF}};
+	plume_status status = PLUME_OK;
+	if ((formats & (CLI_FORMAT_PNG | CLI_FORMAT_SVG | CLI_FORMAT_PDF)) != 0) {
+		if ((status = frame_bounds(spec, options, frames, &image.view_min, &image.view_max, err)) != PLUME_OK)
+			return status;
+		if (image.width == 0) { // 1200 tall, as wide as the framing needs
+			double w = image.view_max.x - image.view_min.x, h = image.view_max.y - image.view_min.y;
+			image.height = 1200;
+			int width =
+			    h > 0.0 ? (int)(1200.0 * (1.0 - 2.0 * image.margin) * w / h + 2.0 * image.margin * 1200.0 + 0.5) : 1200;
+			image.width = width < 256 ? 256 : (width > 4096 ? 4096 : width);
+		}
+	}
+	cli_image_options geometry_only = {0, 0, NULL};
+	for (int i = 0; i < frames && status == PLUME_OK; ++i) {
+		options.stage = frame_stage(i, frames);
+		plume_feather *feather = NULL;
+		status = plume_spec_generate(spec, &options, &feather, err);
+		char stem[32];
+		snprintf(stem, sizeof stem, "frame-%04d", i);
+		for (size_t k = 0; k < sizeof images / sizeof images[0] && status == PLUME_OK; ++k) {
+			if ((formats & images[k].bit) == 0)
+				continue;
+			char name[64], path[4352];
+			snprintf(name, sizeof name, "%s.%s", stem, images[k].extension);
+			status = plume_render2d(feather, &image, images[k].format, cli_output_path(output, name, path, sizeof path),
+			                        err);
+		}
+		unsigned rest = formats & ~(unsigned)(CLI_FORMAT_PNG | CLI_FORMAT_SVG | CLI_FORMAT_PDF);
+		if (status == PLUME_OK && rest != 0)
+			status = cli_write_feather(output, feather, stem, rest, &geometry_only, err);
+		plume_feather_destroy(feather);
+	}
+	return status;
+}
+
+int cli_grow(int argc, char **argv)
+{
+	static const struct option options[] = {
+	    {"output", required_argument, NULL, 'o'},
+	    {"frames", required_argument, NULL, 'n'},
+	    {"unfurl", no_argument, NULL, 'u'},
+	    {"seed", required_argument, NULL, 's'},
+	    {"format", required_argument, NULL, 'f'},
+	    {"size", required_argument, NULL, 'S'},
+	    {"style", required_argument, NULL, 'y'},
+	    {"help", no_argument, NULL, 'h'},
+	    {NULL, 0, NULL, 0},
+	};
+	const char *output_dir = NULL;
+	int frames = 0;
+	unsigned formats = CLI_FORMAT_PNG | CLI_FORMAT_OBJ | CLI_FORMAT_USDA;
+	plume_spec_options spec_options = {.seed = 0, .seed_given = false, .stage_kind = PLUME_STAGE_GROWTH};
+	plume_render2d_def image = plume_render2d_default_def();
+	image.width = image.height = 0;
+	int option;
+	optind = 1;
+	opterr = 0;
+	while ((option = getopt_long(argc, argv, ":o:n:us:f:h", options, NULL)) != -1) {
+		switch (option) {
+		case 'o': output_dir = optarg; break;
+		case 'n':
+			if (!parse_frames(optarg, &frames))
+				return CLI_EXIT_USAGE;
+			break;
+		case 'u': spec_options.stage_kind = PLUME_STAGE_UNFURL; break;
+		case 's':
+			if (!cli_parse_seed("grow", optarg, &spec_options.seed))
+				return CLI_EXIT_USAGE;
+			spec_options.seed_given = true;
+			break;
+		case 'f':
+			if (!cli_parse_formats("grow", optarg, &formats))
+				return CLI_EXIT_USAGE;
+			break;
+		case 'S':
+			if (!cli_parse_size("grow", optarg, &image.width, &image.height))
+				return CLI_EXIT_USAGE;
+			break;
+		case 'y':
+			if (strcmp(optarg, "lines") == 0)
+				image.style = PLUME_STYLE_LINES;
+			else if (strcmp(optarg, "strips") == 0)
+				image.style = PLUME_STYLE_STRIPS;
+			else
+				return cli_usage_error("grow", "--style '%s': allowed lines, strips", optarg);
+			break;
+		case 'h': cli_help_grow(); return CLI_EXIT_OK;
+		case ':': return cli_usage_error("grow", "option '%s' needs a value", argv[optind - 1]);
+		default: return cli_usage_error("grow", "unknown option '%s'", argv[optind - 1]);
+		}
+	}
+	if (optind >= argc)
+		return cli_usage_error("grow", "missing SPEC.json");
+	if (optind + 1 < argc)
+		return cli_usage_error("grow", "unexpected argument '%s'", argv[optind + 1]);
+	if (output_dir == NULL)
+		return cli_usage_error("grow", "missing -o DIR");
+	if (frames == 0)
+		return cli_usage_error("grow", "missing --frames N");
+	cli_output output;
+	plume_error err = {0};
+	plume_status status = cli_output_begin(&output, output_dir, &err);
+	if (status == PLUME_OK) {
+		status = write_frames(&output, argv[optind], spec_options, frames, formats, image, &err);
+		if (status == PLUME_OK)
+			status = cli_output_commit(&output, &err);
+		else
+			cli_output_abort(&output);
+	}
+	if (status != PLUME_OK)
+		return cli_fail(&err);
+	return CLI_EXIT_OK;
 }

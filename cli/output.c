@@ -173,15 +173,41 @@ plume_status cli_output_commit(cli_output *output, plume_error *err)
 		}
 		return PLUME_OK;
 	}
-	for (int i = 0; i < output->name_count; ++i) {
-		char from[4352], to[4352];
-		snprintf(from, sizeof from, "%s/%s", output->stage, output->names[i]);
-		snprintf(to, sizeof to, "%s/%s", output->dir, output->names[i]);
-		if (rename(from, to) != 0) {
-			plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write: %s", to, strerror(errno));
-			cli_output_abort(output);
-			return PLUME_ERROR_IO;
+	// Every entry of the staging folder replaces its namesake. A folder (frames/) that
+	// exists is moved aside first and removed only once the new one is in place.
+	DIR *stage = opendir(output->stage);
+	if (stage == NULL) {
+		plume_error_set(err, PLUME_ERROR_IO, "%s: cannot read the staging folder: %s", output->stage, strerror(errno));
+		cli_output_abort(output);
+		return PLUME_ERROR_IO;
+	}
+	struct dirent *entry;
+	plume_status status = PLUME_OK;
+	while (status == PLUME_OK && (entry = readdir(stage)) != NULL) {
+		if (strcmp(entry->d_name, ".") == 0 || strcmp(entry->d_name, "..") == 0)
+			continue;
+		char from[4608], to[4608], aside[4608];
+		snprintf(from, sizeof from, "%s/%s", output->stage, entry->d_name);
+		snprintf(to, sizeof to, "%s/%s", output->dir, entry->d_name);
+		struct stat info;
+		bool replace_folder = stat(to, &info) == 0 && S_ISDIR(info.st_mode);
+		if (replace_folder) {
+			snprintf(aside, sizeof aside, "%s/.%s.plume-old", output->dir, entry->d_name);
+			if (rename(to, aside) != 0)
+				replace_folder = false;
 		}
+		if (rename(from, to) != 0) {
+			status = plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write: %s", to, strerror(errno));
+			if (replace_folder)
+				rename(aside, to);
+		} else if (replace_folder) {
+			remove_tree(aside);
+		}
+	}
+	closedir(stage);
+	if (status != PLUME_OK) {
+		cli_output_abort(output);
+		return status;
 	}
 	rmdir(output->stage);
 	return PLUME_OK;

@@ -15,6 +15,7 @@ static const command commands[] = {
     {"generate", "generate a feather from a spec; write images and geometry", cli_generate, cli_help_generate},
     {"grow", "write a feather's growth or unfurling sequence, frame by frame", cli_grow, cli_help_grow},
     {"coat", "cover a surface with feathers from a coat spec", cli_coat, cli_help_coat},
+    {"mesh", "mesh a feather into a barb-aligned shell; write OBJ, picture and report", cli_mesh, cli_help_mesh},
     {"simulate", "simulate a feather as an anisotropic shell from a scene spec", cli_simulate, cli_help_simulate},
     {"render", "ray-trace a feather, a coat or a simulation", cli_render, cli_help_render},
     {"lab", "virtual lab: traction tests, calibration, studies", cli_lab, cli_help_lab},

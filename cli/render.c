@@ -1,17 +1,520 @@
-// PLACEHOLDER: replaced by `plume render` (issue in progress).
+// plume render INPUT -o DIR [--camera FILE] [--spp N] [--size WxH] [--seed N] [--texture IMAGE]
+//                          [--turntable N] [--threads N] [--shell] [--format LIST]
+//
+// INPUT is a feather or coat spec (ray-traced to DIR/feather.png, or a turntable in DIR/turntable/) or a simulation
+// output folder (docs/rendering.md): the generated feather's barbs are embedded in the rest shell and
+// carried to every frame, written as DIR/frames/NNNN.png, .obj and .usda.
+#define _POSIX_C_SOURCE 200809L
+#include <dirent.h>
+#include <errno.h>
+#include <math.h>
+#include <getopt.h>
 #include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <jansson.h>
 
 #include "cli.h"
-
-int cli_render(int argc, char **argv)
-{
-	(void)argc;
-	(void)argv;
-	fprintf(stderr, "plume render: not built yet\n");
-	return CLI_EXIT_FAILURE;
-}
+#include "plume/coat.h"
+#include "plume/embed.h"
+#include "plume/raytrace.h"
 
 void cli_help_render(void)
 {
-	printf("plume render: not built yet\n");
+	puts("Usage: plume render INPUT -o DIR [options]\n"
+	     "\n"
+	     "Ray-traces INPUT with Embree: barbs as ribbons facing the vane normal, the shaft as a\n"
+	     "tube, fiber shading, shadows, ambient occlusion, jittered supersampling.\n"
+	     "  INPUT a feather spec (.json): writes DIR/feather.png (or DIR/turntable/NNNN.png).\n"
+	     "  INPUT a coat spec (\"model\": \"coat\"): every feather of the coat over its surface,\n"
+	     "        written the same way.\n"
+	     "  INPUT a simulation folder (from plume simulate): embeds the barbs of feather.json in\n"
+	     "        mesh.obj, carries them to every frames/NNNN.obj and writes DIR/frames/NNNN.png,\n"
+	     "        NNNN.obj and NNNN.usda (barb-level curves).\n"
+	     "All files appear together, or none when anything fails.\n"
+	     "\n"
+	     "Options:\n"
+	     "  -o, --output DIR       output folder (created if missing)\n"
+	     "  -c, --camera FILE      camera, lights and render settings (docs/rendering.md);\n"
+	     "                         default: automatic framing of the feather from the front\n"
+	     "      --spp N            samples per pixel, [1, 4096] (default 16)\n"
+	     "      --size WxH         image size in pixels (default 800x800)\n"
+	     "  -s, --seed N           seed of the sampling (spec renders also use it for the feather)\n"
+	     "  -t, --texture IMAGE    colour the barbs from IMAGE (Franco & Walter 4.4)\n"
+	     "      --turntable N      N images turning the camera once around the feather\n"
+	     "      --threads N        OpenMP threads (default: all); the image does not depend on it\n"
+	     "      --shell            also draw the simulated shell (simulation folders)\n"
+	     "      --strip N          simulation folders: also DIR/strip.png, N frames evenly spaced\n"
+	     "                         from the first to the last, side by side\n"
+	     "  -f, --format LIST      simulation folders: png,obj,usda (default: all three)\n"
+	     "  -h, --help             this help");
+}
+
+typedef struct render_options {
+	const char *input, *output_dir, *camera_path, *texture_path;
+	int spp, width, height, turntable, threads, strip;
+	bool seed_given, shell;
+	uint64_t seed;
+	unsigned formats;
+} render_options;
+
+static bool parse_count(const char *text, int lo, int hi, int *out)
+{
+	char *end;
+	errno = 0;
+	long value = strtol(text, &end, 10);
+	if (errno != 0 || end == text || *end != '\0' || value < lo || value > hi)
+		return false;
+	*out = (int)value;
+	return true;
+}
+
+static int parse_options(int argc, char **argv, render_options *o)
+{
+	static const struct option options[] = {
+	    {"output", required_argument, NULL, 'o'},
+	    {"camera", required_argument, NULL, 'c'},
+	    {"spp", required_argument, NULL, 'p'},
+	    {"size", required_argument, NULL, 'S'},
+	    {"seed", required_argument, NULL, 's'},
+	    {"texture", required_argument, NULL, 't'},
+	    {"turntable", required_argument, NULL, 'T'},
+	    {"threads", required_argument, NULL, 'j'},
+	    {"strip", required_argument, NULL, 'P'},
+	    {"shell", no_argument, NULL, 'm'},
+	    {"format", required_argument, NULL, 'f'},
+	    {"help", no_argument, NULL, 'h'},
+	    {NULL, 0, NULL, 0},
+	};
+	int option;
+	optind = 1;
+	opterr = 0;
+	while ((option = getopt_long(argc, argv, ":o:c:s:t:f:h", options, NULL)) != -1) {
+		switch (option) {
+		case 'o': o->output_dir = optarg; break;
+		case 'c': o->camera_path = optarg; break;
+		case 'p':
+			if (!parse_count(optarg, 1, 4096, &o->spp))
+				return cli_usage_error("render", "--spp '%s' must be an integer in [1, 4096]", optarg);
+			break;
+		case 'S':
+			if (!cli_parse_size("render", optarg, &o->width, &o->height))
+				return CLI_EXIT_USAGE;
+			break;
+		case 's':
+			if (!cli_parse_seed("render", optarg, &o->seed))
+				return CLI_EXIT_USAGE;
+			o->seed_given = true;
+			break;
+		case 't': o->texture_path = optarg; break;
+		case 'T':
+			if (!parse_count(optarg, 1, 3600, &o->turntable))
+				return cli_usage_error("render", "--turntable '%s' must be an integer in [1, 3600]", optarg);
+			break;
+		case 'j':
+			if (!parse_count(optarg, 1, 1024, &o->threads))
+				return cli_usage_error("render", "--threads '%s' must be an integer in [1, 1024]", optarg);
+			break;
+		case 'm': o->shell = true; break;
+		case 'P':
+			if (!parse_count(optarg, 1, 64, &o->strip))
+				return cli_usage_error("render", "--strip '%s' must be an integer in [1, 64]", optarg);
+			break;
+		case 'f': {
+			o->formats = 0;
+			char list[256];
+			snprintf(list, sizeof list, "%s", optarg);
+			for (char *name = strtok(list, ","); name != NULL; name = strtok(NULL, ",")) {
+				if (strcmp(name, "png") == 0)
+					o->formats |= CLI_FORMAT_PNG;
+				else if (strcmp(name, "obj") == 0)
+					o->formats |= CLI_FORMAT_OBJ;
+				else if (strcmp(name, "usda") == 0)
+					o->formats |= CLI_FORMAT_USDA;
+				else
+					return cli_usage_error("render", "unknown format '%s' in --format; allowed: png, obj, usda", name);
+			}
+			if (o->formats == 0)
+				return cli_usage_error("render", "--format needs at least one of png, obj, usda");
+			break;
+		}
+		case 'h': cli_help_render(); return -1;
+		case ':': return cli_usage_error("render", "option '%s' needs a value", argv[optind - 1]);
+		default: return cli_usage_error("render", "unknown option '%s'", argv[optind - 1]);
+		}
+	}
+	if (optind >= argc)
+		return cli_usage_error("render", "missing INPUT (a feather spec or a simulation folder)");
+	if (optind + 1 < argc)
+		return cli_usage_error("render", "unexpected argument '%s'", argv[optind + 1]);
+	if (o->output_dir == NULL)
+		return cli_usage_error("render", "missing -o DIR");
+	o->input = argv[optind];
+	return CLI_EXIT_OK;
+}
+
+/// The render settings: defaults, then the camera file, then the command line.
+static plume_status make_def(const render_options *o, const plume_texture *texture, plume_raytrace_def *def,
+                             plume_error *err)
+{
+	*def = plume_raytrace_default_def();
+	if (o->camera_path != NULL) {
+		plume_status status = plume_raytrace_def_read(o->camera_path, def, err);
+		if (status != PLUME_OK)
+			return status;
+	}
+	if (o->spp > 0)
+		def->spp = o->spp;
+	if (o->width > 0) {
+		def->camera.width = o->width;
+		def->camera.height = o->height;
+	}
+	if (o->seed_given)
+		def->seed = o->seed;
+	def->threads = o->threads;
+	def->texture = texture;
+	return PLUME_OK;
+}
+
+static bool interactive(void) { return isatty(STDERR_FILENO) != 0; }
+
+/// A subfolder of the staging folder, registered as one output name.
+static plume_status stage_folder(cli_output *output, const char *name, char *path, size_t size, plume_error *err)
+{
+	cli_output_path(output, name, path, size);
+	if (mkdir(path, 0777) != 0)
+		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot create: %s", path, strerror(errno));
+	char final[4352];
+	snprintf(final, sizeof final, "%s/%s", output->dir, name);
+	struct stat info;
+	if (output->dir_existed && stat(final, &info) == 0)
+		return plume_error_set(err, PLUME_ERROR_IO, "%s: already exists; choose another output folder", final);
+	return PLUME_OK;
+}
+
+// ---------------------------------------------------------------------------
+// A feather spec
+
+/// True when the spec file says "model": "coat" (anything unreadable is left to the feather reader's errors).
+static bool is_coat_spec(const char *path)
+{
+	json_t *root = json_load_file(path, 0, NULL);
+	const char *model = json_string_value(json_object_get(root, "model"));
+	bool coat = model != NULL && strcmp(model, "coat") == 0;
+	json_decref(root);
+	return coat;
+}
+
+static plume_status render_spec(const render_options *o, const plume_raytrace_def *def, cli_output *output,
+                                plume_error *err)
+{
+	plume_spec_options spec_options = {.seed = o->seed, .seed_given = o->seed_given};
+	plume_feather *feather = NULL;
+	plume_coat *coat = NULL;
+	const plume_feather **list = NULL;
+	plume_raytrace_scene scene = {0};
+	plume_status status;
+	if (is_coat_spec(o->input)) {
+		// A coat: every feather (already in world coordinates) over the coat's surface.
+		if ((status = plume_coat_spec_generate(o->input, &spec_options, &coat, err)) != PLUME_OK)
+			return status;
+		scene.feather_count = plume_coat_feather_count(coat);
+		list = malloc((size_t)(scene.feather_count > 0 ? scene.feather_count : 1) * sizeof *list);
+		if (list == NULL) {
+			plume_coat_destroy(coat);
+			return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory");
+		}
+		for (int i = 0; i < scene.feather_count; ++i)
+			list[i] = plume_coat_feather(coat, i);
+		scene.shell = plume_coat_surface(coat);
+	} else {
+		if ((status = plume_spec_generate(o->input, &spec_options, &feather, err)) != PLUME_OK)
+			return status;
+		list = malloc(sizeof *list);
+		if (list == NULL) {
+			plume_feather_destroy(feather);
+			return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory");
+		}
+		list[0] = feather;
+		scene.feather_count = 1;
+	}
+	scene.feathers = list;
+	char path[4608];
+	if (o->turntable == 0) {
+		cli_output_path(output, "feather.png", path, sizeof path);
+		status = plume_raytrace_render_png(&scene, def, path, NULL, err);
+	} else {
+		char folder[4352];
+		status = stage_folder(output, "turntable", folder, sizeof folder, err);
+		plume_raytrace_def frame = *def;
+		// One framing for every angle: the camera turns, the feather stays.
+		plume_vec3 lo, hi;
+		plume_raytrace_scene_bounds(&scene, &lo, &hi);
+		frame.camera = plume_camera_frame_bounds(&def->camera, lo, hi);
+		for (int i = 0; i < o->turntable && status == PLUME_OK; ++i) {
+			frame.camera.turntable = 2.0 * 3.14159265358979323846 * i / o->turntable;
+			snprintf(path, sizeof path, "%s/%04d.png", folder, i);
+			status = plume_raytrace_render_png(&scene, &frame, path, NULL, err);
+			if (interactive())
+				fprintf(stderr, "\rplume render: %d/%d", i + 1, o->turntable);
+		}
+		if (interactive())
+			fputc('\n', stderr);
+	}
+	free(list);
+	plume_feather_destroy(feather);
+	plume_coat_destroy(coat);
+	return status;
+}
+
+// ---------------------------------------------------------------------------
+// A simulation folder
+
+typedef struct sim_input {
+	plume_feather *feather;
+	plume_mesh *rest;
+	int frame_count;
+	char (*frame_names)[64];
+	plume_vec3 **positions; ///< per frame, rest vertex order
+} sim_input;
+
+static void sim_input_free(sim_input *in)
+{
+	plume_feather_destroy(in->feather);
+	plume_mesh_destroy(in->rest);
+	for (int i = 0; i < in->frame_count; ++i)
+		free(in->positions != NULL ? in->positions[i] : NULL);
+	free(in->positions);
+	free(in->frame_names);
+}
+
+static int compare_names(const void *a, const void *b) { return strcmp(a, b); }
+
+/// Names "NNNN.obj" in dir, sorted.
+static plume_status list_frames(const char *dir, sim_input *in, plume_error *err)
+{
+	DIR *folder = opendir(dir);
+	if (folder == NULL)
+		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot read the frames folder: %s", dir, strerror(errno));
+	struct dirent *entry;
+	int capacity = 0;
+	plume_status status = PLUME_OK;
+	while ((entry = readdir(folder)) != NULL) {
+		size_t length = strlen(entry->d_name);
+		if (length < 5 || length >= 64 || strcmp(entry->d_name + length - 4, ".obj") != 0 ||
+		    strspn(entry->d_name, "0123456789") != length - 4)
+			continue;
+		if (in->frame_count == capacity) {
+			capacity = capacity > 0 ? 2 * capacity : 64;
+			void *grown = realloc(in->frame_names, (size_t)capacity * sizeof *in->frame_names);
+			if (grown == NULL) {
+				status = plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory");
+				break;
+			}
+			in->frame_names = grown;
+		}
+		memcpy(in->frame_names[in->frame_count++], entry->d_name, length + 1); // length < 64, checked above
+	}
+	closedir(folder);
+	if (status == PLUME_OK && in->frame_count == 0)
+		return plume_error_set(err, PLUME_ERROR_IO, "%s: no frames (NNNN.obj) in the frames folder", dir);
+	qsort(in->frame_names, (size_t)in->frame_count, sizeof *in->frame_names, compare_names);
+	return status;
+}
+
+/// Reads feather.json, mesh.obj and every frame, checking that the frames match the rest shell.
+static plume_status read_sim(const char *dir, sim_input *in, plume_error *err)
+{
+	char path[4608];
+	snprintf(path, sizeof path, "%s/feather.json", dir);
+	plume_status status = plume_read_json(path, &in->feather, err);
+	if (status != PLUME_OK) {
+		if (access(path, F_OK) != 0)
+			return plume_error_set(err, PLUME_ERROR_IO,
+			                       "%s: missing; plume render needs the generated feather of a simulation to carry "
+			                       "its barbs",
+			                       path);
+		return status;
+	}
+	snprintf(path, sizeof path, "%s/mesh.obj", dir);
+	if ((status = plume_mesh_read_obj(path, &in->rest, err)) != PLUME_OK)
+		return status;
+	char frames_dir[4352];
+	snprintf(frames_dir, sizeof frames_dir, "%s/frames", dir);
+	int names = 0;
+	in->frame_count = 0;
+	if ((status = list_frames(frames_dir, in, err)) != PLUME_OK)
+		return status;
+	names = in->frame_count;
+	in->positions = calloc((size_t)names, sizeof *in->positions);
+	if (in->positions == NULL)
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory");
+	for (int i = 0; i < names; ++i) {
+		snprintf(path, sizeof path, "%s/%s", frames_dir, in->frame_names[i]);
+		plume_mesh *frame = NULL;
+		if ((status = plume_mesh_read_obj(path, &frame, err)) != PLUME_OK)
+			return status;
+		bool same = frame->vertex_count == in->rest->vertex_count && frame->face_count == in->rest->face_count &&
+		            memcmp(frame->faces, in->rest->faces, 3 * sizeof(int) * (size_t)frame->face_count) == 0;
+		if (!same) {
+			plume_error_set(err, PLUME_ERROR_SPEC,
+			                "%s: has %d vertices and %d faces, but the rest shell mesh.obj has %d and %d (or other "
+			                "faces); frames must keep the shell's vertices and faces",
+			                path, frame->vertex_count, frame->face_count, in->rest->vertex_count, in->rest->face_count);
+			plume_mesh_destroy(frame);
+			return PLUME_ERROR_SPEC;
+		}
+		in->positions[i] = malloc((size_t)frame->vertex_count * sizeof(plume_vec3));
+		if (in->positions[i] == NULL) {
+			plume_mesh_destroy(frame);
+			return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory");
+		}
+		memcpy(in->positions[i], frame->rest, (size_t)frame->vertex_count * sizeof(plume_vec3));
+		plume_mesh_destroy(frame);
+	}
+	return PLUME_OK;
+}
+
+static void grow_bounds(plume_vec3 *lo, plume_vec3 *hi, plume_vec3 a, plume_vec3 b)
+{
+	lo->x = fmin(lo->x, a.x), lo->y = fmin(lo->y, a.y), lo->z = fmin(lo->z, a.z);
+	hi->x = fmax(hi->x, b.x), hi->y = fmax(hi->y, b.y), hi->z = fmax(hi->z, b.z);
+}
+
+/// Which strip slot frame i fills: frames round(k (count - 1) / (slots - 1)) for k = 0 .. slots - 1; -1 for none.
+static int strip_slot(int slots, int count, int i)
+{
+	if (slots <= 0)
+		return -1;
+	if (slots == 1)
+		return i == count - 1 ? 0 : -1;
+	for (int k = 0; k < slots; ++k)
+		if ((int)((double)k * (count - 1) / (slots - 1) + 0.5) == i)
+			return k;
+	return -1;
+}
+
+static plume_status render_sim(const render_options *o, const plume_raytrace_def *def, cli_output *output,
+                               plume_error *err)
+{
+	sim_input in = {0};
+	plume_barb_embedding *embedding = NULL;
+	plume_status status = read_sim(o->input, &in, err);
+	if (status == PLUME_OK)
+		status = plume_embedding_create(in.feather, in.rest, &embedding, err);
+	// One camera for the whole sequence, framing the carried feather over every frame.
+	plume_raytrace_def frame_def = *def;
+	plume_vec3 lo = {INFINITY, INFINITY, INFINITY}, hi = {-INFINITY, -INFINITY, -INFINITY};
+	for (int i = 0; i < in.frame_count && status == PLUME_OK; ++i) {
+		plume_feather *moved = NULL;
+		if ((status = plume_embedding_apply(embedding, in.positions[i], &moved, err)) != PLUME_OK)
+			break;
+		const plume_feather *list[1] = {moved};
+		plume_raytrace_scene scene = {1, list, o->shell ? in.rest : NULL, in.positions[i]};
+		plume_vec3 a, b;
+		plume_raytrace_scene_bounds(&scene, &a, &b);
+		grow_bounds(&lo, &hi, a, b);
+		plume_feather_destroy(moved);
+	}
+	if (status == PLUME_OK)
+		frame_def.camera = plume_camera_frame_bounds(&def->camera, lo, hi);
+	char folder[4352];
+	if (status == PLUME_OK)
+		status = stage_folder(output, "frames", folder, sizeof folder, err);
+	const int w = frame_def.camera.width, h = frame_def.camera.height;
+	uint8_t *image = malloc(4 * (size_t)w * (size_t)h);
+	// A strip of more frames than there are shows each frame once.
+	const int slots = o->strip < in.frame_count ? o->strip : in.frame_count;
+	uint8_t *strip = slots > 0 ? calloc(4 * (size_t)w * (size_t)h, (size_t)slots) : NULL;
+	if (status == PLUME_OK && (image == NULL || (slots > 0 && strip == NULL)))
+		status = plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory for the images");
+	for (int i = 0; i < in.frame_count && status == PLUME_OK; ++i) {
+		plume_feather *moved = NULL;
+		if ((status = plume_embedding_apply(embedding, in.positions[i], &moved, err)) != PLUME_OK)
+			break;
+		const plume_feather *list[1] = {moved};
+		plume_raytrace_scene scene = {1, list, o->shell ? in.rest : NULL, in.positions[i]};
+		char stem[64], path[4608];
+		snprintf(stem, sizeof stem, "%.*s", (int)(strlen(in.frame_names[i]) - 4), in.frame_names[i]);
+		if (status == PLUME_OK && (o->formats & CLI_FORMAT_PNG)) {
+			snprintf(path, sizeof path, "%s/%s.png", folder, stem);
+			status = plume_raytrace_render(&scene, &frame_def, image, NULL, err);
+			if (status == PLUME_OK)
+				status = plume_write_rgba_png(w, h, image, path, err);
+			else
+				plume_error_prefix(err, path);
+		}
+		int slot = strip_slot(slots, in.frame_count, i);
+		if (status == PLUME_OK && slot >= 0 && strip != NULL) {
+			for (int y = 0; y < h; ++y)
+				memcpy(strip + 4 * ((size_t)y * (size_t)(w * slots) + (size_t)(slot * w)),
+				       image + 4 * (size_t)y * (size_t)w, 4 * (size_t)w);
+		}
+		if (status == PLUME_OK && (o->formats & CLI_FORMAT_OBJ)) {
+			snprintf(path, sizeof path, "%s/%s.obj", folder, stem);
+			status = plume_write_obj(moved, path, err);
+		}
+		if (status == PLUME_OK && (o->formats & CLI_FORMAT_USDA)) {
+			snprintf(path, sizeof path, "%s/%s.usda", folder, stem);
+			status = plume_write_usda(moved, path, err);
+		}
+		plume_feather_destroy(moved);
+		if (interactive())
+			fprintf(stderr, "\rplume render: frame %d/%d", i + 1, in.frame_count);
+	}
+	if (interactive() && in.frame_count > 0)
+		fputc('\n', stderr);
+	if (status == PLUME_OK && strip != NULL) {
+		char path[4608];
+		cli_output_path(output, "strip.png", path, sizeof path);
+		status = plume_write_rgba_png(w * slots, h, strip, path, err);
+	}
+	free(image);
+	free(strip);
+	plume_embedding_destroy(embedding);
+	sim_input_free(&in);
+	return status;
+}
+
+int cli_render(int argc, char **argv)
+{
+	render_options o = {.formats = CLI_FORMAT_PNG | CLI_FORMAT_OBJ | CLI_FORMAT_USDA};
+	int code = parse_options(argc, argv, &o);
+	if (code != CLI_EXIT_OK)
+		return code < 0 ? CLI_EXIT_OK : code;
+	struct stat info;
+	if (stat(o.input, &info) != 0) {
+		plume_error err;
+		plume_error_set(&err, PLUME_ERROR_IO, "%s: cannot read: %s", o.input, strerror(errno));
+		return cli_fail(&err);
+	}
+	bool sim = S_ISDIR(info.st_mode);
+	if (!sim && o.shell)
+		return cli_usage_error("render", "--shell needs a simulation folder as INPUT");
+	if (sim && o.turntable > 0)
+		return cli_usage_error("render", "--turntable needs a feather spec as INPUT");
+	if (o.strip > 0 && (!sim || !(o.formats & CLI_FORMAT_PNG)))
+		return cli_usage_error("render", "--strip needs a simulation folder as INPUT and png among the formats");
+
+	plume_error err = {0};
+	plume_texture *texture = NULL;
+	if (o.texture_path != NULL && plume_texture_load(o.texture_path, &texture, &err) != PLUME_OK)
+		return cli_fail(&err);
+	plume_raytrace_def def;
+	plume_status status = make_def(&o, texture, &def, &err);
+	cli_output output;
+	if (status == PLUME_OK && (status = cli_output_begin(&output, o.output_dir, &err)) == PLUME_OK) {
+		status = sim ? render_sim(&o, &def, &output, &err) : render_spec(&o, &def, &output, &err);
+		if (status == PLUME_OK)
+			status = cli_output_commit(&output, &err);
+		else
+			cli_output_abort(&output);
+	}
+	plume_texture_destroy(texture);
+	if (status != PLUME_OK)
+		return cli_fail(&err);
+	return CLI_EXIT_OK;
 }

@@ -1,17 +1,362 @@
-// PLACEHOLDER: replaced by `plume simulate` (issue in progress).
+// plume simulate SCENE.json -o DIR [--seed N] [--png] [--size WxH]
+#define _POSIX_C_SOURCE 200809L
+#include <getopt.h>
+#include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <jansson.h>
 
 #include "cli.h"
 
-int cli_simulate(int argc, char **argv)
-{
-	(void)argc;
-	(void)argv;
-	fprintf(stderr, "plume simulate: not built yet\n");
-	return CLI_EXIT_FAILURE;
-}
-
 void cli_help_simulate(void)
 {
-	printf("plume simulate: not built yet\n");
+	puts("Usage: plume simulate SCENE.json -o DIR [options]\n"
+	     "\n"
+	     "Simulates the feather a scene describes as an anisotropic elastic shell\n"
+	     "(Jouve et al. 2024) and writes:\n"
+	     "  DIR/mesh.obj          the rest shell (UVs, rachis and vane groups)\n"
+	     "  DIR/feather.json      the generated feather (barb-level geometry)\n"
+	     "  DIR/frames/NNNN.obj   the shell at every written step (0000: the start)\n"
+	     "  DIR/frames/NNNN.png   a shaded view of each frame, with --png\n"
+	     "  DIR/stats.csv         per step: time, Newton iterations, gradient norm,\n"
+	     "                        energy, largest barb-edge strain, wall seconds\n"
+	     "  DIR/summary.json      steps, iterations, timings, largest barb strain,\n"
+	     "                        rachis tip deflection\n"
+	     "Bad input writes nothing. If a step fails even with substeps, the frames\n"
+	     "before it are kept, summary.json says where it stopped, and the exit\n"
+	     "status is 1.\n"
+	     "\n"
+	     "Options:\n"
+	     "  -o, --output DIR    output folder (created if missing)\n"
+	     "  -s, --seed N        seed of the scene's feather (overrides the specs)\n"
+	     "      --png           also write a shaded PNG of every frame\n"
+	     "      --size WxH      PNG size (default 800x800)\n"
+	     "      --view AZ,EL    PNG camera azimuth about +y and elevation, degrees\n"
+	     "                      (default 34,20; 0,0 looks at the vane face on)\n"
+	     "      --render        ray-trace every frame at barb level (the feather's barbs\n"
+	     "                      carried by the shell) to frames/NNNN-rt.png, and make\n"
+	     "                      DIR/movie.mp4 when ffmpeg is installed\n"
+	     "      --spp N         samples per pixel of --render (default 4)\n"
+	     "  -h, --help          this help\n"
+	     "\n"
+	     "Scenes are described in docs/scene.md; examples/scenes/ has ready ones.");
+}
+
+plume_status cli_barb_renderer_begin(cli_barb_renderer *renderer, const plume_feather *feather,
+                                     const plume_mesh *mesh, plume_vec3 lo, plume_vec3 hi, int width, int height,
+                                     int spp, plume_error *err)
+{
+	renderer->embedding = NULL;
+	renderer->def = plume_raytrace_default_def();
+	renderer->def.camera.width = width;
+	renderer->def.camera.height = height;
+	renderer->def.spp = spp;
+	renderer->def.camera = plume_camera_frame_bounds(&renderer->def.camera, lo, hi);
+	return plume_embedding_create(feather, mesh, &renderer->embedding, err);
+}
+
+plume_status cli_barb_renderer_frame(const cli_barb_renderer *renderer, const plume_vec3 *positions,
+                                     const char *path, plume_error *err)
+{
+	plume_feather *moved = NULL;
+	plume_status status = plume_embedding_apply(renderer->embedding, positions, &moved, err);
+	if (status == PLUME_OK) {
+		const plume_feather *list[1] = {moved};
+		plume_raytrace_scene scene = {1, list, NULL, NULL};
+		status = plume_raytrace_render_png(&scene, &renderer->def, path, NULL, err);
+	}
+	plume_feather_destroy(moved);
+	return status;
+}
+
+void cli_barb_renderer_end(cli_barb_renderer *renderer)
+{
+	plume_embedding_destroy(renderer->embedding);
+	renderer->embedding = NULL;
+}
+
+typedef struct run_state {
+	const plume_scene *scene;
+	cli_output *output;
+	FILE *stats;
+	bool png;
+	bool render;
+	cli_barb_renderer renderer;
+	plume_shell_view_def view;
+	int frames;
+	int total_steps;
+	bool progress;
+	double max_strain;
+} run_state;
+
+static plume_status write_frame(run_state *run, int frame, const plume_sim *sim, plume_error *err)
+{
+	char name[64], path[4352];
+	snprintf(name, sizeof name, "frames/%04d.obj", frame);
+	cli_output_path(run->output, name, path, sizeof path);
+	plume_status status = plume_mesh_write_obj(run->scene->mesh, plume_sim_positions(sim), path, err);
+	if (status == PLUME_OK && run->png) {
+		snprintf(name, sizeof name, "frames/%04d.png", frame);
+		cli_output_path(run->output, name, path, sizeof path);
+		status = plume_render_shell_png(run->scene->mesh, plume_sim_positions(sim), &run->view, path, err);
+	}
+	if (status == PLUME_OK && run->render) {
+		snprintf(name, sizeof name, "frames/%04d-rt.png", frame);
+		cli_output_path(run->output, name, path, sizeof path);
+		status = cli_barb_renderer_frame(&run->renderer, plume_sim_positions(sim), path, err);
+	}
+	run->frames = frame + 1;
+	return status;
+}
+
+static void show_progress(const run_state *run, int step, double time)
+{
+	int width = 30, done = run->total_steps > 0 ? step * width / run->total_steps : width;
+	fprintf(stderr, "\rsimulate [");
+	for (int i = 0; i < width; ++i)
+		fputc(i < done ? '#' : '.', stderr);
+	fprintf(stderr, "] step %d/%d  t = %.3f s", step, run->total_steps, time);
+	if (step == run->total_steps)
+		fputc('\n', stderr);
+	fflush(stderr);
+}
+
+static plume_status on_step(void *user, int step, double time, const plume_sim *sim,
+                            const plume_solve_report *report, double wall_seconds, plume_error *err)
+{
+	run_state *run = user;
+	if (report != NULL) {
+		fprintf(run->stats, "%.9g,%d,%.6e,%.12e,%.6e,%.6f\n", time, report->newton_iterations, report->gradient_norm,
+		        report->energy, report->max_barb_strain, wall_seconds);
+		run->max_strain = fmax(run->max_strain, report->max_barb_strain);
+	}
+	if (run->progress)
+		show_progress(run, step, time);
+	bool last = step == run->total_steps;
+	if (step % run->scene->frame_every == 0 || last)
+		return write_frame(run, run->frames, sim, err);
+	return PLUME_OK;
+}
+
+/// Bounds of the rest shell grown by the largest handle translation, so a sequence keeps one framing.
+static void frame_bounds(const plume_scene *scene, plume_shell_view_def *view)
+{
+	const plume_mesh *mesh = scene->mesh;
+	plume_vec3 lo = mesh->rest[0], hi = mesh->rest[0];
+	for (int i = 1; i < mesh->vertex_count; ++i) {
+		plume_vec3 p = mesh->rest[i];
+		lo = plume_v3(fmin(lo.x, p.x), fmin(lo.y, p.y), fmin(lo.z, p.z));
+		hi = plume_v3(fmax(hi.x, p.x), fmax(hi.y, p.y), fmax(hi.z, p.z));
+	}
+	double reach = 0;
+	for (int h = 0; h < scene->handle_count; ++h)
+		for (int k = 0; k < scene->handles[h].keyframe_count; ++k)
+			reach = fmax(reach, plume_v3_length(scene->handles[h].keyframes[k].translation));
+	double size = plume_v3_length(plume_v3_sub(hi, lo));
+	double pad = fmax(reach, 0.1 * size);
+	view->bounds_min = plume_v3(lo.x - pad, lo.y - pad, lo.z - pad);
+	view->bounds_max = plume_v3(hi.x + pad, hi.y + pad, hi.z + pad);
+}
+
+static plume_status write_summary(cli_output *output, const plume_scene *scene, const plume_scene_summary *summary,
+                                  const run_state *run, const plume_error *failure, plume_error *err)
+{
+	json_t *root = json_object();
+	json_object_set_new(root, "completed", json_boolean(failure == NULL));
+	if (failure != NULL)
+		json_object_set_new(root, "error", json_string(failure->message));
+	json_object_set_new(root, "steps", json_integer(summary->steps));
+	json_object_set_new(root, "frames", json_integer(run->frames));
+	json_object_set_new(root, "time", json_real(summary->steps * scene->sim.time_step));
+	json_object_set_new(root, "newton_iterations", json_integer(summary->newton_iterations));
+	json_object_set_new(root, "newton_iterations_per_step",
+	                    json_real(summary->steps > 0 ? (double)summary->newton_iterations / summary->steps : 0));
+	json_object_set_new(root, "retried_steps", json_integer(summary->retried_steps));
+	json_object_set_new(root, "wall_seconds", json_real(summary->wall_seconds));
+	json_object_set_new(root, "seconds_assembly", json_real(summary->seconds_assembly));
+	json_object_set_new(root, "seconds_factorization", json_real(summary->seconds_factor));
+	json_object_set_new(root, "seconds_solve", json_real(summary->seconds_solve));
+	json_object_set_new(root, "max_barb_strain", json_real(summary->max_barb_strain));
+	json_object_set_new(root, "rachis_tip_deflection", json_real(summary->rachis_tip_deflection));
+	json_object_set_new(root, "vertices", json_integer(summary->vertex_count));
+	json_object_set_new(root, "faces", json_integer(summary->face_count));
+	json_object_set_new(root, "barb_constraints", json_integer(summary->constraint_count));
+	json_object_set_new(root, "mesh_min_angle_deg", json_real(scene->mesh_report.min_angle * 180 / acos(-1.0)));
+	json_object_set_new(root, "mesh_aligned_fraction", json_real(scene->mesh_report.aligned_fraction));
+	json_object_set_new(root, "mesh_guides_dropped", json_integer(scene->mesh_report.guides_dropped));
+	char path[4352];
+	cli_output_path(output, "summary.json", path, sizeof path);
+	int failed = json_dump_file(root, path, JSON_INDENT(2) | JSON_REAL_PRECISION(10));
+	json_decref(root);
+	if (failed != 0)
+		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write the summary", path);
+	return PLUME_OK;
+}
+
+/// DIR/movie.mp4 from the ray-traced frames when ffmpeg is on the PATH (never required:
+/// without it, or if it fails, the frames are the result).
+static void make_movie(cli_output *output)
+{
+	// The path goes into a shell command in single quotes: a quote in it cannot.
+	if (strchr(output->stage, '\'') != NULL || system("command -v ffmpeg >/dev/null 2>&1") != 0)
+		return;
+	char command[9000];
+	snprintf(command, sizeof command,
+	         "ffmpeg -loglevel error -y -framerate 30 -i '%s/frames/%%04d-rt.png' -pix_fmt yuv420p "
+	         "-vf 'pad=ceil(iw/2)*2:ceil(ih/2)*2' '%s/movie.mp4' </dev/null",
+	         output->stage, output->stage);
+	if (system(command) != 0) {
+		char path[4352];
+		snprintf(path, sizeof path, "%s/movie.mp4", output->stage);
+		remove(path);
+	}
+}
+
+/// Writes the rest shell and the feather, then runs the scene into frames/ and stats.csv.
+static plume_status simulate(const plume_scene *scene, cli_output *output, run_state *run,
+                             plume_scene_summary *summary, plume_error *failure, plume_error *err)
+{
+	char path[4352];
+	run->output = output;
+	plume_status status = plume_mesh_write_obj(scene->mesh, NULL, cli_output_path(output, "mesh.obj", path, sizeof path),
+	                                           err);
+	if (status == PLUME_OK && scene->feather != NULL)
+		status = plume_write_json(scene->feather, cli_output_path(output, "feather.json", path, sizeof path), err);
+	if (status != PLUME_OK)
+		return status;
+	snprintf(path, sizeof path, "%s/frames", output->stage);
+	if (mkdir(path, 0777) != 0)
+		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot create: %s", path, "mkdir failed");
+	run->stats = fopen(cli_output_path(output, "stats.csv", path, sizeof path), "wb");
+	if (run->stats == NULL)
+		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write", path);
+	fprintf(run->stats, "time,newton_iterations,gradient_norm,energy,max_barb_strain,wall_seconds\n");
+	plume_status run_status = plume_scene_run(scene, on_step, run, summary, failure);
+	if (fclose(run->stats) != 0)
+		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write", path);
+	// A run that failed part way keeps what it wrote; input and I/O errors keep nothing.
+	if (run_status != PLUME_OK && (run_status != PLUME_ERROR_NUMERIC || summary->steps == 0)) {
+		*err = *failure;
+		return run_status;
+	}
+	if (run->render)
+		make_movie(output);
+	status = write_summary(output, scene, summary, run, run_status == PLUME_OK ? NULL : failure, err);
+	return status == PLUME_OK ? run_status : status;
+}
+
+int cli_simulate(int argc, char **argv)
+{
+	static const struct option options[] = {
+	    {"output", required_argument, NULL, 'o'}, {"seed", required_argument, NULL, 's'},
+	    {"png", no_argument, NULL, 'p'},         {"size", required_argument, NULL, 'S'},
+	    {"view", required_argument, NULL, 'V'},  {"render", no_argument, NULL, 'R'},
+	    {"spp", required_argument, NULL, 'P'},
+	    {"help", no_argument, NULL, 'h'},        {NULL, 0, NULL, 0},
+	};
+	const char *output_dir = NULL;
+	plume_spec_options spec_options = {0};
+	run_state run = {0};
+	run.view = plume_shell_view_default_def();
+	int spp = 4;
+	int option;
+	optind = 1;
+	opterr = 0;
+	while ((option = getopt_long(argc, argv, ":o:s:h", options, NULL)) != -1) {
+		switch (option) {
+		case 'o': output_dir = optarg; break;
+		case 's':
+			if (!cli_parse_seed("simulate", optarg, &spec_options.seed))
+				return CLI_EXIT_USAGE;
+			spec_options.seed_given = true;
+			break;
+		case 'p': run.png = true; break;
+		case 'S':
+			if (!cli_parse_size("simulate", optarg, &run.view.width, &run.view.height))
+				return CLI_EXIT_USAGE;
+			break;
+		case 'V': {
+			double azimuth, elevation;
+			char tail;
+			if (sscanf(optarg, "%lf,%lf%c", &azimuth, &elevation, &tail) != 2 || fabs(elevation) > 90)
+				return cli_usage_error("simulate", "--view takes AZIMUTH,ELEVATION in degrees (|elevation| <= 90), got '%s'",
+				                       optarg);
+			run.view.azimuth = azimuth * acos(-1.0) / 180;
+			run.view.elevation = elevation * acos(-1.0) / 180;
+			break;
+		}
+		case 'R': run.render = true; break;
+		case 'P': {
+			char *end = NULL;
+			long value = strtol(optarg, &end, 10);
+			if (end == optarg || *end != '\0' || value < 1 || value > 4096)
+				return cli_usage_error("simulate", "--spp takes a whole number in [1, 4096], got '%s'", optarg);
+			spp = (int)value;
+			break;
+		}
+		case 'h': cli_help_simulate(); return CLI_EXIT_OK;
+		case ':': return cli_usage_error("simulate", "option '%s' needs a value", argv[optind - 1]);
+		default: return cli_usage_error("simulate", "unknown option '%s'", argv[optind - 1]);
+		}
+	}
+	if (optind >= argc)
+		return cli_usage_error("simulate", "missing SCENE.json");
+	if (optind + 1 < argc)
+		return cli_usage_error("simulate", "unexpected argument '%s'", argv[optind + 1]);
+	if (output_dir == NULL)
+		return cli_usage_error("simulate", "missing -o DIR");
+
+	plume_error err = {0}, failure = {0};
+	plume_scene *scene = NULL;
+	plume_status status = plume_scene_load(argv[optind], &spec_options, &scene, &err);
+	if (status != PLUME_OK)
+		return cli_fail(&err);
+	run.scene = scene;
+	run.total_steps = (int)ceil(scene->duration / scene->sim.time_step - 1e-9);
+	run.progress = isatty(STDERR_FILENO);
+	// Handles keep the feather in place: one framing for the whole sequence. A free
+	// feather (falling) is followed frame by frame.
+	if (scene->handle_count > 0)
+		frame_bounds(scene, &run.view);
+	if (run.render) {
+		if (scene->feather == NULL) {
+			plume_scene_destroy(scene);
+			return cli_usage_error("simulate", "--render needs a scene whose feather is generated (not guides)");
+		}
+		plume_shell_view_def box = run.view;
+		frame_bounds(scene, &box);
+		status = cli_barb_renderer_begin(&run.renderer, scene->feather, scene->mesh, box.bounds_min, box.bounds_max,
+		                                 run.view.width, run.view.height, spp, &err);
+		if (status != PLUME_OK) {
+			plume_scene_destroy(scene);
+			cli_barb_renderer_end(&run.renderer);
+			return cli_fail(&err);
+		}
+	}
+
+	cli_output output;
+	plume_scene_summary summary = {0};
+	status = cli_output_begin(&output, output_dir, &err);
+	if (status == PLUME_OK) {
+		plume_status run_status = simulate(scene, &output, &run, &summary, &failure, &err);
+		bool keep = run_status == PLUME_OK || (run_status == PLUME_ERROR_NUMERIC && summary.steps > 0);
+		status = keep ? cli_output_commit(&output, &err) : (cli_output_abort(&output), run_status);
+		if (status == PLUME_OK)
+			status = run_status;
+	}
+	if (status == PLUME_OK || summary.steps > 0)
+		printf("%d steps, %d Newton iterations (%.2f a step), %.2f s wall; largest barb strain %.3g; "
+		       "rachis tip deflection %.6g m; %d frames in %s\n",
+		       summary.steps, summary.newton_iterations,
+		       summary.steps > 0 ? (double)summary.newton_iterations / summary.steps : 0.0, summary.wall_seconds,
+		       summary.max_barb_strain, summary.rachis_tip_deflection, run.frames, output_dir);
+	plume_scene_destroy(scene);
+	cli_barb_renderer_end(&run.renderer);
+	if (status != PLUME_OK)
+		return cli_fail(status == PLUME_ERROR_NUMERIC && failure.message[0] ? &failure : &err);
+	return CLI_EXIT_OK;
 }

@@ -116,6 +116,14 @@ bool plume_feather_equal(const plume_feather *a, const plume_feather *b);
 /// A deep copy, or NULL when memory runs out.
 plume_feather *plume_feather_clone(const plume_feather *feather);
 
+/// The generator's diagnostics as a JSON object text (for example the
+/// Zhang–Kanai barbs that could not snap), or NULL when it left none. Owned by
+/// the feather. Diagnostics describe how the feather was made, not its shape:
+/// plume_feather_equal ignores them, plume_feather_clone copies them, and the
+/// feather JSON format does not carry them. `plume generate` writes them to
+/// DIR/summary.json and prints them.
+const char *plume_feather_summary(const plume_feather *feather);
+
 #ifdef __cplusplus
 }
 #endif

@@ -79,10 +79,20 @@ typedef struct plume_mesh_report {
 	double min_angle;
 	/// Fraction of vane faces with an edge on a barb guide; the aligned mesher always reaches 1.
 	double aligned_fraction;
-	/// Input barbs that crossed a neighbour and were left out of the guide set.
+	/// Input barbs left out of the guide set: those whose (smoothed) guide crossed the
+	/// previous kept guide, and those with no length in the feather plane or non-finite points.
 	int guides_dropped;
-	/// Guides the mesher used, per vane (left, right).
+	/// Guides the mesher used, per vane (left, right): one interpolated guide per rachis row
+	/// that has vane vertices.
 	int guide_count[2];
+	/// Input barbs rooted within one edge length of each other along the rachis and averaged
+	/// into one smoothed guide (dense or randomly shaped barbs, Franco & Walter 4.3).
+	int barbs_averaged;
+	/// Guide vertices cut off where two neighbouring guides came too close to give valid
+	/// triangles (0 for well-formed input).
+	int vertices_trimmed;
+	/// The target edge length e used, m.
+	double edge_length;
 } plume_mesh_report;
 
 /// Meshes a generated feather: the shaft is the rachis centre line, the barbs are
@@ -109,13 +119,30 @@ typedef struct plume_mesh_guides {
 plume_status plume_mesh_from_guides(const plume_mesh_guides *guides, const plume_mesh_def *def, plume_mesh **out,
                                     plume_mesh_report *report, plume_error *err);
 
+/// Options of plume_mesh_spec_read.
+typedef struct plume_mesh_spec_options {
+	/// > 0: overrides the spec's edge length, m. Default 0 (the spec's, else plume_mesh_default_def's).
+	double edge_length;
+	/// Overrides a feather spec's "seed" when seed_given is true.
+	uint64_t seed;
+	bool seed_given;
+} plume_mesh_spec_options;
+
+plume_mesh_spec_options plume_mesh_spec_default_options(void);
+
+/// Reads and meshes a spec file: a guides spec (an object with "guides",
+/// "rachis", "boundary" and an optional "mesh" definition, docs/meshing.md),
+/// or else any feather spec, generated with plume_spec_generate and meshed with
+/// the default definition. Errors name the file and the JSON path.
+plume_status plume_mesh_spec_read(const char *path, const plume_mesh_spec_options *options, plume_mesh **out,
+                                  plume_mesh_report *report, plume_error *err);
+
 /// Allocates a mesh with zeroed arrays of the given sizes (barb_edges, groups empty).
 /// The builder fills them. Returns NULL when out of memory.
 plume_mesh *plume_mesh_create(int vertex_count, int face_count);
 
 /// Adds a vertex group (copies the indices). Names are at most 31 bytes.
-plume_status plume_mesh_add_group(plume_mesh *mesh, const char *name, const int *vertices, int count,
-                                  plume_error *err);
+plume_status plume_mesh_add_group(plume_mesh *mesh, const char *name, const int *vertices, int count, plume_error *err);
 
 /// Rebuilds barb_edges from the faces' barb_edge marks (unique edges, sorted).
 plume_status plume_mesh_collect_barb_edges(plume_mesh *mesh, plume_error *err);

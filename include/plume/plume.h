@@ -7,7 +7,13 @@
 #include "plume/io.h"
 #include "plume/mesh.h"
 #include "plume/model.h"
+#include "plume/streit_heidrich.h"
+#include "plume/zhang_kanai.h"
+#include "plume/coat.h"
+#include "plume/embed.h"
+#include "plume/raytrace.h"
 #include "plume/render.h"
+#include "plume/scene.h"
 #include "plume/sim.h"
 
 #endif // PLUME_H

@@ -56,6 +56,16 @@ plume_status plume_texture_write_png(const plume_texture *texture, const char *p
 // fit the image, strokes as filled ribbons whose width tapers as the curves'
 // widths do.
 
+/// How the 2D renderer draws barbs.
+typedef enum plume_render_style {
+	/// Filled ribbons as wide as the barbs (Franco & Walter's line style).
+	PLUME_STYLE_LINES = 0,
+	/// Two triangle strips each side of every barb, of constant width in the vane plane, fading in alpha
+	/// towards the barb's tip and away from its centre line, the vane nearer the camera drawn from the barb
+	/// tips inwards and the other outwards (Streit & Heidrich 4.3.1). Texture colours apply as in lines.
+	PLUME_STYLE_STRIPS = 1,
+} plume_render_style;
+
 typedef struct plume_render2d_def {
 	/// Image size in pixels (points for SVG and PDF), [16, 16384]. Default 1024 x 1024.
 	int width;
@@ -74,6 +84,17 @@ typedef struct plume_render2d_def {
 	bool draw_barbules;
 	/// When not NULL, barbs take their colour from this texture (the shaft keeps shaft_color).
 	const plume_texture *texture;
+	/// Barb drawing. Default PLUME_STYLE_LINES.
+	plume_render_style style;
+	/// PLUME_STYLE_STRIPS: width of each strip (one side of a barb), pixels, > 0. Default 2.
+	double strip_width_px;
+	/// PLUME_STYLE_STRIPS: alpha at a barb's root on its centre line, (0, 1]. Default 0.6.
+	double strip_alpha;
+	/// The region of the feather plane (x, y, m) fitted into the image, when view_max is above view_min in
+	/// both coordinates; otherwise the feather's own bounds. Frames of a sequence share one framing this way.
+	/// Default: empty (0, 0) to (0, 0).
+	plume_vec2 view_min;
+	plume_vec2 view_max;
 } plume_render2d_def;
 
 plume_render2d_def plume_render2d_default_def(void);
@@ -82,6 +103,38 @@ plume_render2d_def plume_render2d_default_def(void);
 /// The file appears whole or not at all.
 plume_status plume_render2d(const plume_feather *feather, const plume_render2d_def *def, plume_image_format format,
                             const char *path, plume_error *err);
+
+/// Renders several feathers into one picture (a coat seen from +z, orthographically): one view fits them
+/// all, and they are drawn whole, one after the other, in the order given (bottom to top).
+plume_status plume_render2d_feathers(const plume_feather *const *feathers, int count, const plume_render2d_def *def,
+                                     plume_image_format format, const char *path, plume_error *err);
+
+// ---------------------------------------------------------------------------
+// Shells: a quick shaded view of a simulated mesh (Cairo, flat shading, painter's order).
+
+typedef struct plume_mesh plume_mesh;
+
+typedef struct plume_shell_view_def {
+	int width;  ///< pixels. Default 800.
+	int height; ///< pixels. Default 800.
+	/// Camera direction (from the scene towards the camera): azimuth about +y and elevation, radians.
+	/// Defaults 0.6 and 0.35: a three-quarter view of a feather whose vane lies in the xy plane.
+	double azimuth;
+	double elevation;
+	/// World box that must stay in view (so frames of a sequence share one framing); when
+	/// min > max the box is taken from the positions. Default empty.
+	plume_vec3 bounds_min;
+	plume_vec3 bounds_max;
+	plume_color background; ///< Default (0.96, 0.96, 0.95, 1).
+	plume_color vane_color; ///< Default (0.78, 0.70, 0.58, 1).
+	plume_color rachis_color; ///< Default (0.35, 0.27, 0.20, 1).
+} plume_shell_view_def;
+
+plume_shell_view_def plume_shell_view_default_def(void);
+
+/// Draws the mesh at positions (mesh->rest when NULL) as a PNG, written whole or not at all.
+plume_status plume_render_shell_png(const plume_mesh *mesh, const plume_vec3 *positions,
+                                    const plume_shell_view_def *def, const char *path, plume_error *err);
 
 #ifdef __cplusplus
 }

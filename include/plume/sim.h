@@ -43,7 +43,8 @@ typedef struct plume_material {
 	double surface_density;
 	/// Hold every barb-aligned edge of these faces at its reference length (eps_vv = 0).
 	bool barb_constraint;
-	/// Bending moduli, N m (thesis eq. 6.4): `bending_along` for an edge parallel to the
+	/// Bending moduli, N m (thesis eq. 6.4), continuum plate moduli: a flat sheet rolled
+	/// into a cylinder of radius R stores (1/2) D A / R^2 (docs/physics-energies.md): `bending_along` for an edge parallel to the
 	/// barbs (a hinge that keeps the barbs straight; soft), `bending_across` for an edge
 	/// across them (bends the barbs; stiff). Isotropic materials use bending_along for both
 	/// when bending_across is negative.
@@ -57,7 +58,8 @@ typedef struct plume_material {
 /// E_vw = E_ww (provisional until the lab's calibration), thickness 1.2e-4 m (mean of
 /// Table 3.1), 2.6e-2 kg/m^2, bending 1e-7 / 2.5e-4 N m, kappa 5.04e7.
 plume_material plume_material_vane(void);
-/// The rachis of thesis Table 6.1: isotropic, E = 34 MPa, nu = 0.49, thickness 1.2e-2 m, 0.54 kg/m^2.
+/// The rachis of thesis Table 6.1: isotropic, E = 34 MPa, nu = 0.49, thickness 1.2e-2 m, 0.54 kg/m^2;
+/// bending D = E t^3 / (12 (1 - nu^2)) = 6.44 N m.
 plume_material plume_material_rachis(void);
 
 /// Newton solver settings (thesis Table 6.1).
@@ -108,6 +110,10 @@ int plume_sim_add_handle(plume_sim *sim, const char *group, plume_error *err);
 /// Moves a handle rigidly: each vertex goes to rotation * (rest - pivot) + pivot + translation.
 void plume_sim_set_handle(plume_sim *sim, int handle, plume_vec3 translation, plume_mat3 rotation, plume_vec3 pivot);
 
+/// Applies a constant external force, N, shared equally by the group's vertices (a weight
+/// hung on them); replaces any load set on that group before. Unknown group: PLUME_ERROR_SPEC.
+plume_status plume_sim_set_group_load(plume_sim *sim, const char *group, plume_vec3 force, plume_error *err);
+
 /// What one solve did.
 typedef struct plume_solve_report {
 	bool converged;
@@ -137,13 +143,16 @@ plume_status plume_sim_solve_static(plume_sim *sim, plume_solve_report *report, 
 plume_status plume_sim_step(plume_sim *sim, plume_solve_report *report, plume_error *err);
 
 int plume_sim_vertex_count(const plume_sim *sim);
+/// Barb-aligned edges held inextensible.
+int plume_sim_constraint_count(const plume_sim *sim);
 const plume_vec3 *plume_sim_positions(const plume_sim *sim);
 const plume_vec3 *plume_sim_velocities(const plume_sim *sim);
 double plume_sim_time(const plume_sim *sim);
 
-/// Sum over a group's vertices of the force the shell exerts on the handle that holds them
-/// (the reaction: minus the elastic force on those vertices), N. Unknown group: returns false.
-bool plume_sim_group_reaction(const plume_sim *sim, const char *group, plume_vec3 *force);
+/// Sum over a group's vertices of the force a handle must apply to hold them where they are
+/// (it balances the elastic, constraint and gravity forces on them), N, at the current state.
+/// A clamp that stretches a sample in +y reports a positive y. Unknown group: returns false.
+bool plume_sim_group_reaction(plume_sim *sim, const char *group, plume_vec3 *force);
 
 /// Energies at the current state, J.
 typedef struct plume_sim_energies {
@@ -153,7 +162,7 @@ typedef struct plume_sim_energies {
 	double gravity;
 	double kinetic;
 } plume_sim_energies;
-plume_sim_energies plume_sim_energy(const plume_sim *sim);
+plume_sim_energies plume_sim_energy(plume_sim *sim);
 
 #ifdef __cplusplus
 }

@@ -50,6 +50,31 @@ plume_status plume_fw_spec_generate(const char *file, const json_t *root, const 
 	return plume_fw_generate(&def, seed, out, err);
 }
 
+plume_status plume_spec_generate_json(const char *file, const json_t *root, const plume_spec_options *options,
+                                      plume_feather **out, plume_error *err)
+{
+	*out = NULL;
+	plume_spec_reader reader = plume_spec_reader_begin(file, err);
+	const char *model = NULL;
+	if (!json_is_object(root))
+		plume_spec_fail(&reader, "$", "expected an object with a \"model\" key");
+	else if (!plume_spec_string(&reader, root, "$", "model", &model) && reader.status == PLUME_OK)
+		plume_spec_fail(&reader, "$.model", "missing; a spec names its generator (one of: " MODEL_LIST ")");
+	if (reader.status != PLUME_OK)
+		return reader.status;
+	for (int i = 0; i < MODEL_COUNT; ++i)
+		if (strcmp(model, models[i].name) == 0)
+			return models[i].generate(file, root, options, out, err);
+	if (strcmp(model, "coat") == 0) {
+		plume_spec_fail(&reader, "$.model", "\"coat\" is a coat spec, not a feather: use `plume coat %s -o DIR` (docs/coats.md)",
+		                file);
+		return reader.status;
+	}
+	plume_spec_fail(&reader, "$.model", "unknown model \"%s\"; did you mean \"%s\"? (known: " MODEL_LIST ")", model,
+	                plume_spec_nearest(model, model_names));
+	return reader.status;
+}
+
 plume_status plume_spec_generate(const char *path, const plume_spec_options *options, plume_feather **out,
                                  plume_error *err)
 {
@@ -57,27 +82,7 @@ plume_status plume_spec_generate(const char *path, const plume_spec_options *opt
 	json_t *root = plume_spec_load(path, err);
 	if (root == NULL)
 		return err != NULL ? err->status : PLUME_ERROR_IO;
-	plume_spec_reader reader = plume_spec_reader_begin(path, err);
-	const char *model = NULL;
-	if (!json_is_object(root))
-		plume_spec_fail(&reader, "$", "expected an object with a \"model\" key");
-	else if (!plume_spec_string(&reader, root, "$", "model", &model) && reader.status == PLUME_OK)
-		plume_spec_fail(&reader, "$.model", "missing; a spec names its generator (one of: " MODEL_LIST ")");
-
-	plume_status status = reader.status;
-	if (status == PLUME_OK) {
-		const model_entry *entry = NULL;
-		for (int i = 0; i < MODEL_COUNT && entry == NULL; ++i)
-			if (strcmp(model, models[i].name) == 0)
-				entry = models + i;
-		if (entry != NULL) {
-			status = entry->generate(path, root, options, out, err);
-		} else {
-			plume_spec_fail(&reader, "$.model", "unknown model \"%s\"; did you mean \"%s\"? (known: " MODEL_LIST ")",
-			                model, plume_spec_nearest(model, model_names));
-			status = reader.status;
-		}
-	}
+	plume_status status = plume_spec_generate_json(path, root, options, out, err);
 	json_decref(root);
 	return status;
 }

@@ -17,6 +17,10 @@ plume_status plume_fw_def_from_json(const char *file, const json_t *root, plume_
 typedef plume_status (*plume_spec_generate_fn)(const char *file, const json_t *root, const plume_spec_options *options,
                                                plume_feather **out, plume_error *err);
 
+/// Generates the feather of a parsed spec, dispatching on its "model" key.
+plume_status plume_spec_generate_json(const char *file, const json_t *root, const plume_spec_options *options,
+                                      plume_feather **out, plume_error *err);
+
 plume_status plume_fw_spec_generate(const char *file, const json_t *root, const plume_spec_options *options,
                                     plume_feather **out, plume_error *err);
 plume_status plume_sh_spec_generate(const char *file, const json_t *root, const plume_spec_options *options,

@@ -27,8 +27,25 @@ void plume_feather_destroy(plume_feather *feather)
 	plume_free(feather->uv);
 	plume_free(feather->barbs);
 	plume_free(feather->barbules);
+	plume_free(feather->summary);
 	plume_free(feather);
 }
+
+int plume_feather_set_summary(plume_feather *feather, const char *json)
+{
+	char *copy = NULL;
+	if (json != NULL) {
+		size_t size = strlen(json) + 1;
+		if ((copy = plume_alloc(size)) == NULL)
+			return -1;
+		memcpy(copy, json, size);
+	}
+	plume_free(feather->summary);
+	feather->summary = copy;
+	return 0;
+}
+
+const char *plume_feather_summary(const plume_feather *feather) { return feather->summary; }
 
 plume_shaft_sample *plume_feather_add_shaft(plume_feather *feather, int count)
 {
@@ -234,7 +251,8 @@ static bool same_curve(const plume_feather *a, plume_curve_range p, const plume_
 // and a NaN equals itself), not of the storage behind them: a
 // curve's offset in the point pool, pool points no curve uses, an empty barb's
 // barbule_first and the attachment parameter of an absent afterfeather are
-// not part of a feather. So a feather rebuilt from a file (whose pool order
+// not part of a feather, nor is the generator's summary (diagnostics, not
+// shape). So a feather rebuilt from a file (whose pool order
 // need not be the generator's) equals the original.
 bool plume_feather_equal(const plume_feather *a, const plume_feather *b)
 {
@@ -300,6 +318,8 @@ plume_feather *plume_feather_clone(const plume_feather *feather)
 		if (plume_feather_add_barbule(copy, feather->barbules + i) < 0)
 			goto fail;
 	if (feather->afterfeather != NULL && (copy->afterfeather = plume_feather_clone(feather->afterfeather)) == NULL)
+		goto fail;
+	if (plume_feather_set_summary(copy, feather->summary) != 0)
 		goto fail;
 	return copy;
 fail:

@@ -50,6 +50,8 @@ struct plume_feather {
 
 	plume_feather *afterfeather;
 	double afterfeather_t;
+
+	char *summary; ///< generator diagnostics (JSON text) or NULL; see plume_feather_summary
 };
 
 /// An empty feather, or NULL when memory runs out.
@@ -70,6 +72,10 @@ int plume_feather_add_barb(plume_feather *feather, const plume_barb_record *barb
 
 /// Appends a barbule record; returns its index or -1.
 int plume_feather_add_barbule(plume_feather *feather, const plume_barbule_record *barbule);
+
+/// Replaces the feather's summary by a copy of json (NULL clears it).
+/// Returns 0, or -1 when memory runs out (the old summary is then kept).
+int plume_feather_set_summary(plume_feather *feather, const char *json);
 
 /// Fills arc_length for a range of the pool from its points, and uv.s as the
 /// arc-length fraction (0 at the first point, 1 at the last).

@@ -18,6 +18,7 @@
 #include "core/atomic_file.h"
 #include "plume/render.h"
 #include "render/cairo_png.h"
+#include "render/strips.h"
 
 plume_render2d_def plume_render2d_default_def(void)
 {
@@ -31,6 +32,11 @@ plume_render2d_def plume_render2d_default_def(void)
 	    .min_stroke_px = 0.35,
 	    .draw_barbules = true,
 	    .texture = NULL,
+	    .style = PLUME_STYLE_LINES,
+	    .strip_width_px = 2.0,
+	    .strip_alpha = 0.6,
+	    .view_min = {0.0, 0.0},
+	    .view_max = {0.0, 0.0},
 	};
 }
 
@@ -67,6 +73,14 @@ static plume_status validate_def(const plume_render2d_def *def, plume_error *err
 	    (status = check_color("barb_color", def->barb_color, err)) != PLUME_OK ||
 	    (status = check_color("shaft_color", def->shaft_color, err)) != PLUME_OK)
 		return status;
+	if (def->style != PLUME_STYLE_LINES && def->style != PLUME_STYLE_STRIPS)
+		return plume_error_set(err, PLUME_ERROR_SPEC, "render2d: style is %d, allowed lines (0) or strips (1)",
+		                       (int)def->style);
+	if (def->style == PLUME_STYLE_STRIPS && (!(def->strip_width_px > 0.0 && isfinite(def->strip_width_px)) ||
+	                                         !(def->strip_alpha > 0.0 && def->strip_alpha <= 1.0)))
+		return plume_error_set(err, PLUME_ERROR_SPEC,
+		                       "render2d: strip_width_px is %g and strip_alpha %g; allowed > 0 and (0, 1]",
+		                       def->strip_width_px, def->strip_alpha);
 	if (!(def->min_stroke_px >= 0.0 && isfinite(def->min_stroke_px)))
 		return plume_error_set(err, PLUME_ERROR_SPEC, "render2d: min_stroke_px is %g, must be a finite number >= 0",
 		                       def->min_stroke_px);
@@ -303,12 +317,17 @@ static void draw_feather(renderer *r, const plume_feather *feather)
 			draw_curve_plain(r, &barbule.curve, color);
 		}
 	}
-	for (int i = 0; i < info.barb_count && !r->out_of_memory; ++i) {
-		plume_barb barb = plume_feather_barb(feather, i);
-		if (def->texture != NULL)
-			draw_barb_textured(r, &barb.curve, barb.side);
-		else
-			draw_curve_plain(r, &barb.curve, def->barb_color);
+	if (def->style == PLUME_STYLE_STRIPS) {
+		if (!plume_strips_draw_barbs(r->cr, feather, def, r->view.scale, r->view.offset_x, r->view.offset_y))
+			r->out_of_memory = true;
+	} else {
+		for (int i = 0; i < info.barb_count && !r->out_of_memory; ++i) {
+			plume_barb barb = plume_feather_barb(feather, i);
+			if (def->texture != NULL)
+				draw_barb_textured(r, &barb.curve, barb.side);
+			else
+				draw_curve_plain(r, &barb.curve, def->barb_color);
+		}
 	}
 	if (!r->out_of_memory)
 		draw_shaft(r, plume_feather_shaft(feather), info.shaft_sample_count);
@@ -318,6 +337,10 @@ static void draw_feather(renderer *r, const plume_feather *feather)
 /// margin, centred, keeping the aspect ratio.
 static view fit_view(const plume_render2d_def *def, plume_feather_info info)
 {
+	if (def->view_max.x > def->view_min.x && def->view_max.y > def->view_min.y) {
+		info.bounds_min = plume_v3(def->view_min.x, def->view_min.y, 0.0);
+		info.bounds_max = plume_v3(def->view_max.x, def->view_max.y, 0.0);
+	}
 	double margin_px = def->margin * (def->width < def->height ? def->width : def->height);
 	double room_x = def->width - 2.0 * margin_px, room_y = def->height - 2.0 * margin_px;
 	double extent_x = info.bounds_max.x - info.bounds_min.x, extent_y = info.bounds_max.y - info.bounds_min.y;
@@ -438,11 +461,27 @@ static plume_status cairo_failure(const char *path, plume_image_format format, c
 }
 
 /// Paints the background and the feather onto surface.
-static cairo_status_t paint(cairo_surface_t *surface, const plume_feather *feather, const plume_render2d_def *def,
-                            bool *out_of_memory)
+/// The bounds of several feathers together.
+static plume_feather_info union_info(const plume_feather *const *feathers, int count)
+{
+	plume_feather_info info = plume_feather_get_info(feathers[0]);
+	for (int i = 1; i < count; ++i) {
+		plume_feather_info other = plume_feather_get_info(feathers[i]);
+		info.bounds_min.x = fmin(info.bounds_min.x, other.bounds_min.x);
+		info.bounds_min.y = fmin(info.bounds_min.y, other.bounds_min.y);
+		info.bounds_min.z = fmin(info.bounds_min.z, other.bounds_min.z);
+		info.bounds_max.x = fmax(info.bounds_max.x, other.bounds_max.x);
+		info.bounds_max.y = fmax(info.bounds_max.y, other.bounds_max.y);
+		info.bounds_max.z = fmax(info.bounds_max.z, other.bounds_max.z);
+	}
+	return info;
+}
+
+static cairo_status_t paint(cairo_surface_t *surface, const plume_feather *const *feathers, int count,
+                            const plume_render2d_def *def, bool *out_of_memory)
 {
 	cairo_t *cr = cairo_create(surface);
-	renderer r = {.cr = cr, .def = def, .view = fit_view(def, plume_feather_get_info(feather))};
+	renderer r = {.cr = cr, .def = def, .view = fit_view(def, union_info(feathers, count))};
 	// SOURCE so that a translucent background replaces the surface's
 	// transparent black instead of blending with it.
 	cairo_set_operator(cr, CAIRO_OPERATOR_SOURCE);
@@ -453,7 +492,8 @@ static cairo_status_t paint(cairo_surface_t *surface, const plume_feather *feath
 	// Ribbons fold over themselves at sharp bends; with the winding rule the
 	// fold stays filled.
 	cairo_set_fill_rule(cr, CAIRO_FILL_RULE_WINDING);
-	draw_feather(&r, feather);
+	for (int i = 0; i < count && !r.out_of_memory; ++i)
+		draw_feather(&r, feathers[i]);
 	plume_free(r.scratch.left);
 	plume_free(r.scratch.right);
 	*out_of_memory = r.out_of_memory;
@@ -462,14 +502,14 @@ static cairo_status_t paint(cairo_surface_t *surface, const plume_feather *feath
 	return status;
 }
 
-static plume_status render_png(const plume_feather *feather, const plume_render2d_def *def, const char *path,
-                               plume_error *err)
+static plume_status render_png(const plume_feather *const *feathers, int count, const plume_render2d_def *def,
+                               const char *path, plume_error *err)
 {
 	cairo_surface_t *surface = cairo_image_surface_create(CAIRO_FORMAT_ARGB32, def->width, def->height);
 	cairo_status_t status = cairo_surface_status(surface);
 	bool out_of_memory = false;
 	if (status == CAIRO_STATUS_SUCCESS)
-		status = paint(surface, feather, def, &out_of_memory);
+		status = paint(surface, feathers, count, def, &out_of_memory);
 	if (status == CAIRO_STATUS_SUCCESS && out_of_memory)
 		status = CAIRO_STATUS_NO_MEMORY;
 	if (status != CAIRO_STATUS_SUCCESS) {
@@ -486,7 +526,7 @@ static plume_status render_png(const plume_feather *feather, const plume_render2
 /// time, and the same feather must give the same bytes. This is the paper's year.
 #define FIXED_PDF_DATE "2002-01-01T00:00:00Z"
 
-static plume_status render_vector(const plume_feather *feather, const plume_render2d_def *def,
+static plume_status render_vector(const plume_feather *const *feathers, int count, const plume_render2d_def *def,
                                   plume_image_format format, const char *path, plume_error *err)
 {
 	plume_atomic_file file;
@@ -507,7 +547,7 @@ static plume_status render_vector(const plume_feather *feather, const plume_rend
 	cairo_status_t status = cairo_surface_status(surface);
 	bool out_of_memory = false;
 	if (status == CAIRO_STATUS_SUCCESS)
-		status = paint(surface, feather, def, &out_of_memory);
+		status = paint(surface, feathers, count, def, &out_of_memory);
 	if (status == CAIRO_STATUS_SUCCESS && out_of_memory)
 		status = CAIRO_STATUS_NO_MEMORY;
 	// Finishing writes the document's tail; its status tells whether every write worked.
@@ -534,19 +574,29 @@ static plume_status render_vector(const plume_feather *feather, const plume_rend
 plume_status plume_render2d(const plume_feather *feather, const plume_render2d_def *def, plume_image_format format,
                             const char *path, plume_error *err)
 {
-	assert(feather != NULL && def != NULL && path != NULL);
+	assert(feather != NULL);
+	return plume_render2d_feathers(&feather, 1, def, format, path, err);
+}
+
+plume_status plume_render2d_feathers(const plume_feather *const *feathers, int count, const plume_render2d_def *def,
+                                     plume_image_format format, const char *path, plume_error *err)
+{
+	assert(feathers != NULL && def != NULL && path != NULL);
+	if (count < 1)
+		return plume_error_set(err, PLUME_ERROR_SPEC, "render2d: no feather to draw");
 	plume_status status = validate_def(def, err);
 	if (status != PLUME_OK)
 		return status;
 	if (format != PLUME_IMAGE_PNG && format != PLUME_IMAGE_SVG && format != PLUME_IMAGE_PDF)
 		return plume_error_set(err, PLUME_ERROR_UNSUPPORTED, "%s: unknown image format %d", path, (int)format);
-	plume_feather_info info = plume_feather_get_info(feather);
-	if (info.shaft_sample_count <= 0)
-		return plume_error_set(err, PLUME_ERROR_SPEC, "render2d: the feather is empty (it has no shaft)");
+	for (int i = 0; i < count; ++i)
+		if (plume_feather_get_info(feathers[i]).shaft_sample_count <= 0)
+			return plume_error_set(err, PLUME_ERROR_SPEC, "render2d: the feather is empty (it has no shaft)");
+	plume_feather_info info = union_info(feathers, count);
 	if (!(isfinite(info.bounds_min.x) && isfinite(info.bounds_min.y) && isfinite(info.bounds_max.x) &&
 	      isfinite(info.bounds_max.y)))
 		return plume_error_set(err, PLUME_ERROR_NUMERIC, "render2d: the feather's bounds are not finite");
 	if (format == PLUME_IMAGE_PNG)
-		return render_png(feather, def, path, err);
-	return render_vector(feather, def, format, path, err);
+		return render_png(feathers, count, def, path, err);
+	return render_vector(feathers, count, def, format, path, err);
 }

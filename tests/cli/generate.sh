@@ -128,7 +128,7 @@ check "help demo" bash -c "'$plume' help demo | grep -q 'plume demo'"
 # --- demo ---------------------------------------------------------------------
 (cd "$scratch" && "$plume" demo >demo.txt)
 check "demo succeeds" test $? -eq 0
-for file in feather.png feather.svg feather.pdf feather.obj feather.usda feather.json feather-textured.png; do
+for file in feather.png feather.svg feather.pdf feather.obj feather.usda feather.json feather-textured.png figure1-0000.png figure1-0050.png; do
 	check "demo writes $file" test -s "$scratch/plume-demo/$file"
 done
 "$plume" demo -o "$scratch/demo2" >/dev/null

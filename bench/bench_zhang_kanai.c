@@ -1,0 +1,90 @@
+// Benchmark: the Zhang–Kanai generator (issue 4). Prints the time to generate
+// a feather of 2 x 400 barbs with expansion (median of repeated runs, one
+// thread) and the time per frame of a 100-frame growth sequence of it. The
+// paper ran at 30-60 frames per second on a 2013 desktop; the target is under
+// 10 ms per feather on one core.
+//
+// Usage: bench_zhang_kanai
+#include <stdio.h>
+#include <stdlib.h>
+#include <time.h>
+
+#include "plume/plume.h"
+#include "plume/zhang_kanai.h"
+
+static double now(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int compare(const void *a, const void *b)
+{
+	double x = *(const double *)a, y = *(const double *)b;
+	return (x > y) - (x < y);
+}
+
+static double median(double *values, int count)
+{
+	qsort(values, (size_t)count, sizeof *values, compare);
+	return count % 2 ? values[count / 2] : 0.5 * (values[count / 2 - 1] + values[count / 2]);
+}
+
+static void check(plume_status status, const plume_error *err)
+{
+	if (status != PLUME_OK) {
+		fprintf(stderr, "bench_zhang_kanai: %s\n", err->message);
+		exit(1);
+	}
+}
+
+int main(void)
+{
+	// The default contour feather with ridges a quarter as wide (so 400 barbs a
+	// vane fit a feather of the same length) and ridge heights scaled alike.
+	plume_zk_def def = plume_zk_default_def();
+	def.barb_count = 400;
+	def.ridge_width = 2e-4;
+	def.expansion = true;
+	for (int k = 0; k < def.ridge_height.count; ++k)
+		def.ridge_height.value[k] *= 0.25;
+	plume_error err = {0};
+	plume_feather *feather = NULL;
+	plume_zk_report report;
+
+	enum { RUNS = 31, FRAMES = 100 };
+	double times[RUNS];
+	for (int i = 0; i < RUNS; ++i) {
+		double start = now();
+		check(plume_zk_generate(&def, 1, &feather, &report, &err), &err);
+		times[i] = now() - start;
+		if (i + 1 < RUNS) {
+			plume_feather_destroy(feather);
+			plume_zk_report_free(&report);
+		}
+	}
+	plume_feather_info info = plume_feather_get_info(feather);
+	printf("zhang-kanai, 2 x %d barbs with expansion (ridge width %.1e m)\n", def.barb_count, def.ridge_width);
+	printf("  barbs %d (%d left, %d right), barbules %d, points %d, t_end %.2f s\n", info.barb_count,
+	       info.barb_count_left, info.barb_count_right, info.barbule_count, info.point_count, report.t_end);
+	printf("  snapping: %d full, %d partial, %d unsnapped\n", report.snapped_count, report.partial_count,
+	       report.unsnapped_count);
+	double generate_median = median(times, RUNS);
+	printf("generate            median %8.3f ms   (min %.3f ms, %d runs, one thread)\n", 1e3 * generate_median,
+	       1e3 * times[0], RUNS);
+	plume_feather_destroy(feather);
+	plume_zk_report_free(&report);
+
+	def.keep_barbules = false;
+	double start = now();
+	for (int i = 0; i < FRAMES; ++i) {
+		def.growth_stage = (double)i / (FRAMES - 1);
+		check(plume_zk_generate(&def, 1, &feather, NULL, &err), &err);
+		plume_feather_destroy(feather);
+	}
+	double total = now() - start;
+	printf("growth sequence     %8.3f ms per frame (%d frames t_curr = 0 .. t_end, expansion, barbules not kept)\n",
+	       1e3 * total / FRAMES, FRAMES);
+	return 0;
+}

@@ -1,0 +1,231 @@
+// plume mesh SPEC.json -o DIR [--edge-length E] [--seed S]
+//
+// Meshes a feather spec (any model) or a guides spec (docs/meshing.md) with the
+// barb-aligned mesher and writes DIR/mesh.obj, DIR/mesh.png (the reference
+// mesh: rachis and vane faces in two colours, barb-aligned edges in dark blue)
+// and DIR/report.json (counts and quality).
+#define _POSIX_C_SOURCE 200809L
+#include <cairo.h>
+#include <errno.h>
+#include <getopt.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+
+// Also declared in cli.h beside the other commands.
+int cli_mesh(int argc, char **argv);
+void cli_help_mesh(void);
+
+void cli_help_mesh(void)
+{
+	puts("Usage: plume mesh SPEC.json -o DIR [options]\n"
+	     "\n"
+	     "Builds the barb-aligned triangle mesh that the simulator deforms (Jouve 2024,\n"
+	     "thesis 6.2) from a feather spec (its rachis and barbs are the guides) or from\n"
+	     "a guides spec (boundary polygon, rachis spline, barb guide splines), and writes\n"
+	     "  DIR/mesh.obj    the rest shape with UVs, one group per material\n"
+	     "  DIR/mesh.png    the reference mesh: rachis and vane faces, barb-aligned edges\n"
+	     "  DIR/report.json vertex and face counts, minimum angle, aligned fraction,\n"
+	     "                  guides dropped\n"
+	     "All files appear together, or none when anything fails.\n"
+	     "\n"
+	     "Options:\n"
+	     "  -o, --output DIR        output folder (created if missing)\n"
+	     "  -e, --edge-length E     target edge length in metres (default: the spec's\n"
+	     "                          \"mesh\".\"edge_length\", else 0.005, thesis Table 6.1)\n"
+	     "  -s, --seed N            random seed of a feather spec; overrides its \"seed\"\n"
+	     "      --size WxH          image size in pixels (default: 1200 tall)\n"
+	     "  -h, --help              this help\n"
+	     "\n"
+	     "The guides spec is described in docs/meshing.md.");
+}
+
+static bool parse_length(const char *text, double *out)
+{
+	char *end;
+	errno = 0;
+	double value = strtod(text, &end);
+	if (end == text || *end != '\0' || errno != 0 || !(value > 0.0) || !isfinite(value))
+		return false;
+	*out = value;
+	return true;
+}
+
+// ---------------------------------------------------------------------------
+// Picture of the reference mesh
+
+typedef struct view {
+	double scale, x0, y1, margin;
+} view;
+
+static void to_pixels(const view *v, plume_vec2 p, double *x, double *y)
+{
+	*x = v->margin + (p.x - v->x0) * v->scale;
+	*y = v->margin + (v->y1 - p.y) * v->scale;
+}
+
+static plume_status draw_mesh(const plume_mesh *mesh, int width, int height, const char *path, plume_error *err)
+{
+	double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
+	for (int i = 0; i < mesh->vertex_count; ++i) {
+		x0 = fmin(x0, mesh->reference[i].x);
+		x1 = fmax(x1, mesh->reference[i].x);
+		y0 = fmin(y0, mesh->reference[i].y);
+		y1 = fmax(y1, mesh->reference[i].y);
+	}
+	double span_x = fmax(x1 - x0, 1e-9), span_y = fmax(y1 - y0, 1e-9);
+	double margin = 20.0;
+	if (height <= 0)
+		height = 1200;
+	if (width <= 0)
+		width = (int)ceil(2.0 * margin + (height - 2.0 * margin) * span_x / span_y);
+	if (width < 16)
+		width = 16;
+	view v = {fmin((width - 2.0 * margin) / span_x, (height - 2.0 * margin) / span_y), x0, y1, margin};
+	cairo_surface_t *surface = cairo_image_surface_create(CAIRO_FORMAT_RGB24, width, height);
+	cairo_t *cr = cairo_create(surface);
+	cairo_set_source_rgb(cr, 1.0, 1.0, 1.0);
+	cairo_paint(cr);
+	cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
+	for (int f = 0; f < mesh->face_count; ++f) {
+		for (int k = 0; k < 3; ++k) {
+			double x, y;
+			to_pixels(&v, mesh->reference[mesh->faces[3 * f + k]], &x, &y);
+			if (k == 0)
+				cairo_move_to(cr, x, y);
+			else
+				cairo_line_to(cr, x, y);
+		}
+		cairo_close_path(cr);
+		if (mesh->material[f] == PLUME_MATERIAL_RACHIS)
+			cairo_set_source_rgb(cr, 0.96, 0.62, 0.25); // orange, as in the paper's Figure 7
+		else
+			cairo_set_source_rgb(cr, 0.72, 0.86, 0.96); // light blue
+		cairo_fill_preserve(cr);
+		cairo_set_source_rgb(cr, 0.45, 0.45, 0.5);
+		cairo_set_line_width(cr, 0.6);
+		cairo_stroke(cr);
+	}
+	cairo_set_source_rgb(cr, 0.05, 0.2, 0.6);
+	cairo_set_line_width(cr, 1.8);
+	cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
+	for (int e = 0; e < mesh->barb_edge_count; ++e) {
+		double x, y;
+		to_pixels(&v, mesh->reference[mesh->barb_edges[2 * e]], &x, &y);
+		cairo_move_to(cr, x, y);
+		to_pixels(&v, mesh->reference[mesh->barb_edges[2 * e + 1]], &x, &y);
+		cairo_line_to(cr, x, y);
+	}
+	cairo_stroke(cr);
+	cairo_destroy(cr);
+	cairo_surface_flush(surface);
+	cairo_status_t written = cairo_surface_write_to_png(surface, path);
+	cairo_surface_destroy(surface);
+	if (written != CAIRO_STATUS_SUCCESS)
+		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write PNG: %s", path, cairo_status_to_string(written));
+	return PLUME_OK;
+}
+
+static plume_status write_report(const plume_mesh *mesh, const plume_mesh_report *report, const char *path,
+                                 plume_error *err)
+{
+	FILE *stream = fopen(path, "w");
+	if (stream == NULL)
+		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write: %s", path, strerror(errno));
+	int rachis_faces = 0;
+	for (int f = 0; f < mesh->face_count; ++f)
+		rachis_faces += mesh->material[f] == PLUME_MATERIAL_RACHIS;
+	fprintf(stream,
+	        "{\n"
+	        "  \"edge_length\": %.17g,\n"
+	        "  \"vertex_count\": %d,\n"
+	        "  \"face_count\": %d,\n"
+	        "  \"rachis_face_count\": %d,\n"
+	        "  \"vane_face_count\": %d,\n"
+	        "  \"barb_edge_count\": %d,\n"
+	        "  \"min_angle_deg\": %.6f,\n"
+	        "  \"aligned_fraction\": %.17g,\n"
+	        "  \"guides_dropped\": %d,\n"
+	        "  \"barbs_averaged\": %d,\n"
+	        "  \"vertices_trimmed\": %d,\n"
+	        "  \"guide_count\": [%d, %d],\n"
+	        "  \"groups\": {",
+	        report->edge_length, mesh->vertex_count, mesh->face_count, rachis_faces, mesh->face_count - rachis_faces,
+	        mesh->barb_edge_count, report->min_angle * 180.0 / 3.14159265358979323846, report->aligned_fraction,
+	        report->guides_dropped, report->barbs_averaged, report->vertices_trimmed, report->guide_count[0],
+	        report->guide_count[1]);
+	for (int g = 0; g < mesh->group_count; ++g)
+		fprintf(stream, "%s\"%s\": %d", g > 0 ? ", " : "", mesh->groups[g].name, mesh->groups[g].count);
+	fprintf(stream, "}\n}\n");
+	bool failed = ferror(stream) != 0;
+	if (fclose(stream) != 0 || failed)
+		return plume_error_set(err, PLUME_ERROR_IO, "%s: write failed", path);
+	return PLUME_OK;
+}
+
+int cli_mesh(int argc, char **argv)
+{
+	static const struct option options[] = {
+	    {"output", required_argument, NULL, 'o'}, {"edge-length", required_argument, NULL, 'e'},
+	    {"seed", required_argument, NULL, 's'},   {"size", required_argument, NULL, 'S'},
+	    {"help", no_argument, NULL, 'h'},         {NULL, 0, NULL, 0},
+	};
+	const char *output_dir = NULL;
+	plume_mesh_spec_options spec_options = plume_mesh_spec_default_options();
+	int width = 0, height = 0;
+	int option;
+	optind = 1;
+	opterr = 0;
+	while ((option = getopt_long(argc, argv, ":o:e:s:h", options, NULL)) != -1) {
+		switch (option) {
+		case 'o': output_dir = optarg; break;
+		case 'e':
+			if (!parse_length(optarg, &spec_options.edge_length))
+				return cli_usage_error("mesh", "--edge-length '%s' is not a positive length in metres", optarg);
+			break;
+		case 's':
+			if (!cli_parse_seed("mesh", optarg, &spec_options.seed))
+				return CLI_EXIT_USAGE;
+			spec_options.seed_given = true;
+			break;
+		case 'S':
+			if (!cli_parse_size("mesh", optarg, &width, &height))
+				return CLI_EXIT_USAGE;
+			break;
+		case 'h': cli_help_mesh(); return CLI_EXIT_OK;
+		case ':': return cli_usage_error("mesh", "option '%s' needs a value", argv[optind - 1]);
+		default: return cli_usage_error("mesh", "unknown option '%s'", argv[optind - 1]);
+		}
+	}
+	if (optind >= argc)
+		return cli_usage_error("mesh", "missing SPEC.json");
+	if (optind + 1 < argc)
+		return cli_usage_error("mesh", "unexpected argument '%s'", argv[optind + 1]);
+	if (output_dir == NULL)
+		return cli_usage_error("mesh", "missing -o DIR");
+
+	plume_error err = {0};
+	plume_mesh *mesh = NULL;
+	plume_mesh_report report;
+	plume_status status = plume_mesh_spec_read(argv[optind], &spec_options, &mesh, &report, &err);
+	cli_output output;
+	if (status == PLUME_OK && (status = cli_output_begin(&output, output_dir, &err)) == PLUME_OK) {
+		char path[4400];
+		status = plume_mesh_write_obj(mesh, NULL, cli_output_path(&output, "mesh.obj", path, sizeof path), &err);
+		if (status == PLUME_OK)
+			status = draw_mesh(mesh, width, height, cli_output_path(&output, "mesh.png", path, sizeof path), &err);
+		if (status == PLUME_OK)
+			status = write_report(mesh, &report, cli_output_path(&output, "report.json", path, sizeof path), &err);
+		if (status == PLUME_OK)
+			status = cli_output_commit(&output, &err);
+		else
+			cli_output_abort(&output);
+	}
+	plume_mesh_destroy(mesh);
+	if (status != PLUME_OK)
+		return cli_fail(&err);
+	return CLI_EXIT_OK;
+}

@@ -1,0 +1,115 @@
+// plume scenes: a feather, how to mesh it, its materials, handles and loads,
+// and how long to simulate — read from JSON (docs/scene.md) and run.
+#ifndef PLUME_SCENE_H
+#define PLUME_SCENE_H
+
+#include "plume/feather.h"
+#include "plume/mesh.h"
+#include "plume/model.h"
+#include "plume/sim.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/// One key of a handle's scripted motion: at `time` the handle's vertices are at
+/// rotation(axis, angle) (rest - pivot) + pivot + translation.
+typedef struct plume_keyframe {
+	double time;
+	plume_vec3 translation;
+	plume_vec3 axis;
+	double angle;
+} plume_keyframe;
+
+typedef enum plume_interpolation {
+	/// Piecewise linear between keys.
+	PLUME_INTERPOLATION_LINEAR = 0,
+	/// Smoothstep 3s^2 - 2s^3 between keys: zero velocity at every key.
+	PLUME_INTERPOLATION_SMOOTH,
+} plume_interpolation;
+
+/// A Dirichlet handle: a vertex group, optionally only its vertices within `radius`
+/// of `near` (reference plane, m), moved by keyframes (none: held still).
+typedef struct plume_scene_handle {
+	char group[32];
+	bool near_given;
+	plume_vec2 near;
+	double radius;
+	plume_vec3 pivot;
+	plume_interpolation interpolation;
+	int keyframe_count;
+	plume_keyframe *keyframes;
+} plume_scene_handle;
+
+/// A constant force, N, shared by a group's vertices.
+typedef struct plume_scene_force {
+	char group[32];
+	plume_vec3 force;
+} plume_scene_force;
+
+typedef struct plume_scene {
+	/// The generated feather (NULL when the scene gives explicit guides).
+	plume_feather *feather;
+	plume_mesh *mesh;
+	plume_mesh_report mesh_report;
+	plume_sim_def sim;
+	int handle_count;
+	plume_scene_handle *handles;
+	int force_count;
+	plume_scene_force *forces;
+	/// Simulated time, s, > 0.
+	double duration;
+	/// Write every n-th step as a frame, >= 1. Default 1.
+	int frame_every;
+	/// Solve each step as a static equilibrium at the handles' positions (quasi-static
+	/// loading, no inertia) instead of implicit Euler. Default false.
+	bool quasi_static;
+} plume_scene;
+
+/// Reads a scene: generates its feather (seed from options or the feather spec)
+/// and meshes it. Errors name the file and the JSON path.
+plume_status plume_scene_load(const char *path, const plume_spec_options *options, plume_scene **out,
+                              plume_error *err);
+/// The same from JSON text; name stands for the file in messages, and relative paths
+/// in the text are relative to the current folder.
+plume_status plume_scene_parse(const char *text, const char *name, const plume_spec_options *options,
+                               plume_scene **out, plume_error *err);
+void plume_scene_destroy(plume_scene *scene);
+
+/// Where a handle is at time t: translation and rotation for plume_sim_set_handle.
+void plume_scene_handle_pose(const plume_scene_handle *handle, double t, plume_vec3 *translation,
+                             plume_mat3 *rotation);
+
+/// What a run measured.
+typedef struct plume_scene_summary {
+	int steps;
+	int newton_iterations;
+	double wall_seconds;
+	double seconds_assembly;
+	double seconds_factor;
+	double seconds_solve;
+	double max_barb_strain;
+	/// Mean displacement of the rachis_tip group from rest at the end, m (0 without that group).
+	double rachis_tip_deflection;
+	/// Steps that needed substeps.
+	int retried_steps;
+	int vertex_count;
+	int face_count;
+	int constraint_count;
+} plume_scene_summary;
+
+/// Called after the initial state (step 0, report NULL) and after every step.
+typedef plume_status plume_scene_step_fn(void *user, int step, double time, const plume_sim *sim,
+                                         const plume_solve_report *report, double wall_seconds, plume_error *err);
+
+/// Creates the simulation, runs it for the scene's duration, calling on_step.
+/// A step that fails (even with substeps) ends the run with its error; what was
+/// reported before stays valid, and nothing after it is reported.
+plume_status plume_scene_run(const plume_scene *scene, plume_scene_step_fn *on_step, void *user,
+                             plume_scene_summary *summary, plume_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif // PLUME_SCENE_H

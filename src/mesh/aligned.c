@@ -1,0 +1,965 @@
+// The barb-aligned mesher (Jouve thesis 6.2 "Meshing", paper section 7 and
+// Figure 7), made exact: every vane triangle has an edge on a barb guide.
+//
+// 1. The rachis band: rows along the centre line at spacing about e, each row
+//    two vertices at +-w/2 across the centre line, w going linearly from w_b
+//    at the vane's base to w_e at the tip (thesis Figure 6.2b-c).
+// 2. From each rachis-edge vertex, a guide interpolated between the two guides
+//    rooted nearest along the rachis and shifted to pass through the vertex
+//    (Figure 6.2d); vertices along it every e of plane arc length, to the
+//    guide's tip (the barb tips' envelope, or the boundary polygon).
+// 3. The strip between two consecutive guides of a vane is triangulated by
+//    walking both guides: each triangle takes one step along one guide, so it
+//    has two vertices on one guide and one on the other, and that step is a
+//    barb-aligned edge. The thesis left this to a constrained Delaunay
+//    triangulation, which "should" make most triangles incident to a guide
+//    edge; the strip walk makes all of them, which the barb inextensibility
+//    constraint (paper section 6) needs.
+// 4. Above the rachis tip, the two vanes' last guides close the tip the same way.
+//
+// A step that would make an inverted or degenerate triangle (two guides
+// touching) is never taken: both guides are cut there and every strip is
+// walked again, so the result is always a valid mesh.
+#include <assert.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../core/alloc.h"
+#include "aligned_internal.h"
+
+static const double pi = 3.14159265358979323846;
+
+/// Meshes bigger than this are refused (an edge length far too small).
+enum { MESH_MAX_VERTICES = 20000000 };
+
+typedef struct mesh_row {
+	double sigma;
+	plume_vec3 centre;
+	plume_vec2 tangent;
+	plume_vec2 left; ///< unit normal in the plane, towards the left vane
+	double width;
+	double t;
+	double lift;
+} mesh_row;
+
+/// The vertices placed along one interpolated guide; the first is the rachis vertex.
+typedef struct mesh_line {
+	bool present;
+	int first; ///< into the point pool
+	int count; ///< vertices in use
+	int full;  ///< vertices before any trimming
+} mesh_line;
+
+typedef struct mesh_strip {
+	int a, b; ///< line indices; walking from a to b turns counter-clockwise
+	bool shared_end;
+} mesh_strip;
+
+typedef struct mesher {
+	const mesh_input *input;
+	double e;
+	bool include_calamus;
+	int row_count;
+	mesh_row *rows;
+	mesh_line *lines; ///< [side * row_count + row]
+	plume_vec3 *points;
+	plume_vec2 *uvs;
+	int *ids; ///< mesh vertex index of each pool point
+	int point_count, point_capacity, uv_capacity, id_capacity;
+	mesh_strip *strip_list;
+	int strip_count;
+	int trimmed;
+	plume_error *err;
+} mesher;
+
+static double cross2(plume_vec3 a, plume_vec3 b, plume_vec3 c)
+{
+	return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+}
+
+static double dist2(plume_vec3 a, plume_vec3 b) { return (b.x - a.x) * (b.x - a.x) + (b.y - a.y) * (b.y - a.y); }
+
+static int line_index(const mesher *m, int side, int row) { return side * m->row_count + row; }
+
+// ---------------------------------------------------------------------------
+// Rows
+
+static int compare_doubles(const void *a, const void *b)
+{
+	double x = *(const double *)a, y = *(const double *)b;
+	return (x > y) - (x < y);
+}
+
+/// Row positions: each interval between breakpoints (band ends, vane ends)
+/// split into equal steps of about e, so that every vane starts on a row.
+static plume_status place_rows(mesher *m)
+{
+	const mesh_input *in = m->input;
+	double e = m->e;
+	double end = in->rachis.sigma[in->rachis.count - 1];
+	double vane_start = fmin(in->sigma_first[0], in->sigma_first[1]);
+	double start = 0.0;
+	if (!m->include_calamus && isfinite(vane_start) && vane_start > 0.0 && vane_start < end - 1e-9 * end)
+		start = vane_start;
+	double breaks[6] = {start, end};
+	int break_count = 2;
+	double candidates[4] = {in->sigma_first[0], in->sigma_first[1], in->sigma_last[0], in->sigma_last[1]};
+	for (int i = 0; i < 4; ++i)
+		if (isfinite(candidates[i]) && candidates[i] > start + 0.5 * e && candidates[i] < end - 0.5 * e)
+			breaks[break_count++] = candidates[i];
+	qsort(breaks, (size_t)break_count, sizeof *breaks, compare_doubles);
+	int kept = 1;
+	for (int i = 1; i < break_count; ++i) {
+		if (breaks[i] - breaks[kept - 1] < 0.5 * e) {
+			if (i == break_count - 1)
+				breaks[kept - 1] = breaks[i]; // the tip wins over an interior breakpoint
+			continue;
+		}
+		breaks[kept++] = breaks[i];
+	}
+	if (kept < 2) { // the band is shorter than half an edge: one step
+		breaks[0] = start;
+		breaks[1] = end;
+		kept = 2;
+	}
+	double total_steps = 0.0;
+	for (int i = 0; i + 1 < kept; ++i)
+		total_steps += fmax(1.0, round((breaks[i + 1] - breaks[i]) / e));
+	if (total_steps + 1.0 > MESH_MAX_VERTICES / 2)
+		return plume_error_set(m->err, PLUME_ERROR_SPEC,
+		                       "edge_length %g m is too small for a %g m rachis (%.0f rows): use a larger edge length",
+		                       e, end, total_steps + 1.0);
+	m->row_count = (int)total_steps + 1;
+	m->rows = plume_calloc((size_t)m->row_count, sizeof *m->rows);
+	if (m->rows == NULL)
+		return plume_error_set(m->err, PLUME_ERROR_MEMORY, "out of memory placing rachis rows");
+	int r = 0;
+	for (int i = 0; i + 1 < kept; ++i) {
+		int steps = (int)fmax(1.0, round((breaks[i + 1] - breaks[i]) / e));
+		for (int k = 0; k < steps; ++k)
+			m->rows[r++].sigma = breaks[i] + (breaks[i + 1] - breaks[i]) * k / steps;
+	}
+	m->rows[r++].sigma = end;
+	assert(r == m->row_count);
+
+	double vane_base = isfinite(vane_start) ? fmax(vane_start, m->rows[0].sigma) : m->rows[0].sigma;
+	for (r = 0; r < m->row_count; ++r) {
+		mesh_row *row = m->rows + r;
+		double width;
+		mesh_centre_eval(&in->rachis, row->sigma, &row->centre, &row->tangent, &width, &row->t, &row->lift);
+		row->left = (plume_vec2){-row->tangent.y, row->tangent.x};
+		// w: w_b up to the vane's base (the calamus keeps it), then linear to w_e at the tip.
+		double a = end > vane_base ? (row->sigma - vane_base) / (end - vane_base) : 1.0;
+		a = a < 0.0 ? 0.0 : a > 1.0 ? 1.0 : a;
+		row->width = in->width_base + a * (in->width_tip - in->width_base);
+	}
+	return PLUME_OK;
+}
+
+/// The rachis vertex of a row on a side (left: +w/2 along the left normal).
+static plume_vec3 rachis_point(const mesh_row *row, int side)
+{
+	double offset = side == PLUME_SIDE_LEFT ? 0.5 * row->width : -0.5 * row->width;
+	return (plume_vec3){row->centre.x + offset * row->left.x, row->centre.y + offset * row->left.y,
+	                    row->centre.z + offset * row->lift};
+}
+
+// ---------------------------------------------------------------------------
+// Guide lines
+
+static bool push_point(mesher *m, plume_vec3 p, plume_vec2 uv)
+{
+	if (PLUME_GROW(m->points, m->point_capacity, m->point_count + 1) != 0 ||
+	    PLUME_GROW(m->uvs, m->uv_capacity, m->point_count + 1) != 0 ||
+	    PLUME_GROW(m->ids, m->id_capacity, m->point_count + 1) != 0)
+		return false;
+	m->points[m->point_count] = p;
+	m->uvs[m->point_count] = uv;
+	m->ids[m->point_count] = -1;
+	m->point_count++;
+	return true;
+}
+
+static bool point_in_polygon(const plume_vec2 *polygon, int count, plume_vec3 p)
+{
+	bool inside = false;
+	for (int i = 0, j = count - 1; i < count; j = i++) {
+		plume_vec2 a = polygon[i], b = polygon[j];
+		if ((a.y > p.y) != (b.y > p.y) && p.x < (b.x - a.x) * (p.y - a.y) / (b.y - a.y) + a.x)
+			inside = !inside;
+	}
+	return inside;
+}
+
+/// Smallest u in (0, 1] where segment p + u (q - p) meets the polygon, or INFINITY.
+/// With ray, u may exceed 1 (a ray from p through q).
+static double polygon_hit(const plume_vec2 *polygon, int count, plume_vec3 p, plume_vec3 q, bool ray)
+{
+	double best = INFINITY;
+	double dx = q.x - p.x, dy = q.y - p.y;
+	for (int i = 0, j = count - 1; i < count; j = i++) {
+		plume_vec2 a = polygon[j], b = polygon[i];
+		double ex = b.x - a.x, ey = b.y - a.y;
+		double denominator = dx * ey - dy * ex;
+		if (denominator == 0.0)
+			continue;
+		double u = ((a.x - p.x) * ey - (a.y - p.y) * ex) / denominator;
+		double v = ((a.x - p.x) * dy - (a.y - p.y) * dx) / denominator;
+		if (u > 1e-12 && (ray || u <= 1.0) && v >= 0.0 && v <= 1.0 && u < best)
+			best = u;
+	}
+	return best;
+}
+
+/// Cuts the guide where it leaves the boundary polygon, or extends its last
+/// segment to the boundary when it ends inside. Returns the new point count
+/// (at most count + 1), or 0 when its root lies outside.
+static int clip_to_boundary(const mesh_input *in, plume_vec3 *p, plume_vec2 *uv, int count)
+{
+	if (!point_in_polygon(in->boundary, in->boundary_count, p[0]))
+		return 0;
+	for (int i = 0; i + 1 < count; ++i) {
+		double u = polygon_hit(in->boundary, in->boundary_count, p[i], p[i + 1], false);
+		if (u <= 1.0) {
+			p[i + 1] = plume_v3_lerp(p[i], p[i + 1], u);
+			uv[i + 1] = (plume_vec2){uv[i].x + u * (uv[i + 1].x - uv[i].x), uv[i].y + u * (uv[i + 1].y - uv[i].y)};
+			return i + 2;
+		}
+	}
+	double u = polygon_hit(in->boundary, in->boundary_count, p[count - 2], p[count - 1], true);
+	if (isfinite(u)) {
+		p[count] = plume_v3_lerp(p[count - 2], p[count - 1], u);
+		uv[count] = uv[count - 1];
+		return count + 1;
+	}
+	return count;
+}
+
+/// Cuts off the part of a guide that lies inside the rachis band or on the far
+/// side of it: barbs drawn with random shapes often start by heading back into
+/// the shaft (Franco & Walter 4.2, v1 <= 0). The guide then starts where it
+/// last crosses the band's edge, measured across the row's centre line.
+/// Returns the new point count (0 when it never leaves the band).
+static int clip_to_band(const mesh_row *row, int side, plume_vec3 *p, plume_vec2 *uv)
+{
+	double sign = side == PLUME_SIDE_LEFT ? 1.0 : -1.0, half = 0.5 * row->width;
+	double lateral[MESH_GUIDE_SAMPLES];
+	for (int k = 0; k < MESH_GUIDE_SAMPLES; ++k)
+		lateral[k] = sign * ((p[k].x - row->centre.x) * row->left.x + (p[k].y - row->centre.y) * row->left.y);
+	int last_inside = -1;
+	for (int k = 0; k < MESH_GUIDE_SAMPLES; ++k)
+		if (lateral[k] <= half)
+			last_inside = k;
+	if (last_inside < 0)
+		return MESH_GUIDE_SAMPLES; // starts outside the band already: the shift takes it to the edge
+	if (last_inside == MESH_GUIDE_SAMPLES - 1)
+		return 0;
+	int k = last_inside;
+	double a = (half - lateral[k]) / (lateral[k + 1] - lateral[k]);
+	plume_vec3 start = plume_v3_lerp(p[k], p[k + 1], a);
+	plume_vec2 start_uv = {uv[k].x + a * (uv[k + 1].x - uv[k].x), uv[k].y + a * (uv[k + 1].y - uv[k].y)};
+	int count = MESH_GUIDE_SAMPLES - k;
+	memmove(p, p + k, (size_t)count * sizeof *p);
+	memmove(uv, uv + k, (size_t)count * sizeof *uv);
+	p[0] = start;
+	uv[0] = start_uv;
+	return count;
+}
+
+/// Builds the guide through a row's rachis vertex on one side and places its vertices.
+static bool build_line(mesher *m, int side, int r)
+{
+	const mesh_input *in = m->input;
+	const mesh_row *row = m->rows + r;
+	const mesh_guide *guides = in->guides[side];
+	int n = in->guide_count[side];
+	mesh_line *line = m->lines + line_index(m, side, r);
+	memset(line, 0, sizeof *line);
+	if (n == 0 || row->sigma < in->sigma_first[side] - 0.5 * m->e || row->sigma > in->sigma_last[side] + 0.5 * m->e)
+		return true;
+
+	// The two guides rooted nearest along the rachis (thesis 6.2), or the end one.
+	int i0 = 0, i1 = 0;
+	double alpha = 0.0;
+	if (row->sigma >= guides[n - 1].sigma) {
+		i0 = i1 = n - 1;
+	} else if (row->sigma > guides[0].sigma) {
+		int lo = 0, hi = n - 1;
+		while (hi - lo > 1) {
+			int mid = (lo + hi) / 2;
+			if (guides[mid].sigma <= row->sigma)
+				lo = mid;
+			else
+				hi = mid;
+		}
+		i0 = lo;
+		i1 = hi;
+		alpha = (row->sigma - guides[lo].sigma) / (guides[hi].sigma - guides[lo].sigma);
+	}
+	plume_vec3 p[MESH_GUIDE_SAMPLES + 1];
+	plume_vec2 uv[MESH_GUIDE_SAMPLES + 1];
+	for (int k = 0; k < MESH_GUIDE_SAMPLES; ++k) {
+		p[k] = plume_v3_lerp(guides[i0].p[k], guides[i1].p[k], alpha);
+		plume_vec2 u0 = guides[i0].uv[k], u1 = guides[i1].uv[k];
+		uv[k] = (plume_vec2){u0.x + alpha * (u1.x - u0.x), u0.y + alpha * (u1.y - u0.y)};
+	}
+	int count = clip_to_band(row, side, p, uv);
+	if (count < 2)
+		return true; // the guide never leaves the rachis band: no vane here
+	// Shift the guide so that it starts at the rachis vertex, the shift fading
+	// to zero at the tip so that the tip stays on the barb tips' envelope.
+	plume_vec3 root = rachis_point(row, side);
+	plume_vec3 shift = plume_v3_sub(root, p[0]);
+	double along = 0.0, total_length = 0.0;
+	for (int k = 0; k + 1 < count; ++k)
+		total_length += sqrt(dist2(p[k], p[k + 1]));
+	plume_vec3 previous = p[0];
+	for (int k = 1; k < count; ++k) {
+		along += sqrt(dist2(previous, p[k]));
+		previous = p[k];
+		p[k] = plume_v3_mad(p[k], 1.0 - along / total_length, shift);
+	}
+	p[0] = root;
+	uv[0] = (plume_vec2){0.0, row->t};
+	if (in->boundary != NULL && (count = clip_to_boundary(in, p, uv, count)) == 0)
+		return true;
+
+	double total = 0.0;
+	for (int k = 0; k + 1 < count; ++k)
+		total += sqrt(dist2(p[k], p[k + 1]));
+	int steps = total > 1e-6 * m->e ? (int)fmax(1.0, round(total / m->e)) : 0;
+	if (m->point_count + steps + 1 > MESH_MAX_VERTICES)
+		return false;
+	line->present = true;
+	line->first = m->point_count;
+	line->count = line->full = steps + 1;
+	if (!push_point(m, root, uv[0]))
+		return false;
+	int segment = 0;
+	double start = 0.0;
+	for (int i = 1; i <= steps; ++i) {
+		double target = total * i / steps;
+		double length = sqrt(dist2(p[segment], p[segment + 1]));
+		while (segment + 2 < count && start + length < target) {
+			start += length;
+			++segment;
+			length = sqrt(dist2(p[segment], p[segment + 1]));
+		}
+		double a = length > 0.0 ? (target - start) / length : 1.0;
+		a = a < 0.0 ? 0.0 : a > 1.0 ? 1.0 : a;
+		if (i == steps) {
+			segment = count - 2;
+			a = 1.0;
+		}
+		plume_vec2 u0 = uv[segment], u1 = uv[segment + 1];
+		if (!push_point(m, plume_v3_lerp(p[segment], p[segment + 1], a),
+		                (plume_vec2){u0.x + a * (u1.x - u0.x), u0.y + a * (u1.y - u0.y)}))
+			return false;
+	}
+	return true;
+}
+
+// ---------------------------------------------------------------------------
+// Strips
+
+static bool add_strip(mesher *m, int a, int b, bool shared_end)
+{
+	mesh_strip *strips = plume_realloc(m->strip_list, (size_t)(m->strip_count + 1) * sizeof *strips);
+	if (strips == NULL)
+		return false;
+	m->strip_list = strips;
+	strips[m->strip_count++] = (mesh_strip){a, b, shared_end};
+	return true;
+}
+
+/// Left strips walk from the upper guide to the lower, right strips from the
+/// lower to the upper, the tip from the right vane's last guide to the left's:
+/// each turns counter-clockwise around the rachis-side edge.
+static bool collect_strips(mesher *m)
+{
+	for (int r = 0; r + 1 < m->row_count; ++r) {
+		int l0 = line_index(m, PLUME_SIDE_LEFT, r), l1 = line_index(m, PLUME_SIDE_LEFT, r + 1);
+		if (m->lines[l0].present && m->lines[l1].present && !add_strip(m, l1, l0, false))
+			return false;
+	}
+	for (int r = 0; r + 1 < m->row_count; ++r) {
+		int r0 = line_index(m, PLUME_SIDE_RIGHT, r), r1 = line_index(m, PLUME_SIDE_RIGHT, r + 1);
+		if (m->lines[r0].present && m->lines[r1].present && !add_strip(m, r0, r1, false))
+			return false;
+	}
+	int top = m->row_count - 1;
+	int left = line_index(m, PLUME_SIDE_LEFT, top), right = line_index(m, PLUME_SIDE_RIGHT, top);
+	mesh_line *a = m->lines + right, *b = m->lines + left;
+	if (!a->present || !b->present || a->count < 2 || b->count < 2)
+		return true;
+	plume_vec3 *tip_a = m->points + a->first + a->count - 1, *tip_b = m->points + b->first + b->count - 1;
+	double gap = sqrt(dist2(*tip_a, *tip_b));
+	if (gap >= 2.0 * m->e)
+		return true; // a blunt tip: the rachis tip edge stays a boundary
+	bool shared = gap < 0.75 * m->e;
+	if (shared) { // the two vanes meet in one tip vertex
+		plume_vec3 middle = plume_v3_lerp(*tip_a, *tip_b, 0.5);
+		*tip_a = *tip_b = middle;
+		plume_vec2 *uv_a = m->uvs + a->first + a->count - 1, *uv_b = m->uvs + b->first + b->count - 1;
+		plume_vec2 uv = {0.5 * (uv_a->x + uv_b->x), 0.5 * (uv_a->y + uv_b->y)};
+		*uv_a = *uv_b = uv;
+	}
+	return add_strip(m, right, left, shared);
+}
+
+/// Mesh vertex of point i of a line.
+static int vertex_of(const mesher *m, int line, int i) { return m->ids[m->lines[line].first + i]; }
+
+typedef struct strip_out {
+	plume_mesh *mesh; ///< NULL: only count and check
+	int faces;
+} strip_out;
+
+static void emit_face(const mesher *m, strip_out *out, int la, int ia, int lb, int ib, int lc, int ic, int barb_edge)
+{
+	if (out->mesh != NULL) {
+		plume_mesh *mesh = out->mesh;
+		int f = out->faces;
+		int v[3] = {vertex_of(m, la, ia), vertex_of(m, lb, ib), vertex_of(m, lc, ic)};
+		memcpy(mesh->faces + 3 * f, v, sizeof v);
+		mesh->material[f] = PLUME_MATERIAL_VANE;
+		mesh->barb_edge[f] = (signed char)barb_edge;
+		plume_vec2 p = mesh->reference[v[barb_edge]], q = mesh->reference[v[(barb_edge + 1) % 3]];
+		double angle = atan2(q.y - p.y, q.x - p.x);
+		if (angle < 0.0)
+			angle += pi;
+		if (angle >= pi)
+			angle -= pi;
+		mesh->barb_angle[f] = angle;
+	}
+	out->faces++;
+}
+
+static double orient3(plume_vec3 a, plume_vec3 b, plume_vec3 c) { return cross2(a, b, c); }
+
+/// Proper crossing of segments pq and rs.
+static bool cross_segments(plume_vec3 p, plume_vec3 q, plume_vec3 r, plume_vec3 s)
+{
+	double o1 = orient3(p, q, r), o2 = orient3(p, q, s), o3 = orient3(r, s, p), o4 = orient3(r, s, q);
+	return ((o1 > 0.0 && o2 < 0.0) || (o1 < 0.0 && o2 > 0.0)) && ((o3 > 0.0 && o4 < 0.0) || (o3 < 0.0 && o4 > 0.0));
+}
+
+/// The strip's outline (guide A, closing edge, guide B back, bottom edge) must
+/// be a simple polygon. Returns false with where to cut the guides when a
+/// segment of one guide crosses the other guide, the closing edge or the
+/// bottom edge.
+static bool strip_is_simple(const mesher *m, const mesh_strip *strip, int *cut_a, int *cut_b)
+{
+	const mesh_line *la = m->lines + strip->a, *lb = m->lines + strip->b;
+	const plume_vec3 *A = m->points + la->first, *B = m->points + lb->first;
+	int ma = la->count - 1, nb = lb->count - 1;
+	for (int i = 0; i < ma; ++i)
+		for (int k = 0; k < nb; ++k)
+			if (cross_segments(A[i], A[i + 1], B[k], B[k + 1])) {
+				*cut_a = i;
+				*cut_b = k;
+				return false;
+			}
+	for (int i = 1; i < ma; ++i)
+		if (cross_segments(A[i], A[i + 1], A[0], B[0])) {
+			*cut_a = i;
+			*cut_b = nb;
+			return false;
+		}
+	for (int k = 1; k < nb; ++k)
+		if (cross_segments(B[k], B[k + 1], A[0], B[0])) {
+			*cut_a = ma;
+			*cut_b = k;
+			return false;
+		}
+	if (!strip->shared_end) {
+		for (int i = 0; i + 1 < ma; ++i)
+			if (cross_segments(A[i], A[i + 1], A[ma], B[nb])) {
+				*cut_a = ma - 1;
+				*cut_b = nb;
+				return false;
+			}
+		for (int k = 0; k + 1 < nb; ++k)
+			if (cross_segments(B[k], B[k + 1], A[ma], B[nb])) {
+				*cut_a = ma;
+				*cut_b = nb - 1;
+				return false;
+			}
+	}
+	return true;
+}
+
+/// True when no vertex of the strip still to be walked lies inside or on
+/// triangle (p, q, r) (the ear test of polygon triangulation).
+static bool ear_is_empty(const mesher *m, const mesh_strip *strip, int i, int k, plume_vec3 p, plume_vec3 q,
+                         plume_vec3 r)
+{
+	const mesh_line *la = m->lines + strip->a, *lb = m->lines + strip->b;
+	const plume_vec3 *A = m->points + la->first, *B = m->points + lb->first;
+	int ma = la->count - 1, nb = lb->count - 1;
+	for (int side = 0; side < 2; ++side) {
+		const plume_vec3 *X = side == 0 ? A : B;
+		int from = side == 0 ? i : k, to = side == 0 ? ma : nb;
+		for (int j = from; j <= to; ++j) {
+			plume_vec3 x = X[j];
+			if ((x.x == p.x && x.y == p.y) || (x.x == q.x && x.y == q.y) || (x.x == r.x && x.y == r.y))
+				continue;
+			if (cross2(p, q, x) >= 0.0 && cross2(q, r, x) >= 0.0 && cross2(r, p, x) >= 0.0)
+				return false;
+		}
+	}
+	return true;
+}
+
+/// Walks one strip. Each triangle is (a_i, a_i+1, b_k), barb edge 0, or
+/// (a_i, b_k+1, b_k), barb edge 1; the shorter new diagonal wins among the
+/// valid ones. Returns false at the first step with no valid triangle, with
+/// the position in *fail_i, *fail_k.
+static bool walk_strip(const mesher *m, const mesh_strip *strip, strip_out *out, int *fail_i, int *fail_k)
+{
+	const mesh_line *la = m->lines + strip->a, *lb = m->lines + strip->b;
+	const plume_vec3 *A = m->points + la->first, *B = m->points + lb->first;
+	int ma = la->count - 1, nb = lb->count - 1;
+	int stop = strip->shared_end ? 2 : 1;
+	double tolerance = 1e-8 * m->e * m->e;
+	int i = 0, k = 0;
+	while ((ma - i) + (nb - k) >= stop) {
+		// With a shared end, the last step on one guide waits for the other's.
+		bool can_a = i < ma && !(strip->shared_end && i + 1 == ma && k < nb - 1);
+		bool can_b = k < nb && !(strip->shared_end && k + 1 == nb && i < ma - 1);
+		bool ok_a =
+		    can_a && cross2(A[i], A[i + 1], B[k]) > tolerance && ear_is_empty(m, strip, i, k, A[i], A[i + 1], B[k]);
+		bool ok_b =
+		    can_b && cross2(A[i], B[k + 1], B[k]) > tolerance && ear_is_empty(m, strip, i, k, A[i], B[k + 1], B[k]);
+		if (!ok_a && !ok_b) {
+			*fail_i = i;
+			*fail_k = k;
+			return false;
+		}
+		bool take_a = ok_a && (!ok_b || dist2(A[i + 1], B[k]) <= dist2(A[i], B[k + 1]));
+		if (take_a) {
+			emit_face(m, out, strip->a, i, strip->a, i + 1, strip->b, k, 0);
+			++i;
+		} else {
+			emit_face(m, out, strip->a, i, strip->b, k + 1, strip->b, k, 1);
+			++k;
+		}
+	}
+	return true;
+}
+
+/// Walks every strip; where one fails, cuts both guides there and starts
+/// over, until all strips walk through. Each cut removes at least one vertex,
+/// so this ends.
+/// Guides of one vane two to four rows apart must not cross either (a short
+/// guide between them would not separate them); where they do, both are cut.
+static bool cut_distant_crossings(mesher *m)
+{
+	bool clean = true;
+	for (int side = 0; side < 2; ++side)
+		for (int r = 0; r < m->row_count; ++r)
+			for (int d = 2; d <= 4 && r + d < m->row_count; ++d) {
+				mesh_line *a = m->lines + line_index(m, side, r), *b = m->lines + line_index(m, side, r + d);
+				if (!a->present || !b->present)
+					continue;
+				const plume_vec3 *A = m->points + a->first, *B = m->points + b->first;
+				for (int i = 0; i + 1 < a->count; ++i)
+					for (int k = 0; k + 1 < b->count; ++k)
+						if (cross_segments(A[i], A[i + 1], B[k], B[k + 1])) {
+							m->trimmed += (a->count - (i + 1)) + (b->count - (k + 1));
+							a->count = i + 1;
+							b->count = k + 1;
+							clean = false;
+						}
+			}
+	// The vane's outer edge between two neighbouring tips must not cross a guide nearby.
+	for (int side = 0; side < 2; ++side)
+		for (int r = 0; r + 1 < m->row_count; ++r) {
+			mesh_line *a = m->lines + line_index(m, side, r), *b = m->lines + line_index(m, side, r + 1);
+			if (!a->present || !b->present)
+				continue;
+			plume_vec3 p = m->points[a->first + a->count - 1], q = m->points[b->first + b->count - 1];
+			for (int d = -3; d <= 4; ++d) {
+				if (d == 0 || d == 1 || r + d < 0 || r + d >= m->row_count)
+					continue;
+				mesh_line *c = m->lines + line_index(m, side, r + d);
+				const plume_vec3 *C = m->points + c->first;
+				for (int k = 0; c->present && k + 1 < c->count; ++k)
+					if (cross_segments(p, q, C[k], C[k + 1])) {
+						m->trimmed += c->count - (k + 1);
+						c->count = k + 1;
+						clean = false;
+						break;
+					}
+			}
+		}
+	return clean;
+}
+
+static int settle_strips(mesher *m)
+{
+	for (;;) {
+		bool clean = cut_distant_crossings(m);
+		for (int s = 0; s < m->strip_count; ++s) {
+			mesh_strip *strip = m->strip_list + s;
+			mesh_line *a = m->lines + strip->a, *b = m->lines + strip->b;
+			if (strip->shared_end && (a->count != a->full || b->count != b->full))
+				strip->shared_end = false; // a cut guide no longer reaches the shared tip
+			strip_out dry = {NULL, 0};
+			int i, k;
+			if (strip_is_simple(m, strip, &i, &k) && walk_strip(m, strip, &dry, &i, &k))
+				continue;
+			m->trimmed += (a->count - (i + 1)) + (b->count - (k + 1));
+			a->count = i + 1;
+			b->count = k + 1;
+			clean = false;
+		}
+		if (clean)
+			break;
+	}
+	int faces = 0;
+	for (int s = 0; s < m->strip_count; ++s) {
+		strip_out dry = {NULL, 0};
+		int i, k;
+		walk_strip(m, m->strip_list + s, &dry, &i, &k);
+		faces += dry.faces;
+	}
+	return faces;
+}
+
+// ---------------------------------------------------------------------------
+// Assembly
+
+/// Rachis band: the quad of rows r, r+1 split along alternating diagonals, so
+/// that the band has no preferred shear direction.
+static plume_status emit_rachis(const mesher *m, plume_mesh *mesh, int *face)
+{
+	double tolerance = 1e-8 * m->e * m->e;
+	for (int r = 0; r + 1 < m->row_count; ++r) {
+		int l0 = 2 * r, r0 = 2 * r + 1, l1 = 2 * r + 2, r1 = 2 * r + 3;
+		int tris[2][3] = {{l0, r0, r1}, {l0, r1, l1}};
+		if (r % 2 == 1) {
+			int other[2][3] = {{l0, r0, l1}, {r0, r1, l1}};
+			memcpy(tris, other, sizeof tris);
+		}
+		plume_vec2 t = {m->rows[r].tangent.x + m->rows[r + 1].tangent.x,
+		                m->rows[r].tangent.y + m->rows[r + 1].tangent.y};
+		double angle = atan2(t.y, t.x);
+		if (angle < 0.0)
+			angle += pi;
+		if (angle >= pi)
+			angle -= pi;
+		for (int j = 0; j < 2; ++j) {
+			plume_vec2 a = mesh->reference[tris[j][0]], b = mesh->reference[tris[j][1]],
+			           c = mesh->reference[tris[j][2]];
+			double area2 = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+			if (!(area2 > tolerance))
+				return plume_error_set(m->err, PLUME_ERROR_NUMERIC,
+				                       "the rachis band folds over between %g m and %g m along the rachis: the "
+				                       "rachis bends too sharply for its width; use a narrower band or a larger "
+				                       "edge length",
+				                       m->rows[r].sigma, m->rows[r + 1].sigma);
+			int f = (*face)++;
+			memcpy(mesh->faces + 3 * f, tris[j], sizeof tris[j]);
+			mesh->material[f] = PLUME_MATERIAL_RACHIS;
+			mesh->barb_edge[f] = -1;
+			mesh->barb_angle[f] = angle;
+		}
+	}
+	return PLUME_OK;
+}
+
+/// Gives every used pool point a mesh vertex (the rachis vertices are 2r + side)
+/// and counts them. The shared tip belongs to the left vane's last guide.
+static int number_vertices(mesher *m)
+{
+	int next = 2 * m->row_count;
+	const mesh_strip *cap = NULL;
+	for (int s = 0; s < m->strip_count; ++s)
+		if (m->strip_list[s].shared_end)
+			cap = m->strip_list + s;
+	for (int side = 0; side < 2; ++side)
+		for (int r = 0; r < m->row_count; ++r) {
+			int index = line_index(m, side, r);
+			const mesh_line *line = m->lines + index;
+			if (!line->present)
+				continue;
+			m->ids[line->first] = 2 * r + side;
+			for (int i = 1; i < line->count; ++i) {
+				if (cap != NULL && index == cap->a && i == line->count - 1)
+					m->ids[line->first + i] = m->ids[m->lines[cap->b].first + m->lines[cap->b].count - 1];
+				else
+					m->ids[line->first + i] = next++;
+			}
+		}
+	return next;
+}
+
+static plume_status add_groups(const mesher *m, plume_mesh *mesh, plume_error *err)
+{
+	int rachis_count = 2 * m->row_count;
+	int *list = plume_alloc((size_t)mesh->vertex_count * sizeof *list);
+	if (list == NULL)
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory building vertex groups");
+	plume_status status = PLUME_OK;
+	int top = m->row_count - 1;
+	int base[2] = {0, 1}, tip[2] = {2 * top, 2 * top + 1}, clamp[4] = {0, 1, 2, 3};
+	for (int i = 0; i < rachis_count; ++i)
+		list[i] = i;
+	if ((status = plume_mesh_add_group(mesh, "rachis", list, rachis_count, err)) != PLUME_OK ||
+	    (status = plume_mesh_add_group(mesh, "rachis_base", base, 2, err)) != PLUME_OK ||
+	    (status = plume_mesh_add_group(mesh, "rachis_clamp", clamp, 4, err)) != PLUME_OK ||
+	    (status = plume_mesh_add_group(mesh, "rachis_tip", tip, 2, err)) != PLUME_OK)
+		goto done;
+	static const char *const edge_names[2] = {"left_edge", "right_edge"};
+	for (int side = 0; side < 2 && status == PLUME_OK; ++side) {
+		int count = 0;
+		for (int r = 0; r < m->row_count; ++r) {
+			const mesh_line *line = m->lines + line_index(m, side, r);
+			if (line->present && line->count >= 2)
+				list[count++] = m->ids[line->first + line->count - 1];
+		}
+		status = plume_mesh_add_group(mesh, edge_names[side], list, count, err);
+	}
+	if (status != PLUME_OK)
+		goto done;
+	// The feather's tip: the vane vertex farthest along the rachis' base-to-tip
+	// direction; the group holds the vane vertices within one edge length of it.
+	plume_vec2 d = {m->rows[top].centre.x - m->rows[0].centre.x, m->rows[top].centre.y - m->rows[0].centre.y};
+	int tip_vertex = -1;
+	double best = -INFINITY;
+	for (int v = rachis_count; v < mesh->vertex_count; ++v) {
+		double along = mesh->reference[v].x * d.x + mesh->reference[v].y * d.y;
+		if (along > best) {
+			best = along;
+			tip_vertex = v;
+		}
+	}
+	int count = 0;
+	if (tip_vertex >= 0) {
+		plume_vec2 q = mesh->reference[tip_vertex];
+		for (int v = rachis_count; v < mesh->vertex_count; ++v)
+			if (hypot(mesh->reference[v].x - q.x, mesh->reference[v].y - q.y) <= m->e * (1.0 + 1e-9))
+				list[count++] = v;
+	}
+	status = plume_mesh_add_group(mesh, "vane_tip", list, count, err);
+done:
+	plume_free(list);
+	return status;
+}
+
+typedef struct face_box {
+	double x0, x1, y0, y1;
+	int face;
+} face_box;
+
+static int compare_boxes(const void *a, const void *b)
+{
+	const face_box *x = a, *y = b;
+	if (x->x0 != y->x0)
+		return x->x0 < y->x0 ? -1 : 1;
+	return (x->face > y->face) - (x->face < y->face);
+}
+
+static bool faces_overlap(const plume_mesh *mesh, int f, int g)
+{
+	const int *a = mesh->faces + 3 * f, *b = mesh->faces + 3 * g;
+	plume_vec3 pa[3], pb[3];
+	for (int k = 0; k < 3; ++k) {
+		pa[k] = (plume_vec3){mesh->reference[a[k]].x, mesh->reference[a[k]].y, 0.0};
+		pb[k] = (plume_vec3){mesh->reference[b[k]].x, mesh->reference[b[k]].y, 0.0};
+	}
+	for (int i = 0; i < 3; ++i)
+		for (int j = 0; j < 3; ++j)
+			if (cross_segments(pa[i], pa[(i + 1) % 3], pb[j], pb[(j + 1) % 3]))
+				return true;
+	// A vertex of one strictly inside the other (nested triangles cross no edge).
+	for (int i = 0; i < 3; ++i) {
+		bool a_shared = a[i] == b[0] || a[i] == b[1] || a[i] == b[2];
+		bool b_shared = b[i] == a[0] || b[i] == a[1] || b[i] == a[2];
+		if (!b_shared && cross2(pa[0], pa[1], pb[i]) > 0.0 && cross2(pa[1], pa[2], pb[i]) > 0.0 &&
+		    cross2(pa[2], pa[0], pb[i]) > 0.0)
+			return true;
+		if (!a_shared && cross2(pb[0], pb[1], pa[i]) > 0.0 && cross2(pb[1], pb[2], pa[i]) > 0.0 &&
+		    cross2(pb[2], pb[0], pa[i]) > 0.0)
+			return true;
+	}
+	return false;
+}
+
+/// The last safety net: no two faces of the result may overlap (sweep over
+/// face boxes sorted by x). Returns the first overlapping face, or -1.
+static int find_overlap(const plume_mesh *mesh, bool *out_of_memory)
+{
+	face_box *boxes = plume_alloc((size_t)mesh->face_count * sizeof *boxes);
+	*out_of_memory = boxes == NULL;
+	if (boxes == NULL)
+		return -1;
+	for (int f = 0; f < mesh->face_count; ++f) {
+		face_box *box = boxes + f;
+		box->face = f;
+		box->x0 = box->y0 = INFINITY;
+		box->x1 = box->y1 = -INFINITY;
+		for (int k = 0; k < 3; ++k) {
+			plume_vec2 p = mesh->reference[mesh->faces[3 * f + k]];
+			box->x0 = fmin(box->x0, p.x);
+			box->x1 = fmax(box->x1, p.x);
+			box->y0 = fmin(box->y0, p.y);
+			box->y1 = fmax(box->y1, p.y);
+		}
+	}
+	qsort(boxes, (size_t)mesh->face_count, sizeof *boxes, compare_boxes);
+	int found = -1;
+	for (int i = 0; i < mesh->face_count && found < 0; ++i)
+		for (int j = i + 1; j < mesh->face_count && boxes[j].x0 <= boxes[i].x1 && found < 0; ++j)
+			if (boxes[j].y0 <= boxes[i].y1 && boxes[i].y0 <= boxes[j].y1 &&
+			    faces_overlap(mesh, boxes[i].face, boxes[j].face))
+				found = boxes[i].face;
+	plume_free(boxes);
+	return found;
+}
+
+static plume_status assemble(mesher *m, plume_mesh **out, plume_mesh_report *report)
+{
+	int vane_faces = settle_strips(m);
+	int vertex_count = number_vertices(m);
+	if (vertex_count == 2 * m->row_count || vane_faces == 0)
+		return plume_error_set(m->err, PLUME_ERROR_SPEC,
+		                       "no vane to mesh: %d usable barb guides on the left, %d on the right (%d input barbs "
+		                       "left out); the feather needs barbs with a length in the feather plane",
+		                       m->input->guide_count[0], m->input->guide_count[1], m->input->guides_dropped);
+	int face_count = 2 * (m->row_count - 1) + vane_faces;
+	plume_mesh *mesh = plume_mesh_create(vertex_count, face_count);
+	if (mesh == NULL)
+		return plume_error_set(m->err, PLUME_ERROR_MEMORY, "out of memory creating a %d-vertex mesh", vertex_count);
+	for (int r = 0; r < m->row_count; ++r)
+		for (int side = 0; side < 2; ++side) {
+			plume_vec3 p = rachis_point(m->rows + r, side);
+			mesh->reference[2 * r + side] = (plume_vec2){p.x, p.y};
+			mesh->rest[2 * r + side] = p;
+			mesh->uv[2 * r + side] = (plume_vec2){0.0, m->rows[r].t};
+		}
+	for (int side = 0; side < 2; ++side)
+		for (int r = 0; r < m->row_count; ++r) {
+			const mesh_line *line = m->lines + line_index(m, side, r);
+			for (int i = 1; line->present && i < line->count; ++i) {
+				int v = m->ids[line->first + i];
+				plume_vec3 p = m->points[line->first + i];
+				mesh->reference[v] = (plume_vec2){p.x, p.y};
+				mesh->rest[v] = p;
+				mesh->uv[v] = m->uvs[line->first + i];
+			}
+		}
+	int face = 0;
+	plume_status status = emit_rachis(m, mesh, &face);
+	strip_out emitted = {mesh, face};
+	for (int s = 0; s < m->strip_count && status == PLUME_OK; ++s) {
+		int i, k;
+		bool ok = walk_strip(m, m->strip_list + s, &emitted, &i, &k);
+		assert(ok);
+		(void)ok;
+	}
+	assert(status != PLUME_OK || emitted.faces == face_count);
+	if (status == PLUME_OK)
+		status = plume_mesh_collect_barb_edges(mesh, m->err);
+	if (status == PLUME_OK)
+		status = add_groups(m, mesh, m->err);
+	if (status == PLUME_OK) {
+		bool out_of_memory;
+		int overlap = find_overlap(mesh, &out_of_memory);
+		if (out_of_memory)
+			status = plume_error_set(m->err, PLUME_ERROR_MEMORY, "out of memory checking the mesh");
+		else if (overlap >= 0) {
+			plume_vec2 p = mesh->reference[mesh->faces[3 * overlap]];
+			status = plume_error_set(m->err, PLUME_ERROR_NUMERIC,
+			                         "the barb guides fold over one another near (%g, %g) m and no valid aligned "
+			                         "mesh was found at edge length %g m; try another edge length",
+			                         p.x, p.y, m->e);
+		}
+	}
+	if (status != PLUME_OK) {
+		plume_mesh_destroy(mesh);
+		return status;
+	}
+	for (int v = 0; v < mesh->vertex_count; ++v)
+		if (!isfinite(mesh->rest[v].x) || !isfinite(mesh->rest[v].y) || !isfinite(mesh->rest[v].z)) {
+			plume_mesh_destroy(mesh);
+			return plume_error_set(m->err, PLUME_ERROR_NUMERIC, "mesh vertex %d is not finite", v);
+		}
+	if (report != NULL) {
+		plume_mesh_report measured = plume_mesh_measure(mesh);
+		report->min_angle = measured.min_angle;
+		report->aligned_fraction = measured.aligned_fraction;
+		report->guides_dropped = m->input->guides_dropped;
+		report->barbs_averaged = m->input->barbs_averaged;
+		report->vertices_trimmed = m->trimmed;
+		report->edge_length = m->e;
+		for (int side = 0; side < 2; ++side) {
+			report->guide_count[side] = 0;
+			for (int r = 0; r < m->row_count; ++r) {
+				const mesh_line *line = m->lines + line_index(m, side, r);
+				report->guide_count[side] += line->present && line->count >= 2;
+			}
+		}
+	}
+	*out = mesh;
+	return PLUME_OK;
+}
+
+static plume_status mesh_run(const mesh_input *input, const plume_mesh_def *def, plume_mesh **out,
+                             plume_mesh_report *report, plume_error *err)
+{
+	mesher m = {.input = input, .e = def->edge_length, .include_calamus = def->include_calamus, .err = err};
+	plume_status status = place_rows(&m);
+	if (status == PLUME_OK) {
+		m.lines = plume_calloc((size_t)(2 * m.row_count), sizeof *m.lines);
+		if (m.lines == NULL)
+			status = plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory placing guides");
+	}
+	for (int side = 0; side < 2 && status == PLUME_OK; ++side)
+		for (int r = 0; r < m.row_count && status == PLUME_OK; ++r)
+			if (!build_line(&m, side, r))
+				status = m.point_count + 1 > MESH_MAX_VERTICES
+				             ? plume_error_set(err, PLUME_ERROR_SPEC,
+				                               "edge_length %g m is too small for this feather (over %d vertices)", m.e,
+				                               MESH_MAX_VERTICES)
+				             : plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory placing guide vertices");
+	if (status == PLUME_OK && !collect_strips(&m))
+		status = plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory");
+	if (status == PLUME_OK)
+		status = assemble(&m, out, report);
+	plume_free(m.rows);
+	plume_free(m.lines);
+	plume_free(m.points);
+	plume_free(m.uvs);
+	plume_free(m.ids);
+	plume_free(m.strip_list);
+	return status;
+}
+
+plume_status plume_mesh_from_feather(const plume_feather *feather, const plume_mesh_def *def, plume_mesh **out,
+                                     plume_mesh_report *report, plume_error *err)
+{
+	*out = NULL;
+	mesh_input input;
+	plume_status status = mesh_input_from_feather(feather, def, &input, err);
+	if (status != PLUME_OK)
+		return status;
+	status = mesh_run(&input, def, out, report, err);
+	mesh_input_free(&input);
+	return status;
+}
+
+plume_status plume_mesh_from_guides(const plume_mesh_guides *guides, const plume_mesh_def *def, plume_mesh **out,
+                                    plume_mesh_report *report, plume_error *err)
+{
+	*out = NULL;
+	mesh_input input;
+	plume_status status = mesh_input_from_guides(guides, def, &input, err);
+	if (status != PLUME_OK)
+		return status;
+	status = mesh_run(&input, def, out, report, err);
+	mesh_input_free(&input);
+	return status;
+}

@@ -1,0 +1,173 @@
+// plume_mesh: allocation, vertex groups, barb-edge collection and quality
+// measures. The builders (aligned.c, sample.c, obj.c) fill the arrays.
+#include <assert.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../core/alloc.h"
+#include "plume/mesh.h"
+
+static const double pi = 3.14159265358979323846;
+
+plume_mesh_def plume_mesh_default_def(void)
+{
+	return (plume_mesh_def){
+	    .edge_length = 5e-3,
+	    .rachis_width_base = 0.0,
+	    .rachis_width_tip = 0.0,
+	    .include_calamus = true,
+	};
+}
+
+/// calloc of at least one element, so that an empty array is still a valid pointer.
+static void *zeroed(int count, size_t size) { return plume_calloc(count > 0 ? (size_t)count : 1u, size); }
+
+plume_mesh *plume_mesh_create(int vertex_count, int face_count)
+{
+	assert(vertex_count >= 0 && face_count >= 0);
+	plume_mesh *mesh = plume_calloc(1, sizeof *mesh);
+	if (mesh == NULL)
+		return NULL;
+	mesh->vertex_count = vertex_count;
+	mesh->face_count = face_count;
+	mesh->reference = zeroed(vertex_count, sizeof *mesh->reference);
+	mesh->rest = zeroed(vertex_count, sizeof *mesh->rest);
+	mesh->uv = zeroed(vertex_count, sizeof *mesh->uv);
+	mesh->faces = zeroed(3 * face_count, sizeof *mesh->faces);
+	mesh->material = zeroed(face_count, sizeof *mesh->material);
+	mesh->barb_angle = zeroed(face_count, sizeof *mesh->barb_angle);
+	mesh->barb_edge = zeroed(face_count, sizeof *mesh->barb_edge);
+	mesh->barb_edges = zeroed(0, sizeof *mesh->barb_edges);
+	if (mesh->reference == NULL || mesh->rest == NULL || mesh->uv == NULL || mesh->faces == NULL ||
+	    mesh->material == NULL || mesh->barb_angle == NULL || mesh->barb_edge == NULL || mesh->barb_edges == NULL) {
+		plume_mesh_destroy(mesh);
+		return NULL;
+	}
+	for (int f = 0; f < face_count; ++f)
+		mesh->barb_edge[f] = -1;
+	return mesh;
+}
+
+void plume_mesh_destroy(plume_mesh *mesh)
+{
+	if (mesh == NULL)
+		return;
+	for (int g = 0; g < mesh->group_count; ++g)
+		plume_free(mesh->groups[g].vertices);
+	plume_free(mesh->groups);
+	plume_free(mesh->reference);
+	plume_free(mesh->rest);
+	plume_free(mesh->uv);
+	plume_free(mesh->faces);
+	plume_free(mesh->material);
+	plume_free(mesh->barb_angle);
+	plume_free(mesh->barb_edge);
+	plume_free(mesh->barb_edges);
+	plume_free(mesh);
+}
+
+plume_status plume_mesh_add_group(plume_mesh *mesh, const char *name, const int *vertices, int count, plume_error *err)
+{
+	size_t length = strlen(name);
+	if (length == 0 || length >= sizeof mesh->groups[0].name)
+		return plume_error_set(err, PLUME_ERROR_SPEC, "vertex group name \"%s\" must have 1 to %zu bytes", name,
+		                       sizeof mesh->groups[0].name - 1);
+	if (plume_mesh_find_group(mesh, name) != NULL)
+		return plume_error_set(err, PLUME_ERROR_SPEC, "the mesh already has a vertex group \"%s\"", name);
+	for (int i = 0; i < count; ++i)
+		if (vertices[i] < 0 || vertices[i] >= mesh->vertex_count)
+			return plume_error_set(err, PLUME_ERROR_SPEC, "vertex group \"%s\": vertex %d out of range [0, %d)", name,
+			                       vertices[i], mesh->vertex_count);
+	int *copy = zeroed(count, sizeof *copy);
+	plume_vertex_group *groups = plume_realloc(mesh->groups, (size_t)(mesh->group_count + 1) * sizeof *groups);
+	if (copy == NULL || groups == NULL) {
+		plume_free(copy);
+		if (groups != NULL)
+			mesh->groups = groups;
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory adding vertex group \"%s\"", name);
+	}
+	if (count > 0)
+		memcpy(copy, vertices, (size_t)count * sizeof *copy);
+	mesh->groups = groups;
+	plume_vertex_group *group = groups + mesh->group_count++;
+	memset(group->name, 0, sizeof group->name);
+	memcpy(group->name, name, length);
+	group->count = count;
+	group->vertices = copy;
+	return PLUME_OK;
+}
+
+const plume_vertex_group *plume_mesh_find_group(const plume_mesh *mesh, const char *name)
+{
+	for (int g = 0; g < mesh->group_count; ++g)
+		if (strcmp(mesh->groups[g].name, name) == 0)
+			return mesh->groups + g;
+	return NULL;
+}
+
+static int compare_edges(const void *a, const void *b)
+{
+	const int *x = a, *y = b;
+	if (x[0] != y[0])
+		return x[0] < y[0] ? -1 : 1;
+	return (x[1] > y[1]) - (x[1] < y[1]);
+}
+
+plume_status plume_mesh_collect_barb_edges(plume_mesh *mesh, plume_error *err)
+{
+	int count = 0;
+	for (int f = 0; f < mesh->face_count; ++f)
+		count += mesh->barb_edge[f] >= 0;
+	int *edges = zeroed(2 * count, sizeof *edges);
+	if (edges == NULL)
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory collecting barb edges");
+	int n = 0;
+	for (int f = 0; f < mesh->face_count; ++f) {
+		int k = mesh->barb_edge[f];
+		if (k < 0)
+			continue;
+		assert(k < 3);
+		int a = mesh->faces[3 * f + k], b = mesh->faces[3 * f + (k + 1) % 3];
+		edges[2 * n] = a < b ? a : b;
+		edges[2 * n + 1] = a < b ? b : a;
+		++n;
+	}
+	qsort(edges, (size_t)n, 2 * sizeof *edges, compare_edges);
+	int unique = 0;
+	for (int i = 0; i < n; ++i) {
+		if (unique > 0 && edges[2 * i] == edges[2 * (unique - 1)] && edges[2 * i + 1] == edges[2 * (unique - 1) + 1])
+			continue;
+		edges[2 * unique] = edges[2 * i];
+		edges[2 * unique + 1] = edges[2 * i + 1];
+		++unique;
+	}
+	plume_free(mesh->barb_edges);
+	mesh->barb_edges = edges;
+	mesh->barb_edge_count = unique;
+	return PLUME_OK;
+}
+
+plume_mesh_report plume_mesh_measure(const plume_mesh *mesh)
+{
+	plume_mesh_report report = {.min_angle = mesh->face_count > 0 ? pi : 0.0, .aligned_fraction = 1.0};
+	int vane_faces = 0, aligned = 0;
+	for (int f = 0; f < mesh->face_count; ++f) {
+		const int *v = mesh->faces + 3 * f;
+		for (int k = 0; k < 3; ++k) {
+			plume_vec2 p = mesh->reference[v[k]], a = mesh->reference[v[(k + 1) % 3]],
+			           b = mesh->reference[v[(k + 2) % 3]];
+			double ax = a.x - p.x, ay = a.y - p.y, bx = b.x - p.x, by = b.y - p.y;
+			// atan2(|a x b|, a . b) is accurate for small and near-pi angles alike.
+			double angle = atan2(fabs(ax * by - ay * bx), ax * bx + ay * by);
+			if (angle < report.min_angle)
+				report.min_angle = angle;
+		}
+		if (mesh->material[f] == PLUME_MATERIAL_VANE) {
+			++vane_faces;
+			aligned += mesh->barb_edge[f] >= 0;
+		}
+	}
+	report.aligned_fraction = vane_faces > 0 ? (double)aligned / vane_faces : 1.0;
+	return report;
+}

@@ -1,0 +1,401 @@
+// Helical growth (Zhang & Kanai IV-A).
+//
+// Two emitters start at the boundaries of I_A and move towards I_P at V_e(s);
+// after moving a total distance D_i = (i + 1) d an emitter emits barb i there
+// (emission continues at the rate V_e(I_P) / d once the emitter is clamped at
+// I_P). A barb particle then moves back towards I_A at V_b(s) and every
+// Runge–Kutta step records a point of the barb; when it reaches I_A the barb
+// is mature. On the collar of perimeter L, a locus moves at
+//   ds/dt = sigma V(s) / L                                          (eq. 2)
+// integrated by the classic fourth-order Runge–Kutta method with the step h;
+// eq. 3-4 are its integral form, clamped at I_P. Crossings of a locus inside
+// a step (an emission distance, I_P, I_A) are found on the step's cubic
+// Hermite interpolant, so their times do not snap to the step grid.
+// The growth terminates at t_end, when N barbs of either vane are mature.
+//
+// A 1D autonomous flow keeps its particles in order, so barbs mature in
+// emission order, and every barb emitted at the clamped emitter (s0 = I_P)
+// follows the same pathline: it is integrated once and reused.
+#include <math.h>
+#include <string.h>
+
+#include "../core/alloc.h"
+#include "zhang_kanai_internal.h"
+
+/// Upper bounds that turn a runaway spec into an error instead of a hang.
+enum { MAX_STEPS_PER_PATH = 2000000, MAX_EMISSIONS_PER_VANE = 200000 };
+
+typedef struct zk_flow {
+	const zk_curve *speed;
+	double scale; ///< sigma / L: ds/dt = scale V(s)
+} zk_flow;
+
+static double flow_rate(const zk_flow *flow, double s) { return flow->scale * zk_curve_eval(flow->speed, s); }
+
+static double rk4_step(const zk_flow *flow, double s, double h)
+{
+	double k1 = flow_rate(flow, s);
+	double k2 = flow_rate(flow, s + 0.5 * h * k1);
+	double k3 = flow_rate(flow, s + 0.5 * h * k2);
+	double k4 = flow_rate(flow, s + h * k3);
+	return s + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+}
+
+/// Time in [0, h] at which the cubic Hermite interpolant of a step from s0
+/// to s1 reaches target, sigma (target - s0) > 0 and sigma (s1 - target) >= 0.
+static double crossing_time(const zk_flow *flow, double s0, double s1, double h, double target)
+{
+	double sigma = flow->scale > 0.0 ? 1.0 : -1.0;
+	double d0 = h * flow_rate(flow, s0), d1 = h * flow_rate(flow, s1);
+	double lo = 0.0, hi = 1.0;
+	// Bisection to the last bit: a handful of cubic evaluations, once per event.
+	for (int i = 0; i < 64; ++i) {
+		double u = 0.5 * (lo + hi);
+		if (u <= lo || u >= hi)
+			break;
+		double u2 = u * u, u3 = u2 * u;
+		double value = (2 * u3 - 3 * u2 + 1) * s0 + (u3 - 2 * u2 + u) * d0 + (-2 * u3 + 3 * u2) * s1 + (u3 - u2) * d1;
+		if (sigma * (value - target) >= 0.0)
+			hi = u;
+		else
+			lo = u;
+	}
+	return hi * h;
+}
+
+// ---------------------------------------------------------------------------
+// Barb pathlines
+
+typedef struct zk_vane {
+	zk_flow emitter, barb;
+	double s_anterior, s_posterior; ///< this side's boundaries of I_A and I_P
+	double length, h;
+	int f;
+	double ridge_width, variation;
+	plume_rng rng;
+} zk_vane;
+
+/// Where a pathline ends: K whole steps, then a last part of length tail.
+typedef struct path_end {
+	long steps;
+	double tail;
+	bool reached; ///< the root reached I_A (else it stopped at t_stop)
+	int count;    ///< points kept after downsampling
+} path_end;
+
+/// Integrates a barb from (s0, t0) towards I_A until it arrives or t_stop.
+/// Keeps every f-th step and the last point; writes them when locus is not NULL.
+static plume_status pathline(const zk_vane *vane, double s0, double t0, double t_stop, double *locus, double *time,
+                             path_end *end)
+{
+	const double h = vane->h, target = vane->s_anterior;
+	const double sigma = vane->barb.scale > 0.0 ? 1.0 : -1.0;
+	int count = 0;
+	if (locus != NULL) {
+		locus[0] = s0;
+		time[0] = t0;
+	}
+	count = 1;
+	double s = s0;
+	long kept = 0; // the last step whose point was kept
+	*end = (path_end){0};
+	if (!(t0 < t_stop)) {
+		end->count = 1;
+		return PLUME_OK;
+	}
+	for (long k = 0;; ++k) {
+		if (k >= MAX_STEPS_PER_PATH)
+			return PLUME_ERROR_NUMERIC;
+		double tk = t0 + (double)k * h;
+		double step = h;
+		bool last = false;
+		if (tk + h >= t_stop) {
+			step = t_stop - tk;
+			last = true;
+		}
+		double next = rk4_step(&vane->barb, s, step);
+		bool reached = sigma * (next - target) >= 0.0;
+		if (reached || last) {
+			double tail = reached ? crossing_time(&vane->barb, s, next, step, target) : step;
+			// An end a rounding error away from a kept step point replaces it
+			// instead of making a segment of zero length.
+			int at = (tail <= 1e-9 * h && kept == k && count > 1) ? count - 1 : count;
+			if (locus != NULL) {
+				locus[at] = reached ? target : next;
+				time[at] = reached ? tk + tail : t_stop;
+			}
+			*end = (path_end){.steps = k, .tail = tail, .reached = reached, .count = at + 1};
+			return PLUME_OK;
+		}
+		s = next;
+		if ((k + 1) % vane->f == 0) {
+			if (locus != NULL) {
+				locus[count] = s;
+				time[count] = t0 + (double)(k + 1) * h;
+			}
+			++count;
+			kept = k + 1;
+		}
+	}
+}
+
+// ---------------------------------------------------------------------------
+// Emitters
+
+typedef struct emitter {
+	double s, next;
+	long k;
+	bool have_next;
+	bool clamped;
+	double clamp_time;
+	double variation_sum; ///< sum of the r_i drawn so far
+	int emitted;
+} emitter;
+
+/// Advances the emitter's steps until its locus reaches target; returns the
+/// time, or INFINITY when the step grid passes t_limit first.
+static double advance_to(const zk_vane *vane, emitter *em, double target, double t_limit)
+{
+	const double sigma = vane->emitter.scale > 0.0 ? 1.0 : -1.0, h = vane->h;
+	for (;;) {
+		if ((double)em->k * h > t_limit || em->k >= (long)MAX_STEPS_PER_PATH * 8)
+			return INFINITY;
+		if (!em->have_next) {
+			em->next = rk4_step(&vane->emitter, em->s, h);
+			em->have_next = true;
+		}
+		if (sigma * (em->next - target) >= 0.0)
+			return (double)em->k * h + crossing_time(&vane->emitter, em->s, em->next, h, target);
+		em->s = em->next;
+		em->have_next = false;
+		em->k++;
+	}
+}
+
+/// Emission i: P_0.t and P_0.locus (eq. 3-4 with the thresholds D_i).
+static void emit(zk_vane *vane, emitter *em, double *t0, double *s0)
+{
+	double r = vane->variation > 0.0 ? plume_rng_range(&vane->rng, -vane->variation, vane->variation) : 0.0;
+	em->variation_sum += r;
+	double distance = vane->ridge_width * ((double)(em->emitted + 1) + em->variation_sum);
+	em->emitted++;
+	double sigma = vane->emitter.scale > 0.0 ? 1.0 : -1.0;
+	double target = vane->s_anterior + sigma * distance / vane->length;
+	if (!em->clamped && sigma * (target - vane->s_posterior) < 0.0) {
+		*t0 = advance_to(vane, em, target, INFINITY);
+		*s0 = target;
+		return;
+	}
+	if (!em->clamped) {
+		em->clamp_time = advance_to(vane, em, vane->s_posterior, INFINITY);
+		em->clamped = true;
+	}
+	// Clamped at I_P, the emitter keeps "moving" at V_e(I_P) for emission.
+	double clamp_distance = vane->length * fabs(vane->s_posterior - vane->s_anterior);
+	double extra = fmax(0.0, distance - clamp_distance);
+	*t0 = em->clamp_time + extra / zk_curve_eval(vane->emitter.speed, vane->s_posterior);
+	*s0 = vane->s_posterior;
+}
+
+// ---------------------------------------------------------------------------
+// The growth
+
+typedef struct emission {
+	double t0, s0, mature_time;
+	path_end end;
+} emission;
+
+typedef struct vane_run {
+	zk_vane vane;
+	emitter em;
+	emission *list;
+	int count, capacity;
+	bool have_cache; ///< the pathline from I_P, integrated once
+	path_end cache;
+} vane_run;
+
+static plume_status add_emission(vane_run *run)
+{
+	if (run->count >= MAX_EMISSIONS_PER_VANE)
+		return PLUME_ERROR_NUMERIC;
+	if (PLUME_GROW(run->list, run->capacity, run->count + 1) != 0)
+		return PLUME_ERROR_MEMORY;
+	emission *e = run->list + run->count;
+	emit(&run->vane, &run->em, &e->t0, &e->s0);
+	if (e->s0 == run->vane.s_posterior && run->have_cache) {
+		e->end = run->cache;
+	} else {
+		plume_status status = pathline(&run->vane, e->s0, e->t0, INFINITY, NULL, NULL, &e->end);
+		if (status != PLUME_OK)
+			return status;
+		if (e->s0 == run->vane.s_posterior) {
+			run->cache = e->end;
+			run->have_cache = true;
+		}
+	}
+	// The same expression pathline() uses for its last point's time.
+	e->mature_time = (e->t0 + (double)e->end.steps * run->vane.h) + e->end.tail;
+	run->count++;
+	return PLUME_OK;
+}
+
+static void vane_setup(vane_run *run, const plume_zk_def *def, const zk_collar *collar, const zk_curve *ve,
+                       const zk_curve *vb, plume_side side, plume_rng rng)
+{
+	// The left emitter moves from I_A.left down to I_P.left (eq. 3), the right
+	// one from I_A.right up to I_P.right (eq. 4); barbs elongate the other way.
+	double sigma = side == PLUME_SIDE_LEFT ? -1.0 : 1.0;
+	memset(run, 0, sizeof *run);
+	run->vane = (zk_vane){
+	    .emitter = {ve, sigma / collar->length},
+	    .barb = {vb, -sigma / collar->length},
+	    .s_anterior = def->anterior[side],
+	    .s_posterior = def->posterior[side],
+	    .length = collar->length,
+	    .h = def->step,
+	    .f = def->downsample,
+	    .ridge_width = def->ridge_width,
+	    .variation = def->ridge_width_variation,
+	    .rng = rng,
+	};
+	run->em.s = run->vane.s_anterior;
+	run->em.clamp_time = INFINITY;
+}
+
+void zk_growth_free(zk_growth *growth)
+{
+	plume_free(growth->barbs);
+	plume_free(growth->locus);
+	plume_free(growth->time);
+	memset(growth, 0, sizeof *growth);
+}
+
+static plume_status fail_runaway(plume_status status, plume_error *err)
+{
+	if (status == PLUME_ERROR_MEMORY)
+		return plume_error_set(err, status, "out of memory while growing the barbs");
+	return plume_error_set(err, status,
+	                       "the growth does not end: a pathline needs more than %d steps or a vane more than %d "
+	                       "emissions; raise $.step, $.barb_speed or $.ridge_width",
+	                       (int)MAX_STEPS_PER_PATH, (int)MAX_EMISSIONS_PER_VANE);
+}
+
+plume_status zk_grow(const plume_zk_def *def, const zk_collar *collar, uint64_t seed, zk_growth *growth,
+                     plume_error *err)
+{
+	memset(growth, 0, sizeof *growth);
+	zk_curve ve, vb;
+	zk_curve_init(&ve, &def->emitter_speed);
+	zk_curve_init(&vb, &def->barb_speed);
+	plume_rng rng = plume_rng_seed(seed);
+	vane_run runs[2];
+	vane_setup(runs + PLUME_SIDE_LEFT, def, collar, &ve, &vb, PLUME_SIDE_LEFT, plume_rng_split(&rng));
+	vane_setup(runs + PLUME_SIDE_RIGHT, def, collar, &ve, &vb, PLUME_SIDE_RIGHT, plume_rng_split(&rng));
+
+	plume_status status = PLUME_OK;
+	// Termination: barbs mature in emission order, so N mature barbs on a vane
+	// means its barb N - 1 is mature.
+	for (int side = 0; side < 2 && status == PLUME_OK; ++side)
+		while (runs[side].count < def->barb_count && status == PLUME_OK)
+			status = add_emission(runs + side);
+	if (status != PLUME_OK)
+		goto fail;
+	double t_end = fmin(runs[0].list[def->barb_count - 1].mature_time, runs[1].list[def->barb_count - 1].mature_time);
+	double t_curr = def->growth_stage >= 1.0 ? t_end : def->growth_stage * t_end;
+	bool final = def->growth_stage >= 1.0;
+	// Barbs emitted up to t_curr are there (developing ones are kept below the final stage).
+	for (int side = 0; side < 2 && status == PLUME_OK; ++side)
+		while (runs[side].list[runs[side].count - 1].t0 < t_curr && status == PLUME_OK)
+			status = add_emission(runs + side);
+	if (status != PLUME_OK)
+		goto fail;
+
+	growth->t_end = t_end;
+	growth->t_curr = t_curr;
+	int total_barbs = 0;
+	for (int side = 0; side < 2; ++side) {
+		vane_run *run = runs + side;
+		if (!run->em.clamped)
+			run->em.clamp_time = advance_to(&run->vane, &run->em, run->vane.s_posterior, t_end);
+		growth->clamp_time[side] = run->em.clamp_time <= t_end ? run->em.clamp_time : INFINITY;
+		total_barbs += run->count;
+	}
+	growth->barbs = plume_calloc((size_t)total_barbs, sizeof *growth->barbs);
+	if (growth->barbs == NULL) {
+		status = PLUME_ERROR_MEMORY;
+		goto fail;
+	}
+
+	// Pass 1: which barbs are kept and how many points each has.
+	long vertex_total = 0;
+	for (int side = 0; side < 2; ++side) {
+		vane_run *run = runs + side;
+		for (int i = 0; i < run->count; ++i) {
+			emission *e = run->list + i;
+			bool mature = e->mature_time <= t_curr;
+			if (!(e->t0 < t_curr))
+				continue; // emitted at t_curr or later: not a curve yet
+			if (!mature)
+				growth->developing_count++;
+			if (!mature && final)
+				continue; // IV-A Termination: developing barbs are discarded
+			path_end end = e->end;
+			if (!mature && (status = pathline(&run->vane, e->s0, e->t0, t_curr, NULL, NULL, &end)) != PLUME_OK)
+				goto fail;
+			zk_barb *barb = growth->barbs + growth->barb_count++;
+			*barb = (zk_barb){
+			    .side = (plume_side)side,
+			    .index = i,
+			    .emit_time = e->t0,
+			    .emit_locus = e->s0,
+			    .mature_time = e->mature_time,
+			    .mature = mature,
+			    .first = (int)vertex_total,
+			    .count = end.count,
+			};
+			growth->side_count[side]++;
+			vertex_total += end.count;
+		}
+	}
+	if (vertex_total > 200000000L) {
+		status = PLUME_ERROR_NUMERIC;
+		goto fail;
+	}
+	growth->vertex_count = (int)vertex_total;
+	growth->locus = plume_alloc((size_t)(vertex_total > 0 ? vertex_total : 1) * sizeof *growth->locus);
+	growth->time = plume_alloc((size_t)(vertex_total > 0 ? vertex_total : 1) * sizeof *growth->time);
+	if (growth->locus == NULL || growth->time == NULL) {
+		status = PLUME_ERROR_MEMORY;
+		goto fail;
+	}
+	// Pass 2: the points. Barbs from I_P share one pathline: copy its loci.
+	int cached[2] = {-1, -1};
+	for (int b = 0; b < growth->barb_count; ++b) {
+		zk_barb *barb = growth->barbs + b;
+		vane_run *run = runs + barb->side;
+		double *locus = growth->locus + barb->first, *time = growth->time + barb->first;
+		int source = cached[barb->side];
+		if (barb->mature && barb->emit_locus == run->vane.s_posterior && source >= 0) {
+			const zk_barb *from = growth->barbs + source;
+			memcpy(locus, growth->locus + from->first, (size_t)barb->count * sizeof *locus);
+			for (int j = 0; j + 1 < barb->count; ++j)
+				time[j] = barb->emit_time + (double)((long)j * run->vane.f) * run->vane.h;
+			time[barb->count - 1] = barb->mature_time;
+			continue;
+		}
+		path_end end;
+		double stop = barb->mature ? INFINITY : t_curr;
+		if ((status = pathline(&run->vane, barb->emit_locus, barb->emit_time, stop, locus, time, &end)) != PLUME_OK)
+			goto fail;
+		if (barb->mature && barb->emit_locus == run->vane.s_posterior)
+			cached[barb->side] = b;
+	}
+	for (int side = 0; side < 2; ++side)
+		plume_free(runs[side].list);
+	return PLUME_OK;
+fail:
+	for (int side = 0; side < 2; ++side)
+		plume_free(runs[side].list);
+	zk_growth_free(growth);
+	return fail_runaway(status, err);
+}

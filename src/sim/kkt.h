@@ -1,0 +1,68 @@
+// Private: the sparse symmetric systems of the Newton iteration, factored by CHOLMOD.
+//
+//   [ H   C^T ] [ dx     ]   [ -g ]
+//   [ C  -dI  ] [ lambda ] = [ -c ]
+//
+// H is the (projected) Hessian over 3 n position unknowns, C the Jacobian of the
+// barb-length constraints, d a tiny regularisation that makes the matrix
+// quasi-definite. A quasi-definite matrix has an LDL' factorisation for every
+// symmetric ordering (Vanderbei 1995), so CHOLMOD's simplicial LDL' factors it
+// without pivoting; its supernodal mode computes LL' only and cannot. Without
+// constraints the matrix is H alone and supernodal Cholesky is used.
+// The pattern is fixed per mesh: the symbolic analysis runs once.
+#ifndef PLUME_SIM_KKT_H
+#define PLUME_SIM_KKT_H
+
+#include <stdbool.h>
+
+#include <cholmod.h>
+
+#include "plume/core.h"
+
+typedef struct plume_kkt {
+	cholmod_common common;
+	bool started;
+	/// Upper triangle (stype 1), CSC; values rewritten every iteration.
+	cholmod_sparse *matrix;
+	cholmod_factor *factor;
+	cholmod_dense *solution;
+	cholmod_dense *rhs;
+	cholmod_dense *work_y;
+	cholmod_dense *work_e;
+	int dof_count;
+	int constraint_count;
+	/// Slot of the entry for each element block pair (upper part), -1 for the lower part.
+	int *face_slots;       ///< 81 per face
+	int *hinge_slots;      ///< 144 per hinge
+	int *vertex_slots;     ///< 9 per vertex
+	int *constraint_slots; ///< 7 per constraint: 6 Jacobian entries and the diagonal
+	int *pair_slots;       ///< 36 per constraint: the 6x6 position block of its two vertices
+	double *refine;        ///< scratch for iterative refinement (2 x size)
+} plume_kkt;
+
+/// Builds the pattern from faces (3 vertices), hinges (4 vertices), per-vertex blocks and
+/// constraints (2 vertices each), and runs the symbolic analysis.
+plume_status plume_kkt_init(plume_kkt *kkt, int vertex_count, int face_count, const int *faces, int hinge_count,
+                            const int *hinge_vertices, int hinge_stride, int constraint_count,
+                            const int *constraint_vertices, plume_error *err);
+void plume_kkt_free(plume_kkt *kkt);
+
+/// Values array of the matrix (zero it, then add into slots).
+double *plume_kkt_values(plume_kkt *kkt);
+void plume_kkt_zero(plume_kkt *kkt);
+
+/// Factors the current values. With allow_shift, a Hessian that is not positive
+/// definite on the free unknowns is shifted by growing multiples of its mean
+/// diagonal until it factors; *shift reports the shift used (0 normally). Without,
+/// such a matrix returns PLUME_ERROR_NUMERIC.
+plume_status plume_kkt_factor(plume_kkt *kkt, bool allow_shift, double *shift, plume_error *err);
+
+/// Solves with the last factorisation: rhs and solution have dof_count + constraint_count entries.
+/// With constraints, iterative refinement against the unregularised matrix (d = 0) removes
+/// the regularisation's error, so the linearised constraints hold to rounding.
+plume_status plume_kkt_solve(plume_kkt *kkt, const double *rhs, double *solution, plume_error *err);
+
+/// y += K x for the assembled (symmetric) matrix.
+void plume_kkt_multiply_add(const plume_kkt *kkt, const double *x, double *y);
+
+#endif

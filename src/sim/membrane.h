@@ -1,0 +1,70 @@
+// In-plane energies of one shell triangle: the St-Venant-Kirchhoff membrane with an
+// orthotropic (paper eq. 5, thesis A.2) or isotropic elasticity tensor, and the
+// Kikuuwe compression term (thesis eq. 6.6). Each returns the energy and, on request,
+// its exact gradient and Hessian with respect to the three vertex positions.
+#ifndef PLUME_SIM_MEMBRANE_H
+#define PLUME_SIM_MEMBRANE_H
+
+#include <stdbool.h>
+
+#include "plume/core.h"
+
+/// One triangle's reference data, computed once from the planar (material) mesh.
+typedef struct plume_membrane_element {
+	int vertices[3];
+	/// Inverse of Dm = [X1-X0 | X2-X0] (2x2, columns are reference edges), row-major.
+	double inverse_rest[4];
+	/// Reference area, m^2.
+	double area;
+	/// thickness * E in the reference (x, y) frame, Voigt (xx, yy, 2xy), row-major, Pa m.
+	double stiffness[9];
+	/// thickness * kappa, Pa m; 0 disables the Kikuuwe term.
+	double compression;
+} plume_membrane_element;
+
+/// E(theta): the orthotropic tensor diag(E_vv, E_ww, E_vw) of the barb frame expressed in
+/// the reference frame, the barb running along (cos theta, sin theta) in reference
+/// coordinates (thesis section 6.2: theta is the angle from the x axis to the barb).
+/// Voigt (xx, yy, 2xy) with sigma_vw = E_vw * 2 eps_vw (paper eq. 4, thesis eq. 4.1).
+void plume_orthotropic_tensor(double E_vv, double E_ww, double E_vw, double theta, double voigt[9]);
+
+/// Plane-stress isotropic St-Venant-Kirchhoff: E/(1-nu^2) [[1,nu,0],[nu,1,0],[0,0,(1-nu)/2]].
+void plume_isotropic_tensor(double E, double nu, double voigt[9]);
+
+/// Fills element from its reference triangle. kappa is the Kikuuwe coefficient, Pa.
+/// Returns false when the reference triangle is degenerate (or not finite).
+bool plume_membrane_element_init(plume_membrane_element *element, const int vertices[3], const plume_vec2 reference[3],
+                                 double thickness, const double voigt[9], double kappa);
+
+/// Energy A * (1/2) eps : E : eps (thickness folded into element->stiffness), eps the Green
+/// strain (F^T F - I)/2 with F = [x1-x0 | x2-x0] Dm^-1 (3x2) (paper eq. 5).
+/// gradient (9, vertex-major xyz) and hessian (9x9 row-major, symmetric, NOT projected)
+/// may be NULL; they are overwritten, not accumulated.
+double plume_membrane_energy(const plume_membrane_element *element, const plume_vec3 x[3], double gradient[9],
+                             double hessian[81]);
+
+/// Kikuuwe term A * thickness*kappa/12 * ((1-J)/6)^3 for J < 1, else 0 (thesis eq. 6.6), with
+/// J = deformed area / reference area = sqrt(det(F^T F)). gradient/hessian as above; at a
+/// triangle collapsed to zero area (J = 0) the derivatives do not exist and are returned as 0.
+double plume_compression_energy(const plume_membrane_element *element, const plume_vec3 x[3], double gradient[9],
+                                double hessian[81]);
+
+/// Green strain of a deformed triangle and its derivatives: the kinematics shared by every
+/// energy density psi(strain) of a triangle (library-internal).
+typedef struct plume_green_strain {
+	/// Voigt (eps_xx, eps_yy, 2 eps_xy) in the reference frame.
+	double strain[3];
+	/// d strain / d x: 3 x 9 row-major.
+	double jacobian[27];
+	/// Gradients of the three linear shape functions in the reference frame, (x, y) per vertex.
+	double shape[6];
+} plume_green_strain;
+
+void plume_green_strain_eval(const plume_membrane_element *element, const plume_vec3 x[3], plume_green_strain *out);
+
+/// Chain rule for W = area * psi(strain): gradient = area J^T dpsi and
+/// hessian = area (J^T d2psi J + sum_k dpsi_k d2strain_k/dx2). Either output may be NULL.
+void plume_green_strain_chain(const plume_green_strain *strain, double area, const double dpsi[3],
+                              const double d2psi[9], double gradient[9], double hessian[81]);
+
+#endif // PLUME_SIM_MEMBRANE_H

@@ -1,0 +1,173 @@
+// The potential Newton minimises, its gradient and its projected Hessian.
+//
+// Statics: Phi(x) = E_membrane + E_compression + E_bending - sum m_i g . x_i.
+// An implicit-Euler step of length h minimises the incremental potential
+//   Phi(x) + sum m_i |x_i - x_hat_i|^2 / (2 h^2) + h R((x - x_n) / h),
+// whose stationarity is M (v_{n+1} - v_n) / h = f(x_{n+1}) exactly (thesis B.2),
+// with R the Rayleigh dissipation of the linear drag, (1/2) c A_i (v_i . n_i)^2,
+// normals frozen at the start of the step.
+//
+// Elements are evaluated in parallel into per-element buffers and summed in a
+// fixed order, so results do not depend on the number of threads.
+#include <math.h>
+#include <string.h>
+
+#include "sim/dense.h"
+#include "sim/sim_internal.h"
+
+static void gather(const plume_vec3 *x, const int *vertices, int count, plume_vec3 *out)
+{
+	for (int i = 0; i < count; ++i)
+		out[i] = x[vertices[i]];
+}
+
+static void evaluate_faces(plume_sim *sim, const plume_vec3 *x, bool gradient, bool hessian, bool project)
+{
+	int count = sim->face_count;
+#pragma omp parallel for schedule(static) if (count >= 4096)
+	for (int f = 0; f < count; ++f) {
+		const plume_membrane_element *element = sim->membranes + f;
+		plume_vec3 local[3];
+		gather(x, element->vertices, 3, local);
+		double *g = gradient ? sim->face_gradient + 9 * f : NULL;
+		double *h = hessian ? sim->face_hessian + 81 * f : NULL;
+		double energy = plume_membrane_energy(element, local, g, h);
+		if (element->compression > 0) {
+			double gc[9], hc[81];
+			energy += plume_compression_energy(element, local, g ? gc : NULL, h ? hc : NULL);
+			for (int i = 0; g != NULL && i < 9; ++i)
+				g[i] += gc[i];
+			for (int i = 0; h != NULL && i < 81; ++i)
+				h[i] += hc[i];
+		}
+		if (h != NULL && project)
+			plume_project_psd_translation_free(h, 3);
+		sim->face_energy[f] = energy;
+	}
+}
+
+static void evaluate_hinges(plume_sim *sim, const plume_vec3 *x, bool gradient, bool hessian, bool project)
+{
+	int count = sim->hinge_count;
+#pragma omp parallel for schedule(static) if (count >= 4096)
+	for (int e = 0; e < count; ++e) {
+		const plume_hinge *hinge = sim->hinges + e;
+		plume_vec3 local[4];
+		gather(x, hinge->vertices, 4, local);
+		double *h = hessian ? sim->hinge_hessian + 144 * e : NULL;
+		sim->hinge_energy[e] = plume_hinge_energy(hinge, local, gradient ? sim->hinge_gradient + 12 * e : NULL, h);
+		if (h != NULL && project)
+			plume_project_psd_translation_free(h, 4);
+	}
+}
+
+/// Adds a symmetric element block into the matrix, skipping held unknowns.
+static void scatter_block(const plume_sim *sim, double *values, const int *vertices, int count, const int *slots,
+                          const double *block)
+{
+	int n = 3 * count;
+	for (int a = 0; a < n; ++a) {
+		if (sim->fixed[3 * vertices[a / 3] + a % 3])
+			continue;
+		for (int b = 0; b < n; ++b) {
+			int slot = slots[a * n + b];
+			if (slot >= 0 && !sim->fixed[3 * vertices[b / 3] + b % 3])
+				values[slot] += block[a * n + b];
+		}
+	}
+}
+
+static void scatter_gradient(double *gradient, const int *vertices, int count, const double *local)
+{
+	for (int a = 0; a < 3 * count; ++a)
+		gradient[3 * vertices[a / 3] + a % 3] += local[a];
+}
+
+double plume_sim_potential(plume_sim *sim, const sim_problem *problem, const plume_vec3 *x, double *gradient,
+                           bool hessian, bool project)
+{
+	int n = sim->vertex_count;
+	bool want_gradient = gradient != NULL;
+	evaluate_faces(sim, x, want_gradient, hessian, project);
+	if (sim->def.bending)
+		evaluate_hinges(sim, x, want_gradient, hessian, project);
+
+	double *values = hessian ? plume_kkt_values(&sim->kkt) : NULL;
+	if (hessian)
+		plume_kkt_zero(&sim->kkt);
+	if (want_gradient)
+		memset(gradient, 0, sizeof(double) * 3 * (size_t)n);
+
+	double energy = 0;
+	for (int f = 0; f < sim->face_count; ++f) {
+		energy += sim->face_energy[f];
+		const int *vertices = sim->membranes[f].vertices;
+		if (want_gradient)
+			scatter_gradient(gradient, vertices, 3, sim->face_gradient + 9 * f);
+		if (hessian)
+			scatter_block(sim, values, vertices, 3, sim->kkt.face_slots + 81 * f, sim->face_hessian + 81 * f);
+	}
+	for (int e = 0; sim->def.bending && e < sim->hinge_count; ++e) {
+		energy += sim->hinge_energy[e];
+		const int *vertices = sim->hinges[e].vertices;
+		if (want_gradient)
+			scatter_gradient(gradient, vertices, 4, sim->hinge_gradient + 12 * e);
+		if (hessian)
+			scatter_block(sim, values, vertices, 4, sim->kkt.hinge_slots + 144 * e, sim->hinge_hessian + 144 * e);
+	}
+
+	plume_vec3 g = sim->def.gravity;
+	double h2 = problem->dynamic ? problem->h * problem->h : 1;
+	for (int i = 0; i < n; ++i) {
+		double m = sim->mass[i];
+		plume_vec3 load = sim->load[i];
+		energy -= m * plume_v3_dot(g, x[i]) + plume_v3_dot(load, x[i]);
+		double local_gradient[3] = {-m * g.x - load.x, -m * g.y - load.y, -m * g.z - load.z};
+		double block[9] = {0};
+		if (problem->dynamic) {
+			plume_vec3 d = plume_v3_sub(x[i], problem->predicted[i]);
+			energy += 0.5 * m * plume_v3_dot(d, d) / h2;
+			local_gradient[0] += m * d.x / h2;
+			local_gradient[1] += m * d.y / h2;
+			local_gradient[2] += m * d.z / h2;
+			block[0] = block[4] = block[8] = m / h2;
+			double c = sim->def.drag * sim->vertex_area[i];
+			if (c > 0) {
+				plume_vec3 normal = problem->drag_normals[i];
+				double along = plume_v3_dot(plume_v3_sub(x[i], problem->previous[i]), normal);
+				// h R(v) with v . n = along / h: (1/2) c along^2 / h.
+				energy += 0.5 * c * along * along / problem->h;
+				double k = c / problem->h;
+				const double nv[3] = {normal.x, normal.y, normal.z};
+				for (int a = 0; a < 3; ++a) {
+					local_gradient[a] += k * along * nv[a];
+					for (int b = 0; b < 3; ++b)
+						block[3 * a + b] += k * nv[a] * nv[b];
+				}
+			}
+		}
+		if (want_gradient)
+			for (int a = 0; a < 3; ++a)
+				gradient[3 * i + a] += local_gradient[a];
+		if (hessian)
+			scatter_block(sim, values, &i, 1, sim->kkt.vertex_slots + 9 * i, block);
+	}
+
+	if (hessian)
+		for (int i = 0; i < 3 * n; ++i)
+			if (sim->fixed[i])
+				values[sim->kkt.vertex_slots[9 * (i / 3) + 4 * (i % 3)]] = 1;
+	return isfinite(energy) ? energy : NAN;
+}
+
+double plume_sim_max_barb_strain(const plume_sim *sim, const plume_vec3 *x)
+{
+	double worst = 0;
+	for (int e = 0; e < sim->barb_edge_count; ++e) {
+		double length = plume_v3_distance(x[sim->barb_edges[2 * e]], x[sim->barb_edges[2 * e + 1]]);
+		double strain = fabs(length - sim->barb_length[e]) / sim->barb_length[e];
+		if (strain > worst)
+			worst = strain;
+	}
+	return worst;
+}

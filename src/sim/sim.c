@@ -1,0 +1,698 @@
+// The simulation object: definitions, set-up from a mesh, handles, statics and
+// implicit-Euler steps with substep retries, and measurements.
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/alloc.h"
+#include "sim/sim_internal.h"
+
+plume_sim_def plume_sim_default_def(void)
+{
+	plume_sim_def def;
+	memset(&def, 0, sizeof def);
+	def.materials[PLUME_MATERIAL_VANE] = plume_material_vane();
+	def.materials[PLUME_MATERIAL_RACHIS] = plume_material_rachis();
+	def.material_count = 2;
+	def.gravity = plume_v3(0, -9.81, 0);
+	def.drag = 0;
+	def.time_step = 0.011;
+	def.bending = true;
+	def.planar = false;
+	def.solver.tolerance = 1e-7;
+	def.solver.max_iterations = 50;
+	def.solver.max_substep_halvings = 4;
+	return def;
+}
+
+static const char *material_path(int index, char *buffer, size_t size)
+{
+	if (index == PLUME_MATERIAL_VANE)
+		return "$.materials.vane";
+	if (index == PLUME_MATERIAL_RACHIS)
+		return "$.materials.rachis";
+	snprintf(buffer, size, "$.materials[%d]", index);
+	return buffer;
+}
+
+static plume_status check_material(const plume_material *material, const char *path, plume_error *err)
+{
+#define REQUIRE(condition, field, allowed)                                                                             \
+	if (!(condition))                                                                                                  \
+		return plume_error_set(err, PLUME_ERROR_SPEC, "%s.%s is %g, allowed " allowed, path, #field,                   \
+		                       (double)material->field);
+	REQUIRE(material->thickness > 0 && isfinite(material->thickness), thickness, "> 0");
+	REQUIRE(material->surface_density >= 0 && isfinite(material->surface_density), surface_density, ">= 0");
+	REQUIRE(material->bending_along >= 0 && isfinite(material->bending_along), bending_along, ">= 0");
+	REQUIRE(isfinite(material->bending_across), bending_across, "finite");
+	REQUIRE(material->compression_coefficient >= 0 && isfinite(material->compression_coefficient),
+	        compression_coefficient, ">= 0");
+	if (material->kind == PLUME_MATERIAL_ORTHOTROPIC) {
+		REQUIRE(material->bending_across >= 0, bending_across, ">= 0");
+		REQUIRE(material->E_ww > 0 && isfinite(material->E_ww), E_ww, "> 0");
+		REQUIRE(material->E_vw > 0 && isfinite(material->E_vw), E_vw, "> 0");
+		REQUIRE(material->barb_constraint || (material->E_vv > 0 && isfinite(material->E_vv)), E_vv,
+		        "> 0 (or barb_constraint true)");
+	} else if (material->kind == PLUME_MATERIAL_ISOTROPIC) {
+		REQUIRE(material->youngs_modulus > 0 && isfinite(material->youngs_modulus), youngs_modulus, "> 0");
+		REQUIRE(material->poisson_ratio >= 0 && material->poisson_ratio < 0.5, poisson_ratio, "[0, 0.5)");
+	} else {
+		return plume_error_set(err, PLUME_ERROR_SPEC, "%s.kind is %d, allowed orthotropic or isotropic", path,
+		                       (int)material->kind);
+	}
+#undef REQUIRE
+	return PLUME_OK;
+}
+
+plume_status plume_sim_def_validate(const plume_sim_def *def, int mesh_material_count, plume_error *err)
+{
+	if (def->material_count < 1 || def->material_count > PLUME_MAX_MATERIALS)
+		return plume_error_set(err, PLUME_ERROR_SPEC, "$.materials: %d materials, allowed 1 to %d", def->material_count,
+		                       PLUME_MAX_MATERIALS);
+	if (mesh_material_count > def->material_count)
+		return plume_error_set(err, PLUME_ERROR_SPEC, "$.materials: the mesh uses %d materials but only %d are defined",
+		                       mesh_material_count, def->material_count);
+	char buffer[32];
+	for (int i = 0; i < def->material_count; ++i) {
+		plume_status status = check_material(def->materials + i, material_path(i, buffer, sizeof buffer), err);
+		if (status != PLUME_OK)
+			return status;
+	}
+	if (!(def->time_step > 0) || !isfinite(def->time_step))
+		return plume_error_set(err, PLUME_ERROR_SPEC, "$.time_step is %g, allowed > 0", def->time_step);
+	if (!(def->drag >= 0) || !isfinite(def->drag))
+		return plume_error_set(err, PLUME_ERROR_SPEC, "$.drag is %g, allowed >= 0", def->drag);
+	if (!isfinite(def->gravity.x) || !isfinite(def->gravity.y) || !isfinite(def->gravity.z))
+		return plume_error_set(err, PLUME_ERROR_SPEC, "$.gravity must be finite");
+	if (!(def->solver.tolerance > 0) || !(def->solver.tolerance < 1))
+		return plume_error_set(err, PLUME_ERROR_SPEC, "$.solver.tolerance is %g, allowed (0, 1)",
+		                       def->solver.tolerance);
+	if (def->solver.max_iterations < 1 || def->solver.max_iterations > 100000)
+		return plume_error_set(err, PLUME_ERROR_SPEC, "$.solver.max_iterations is %d, allowed [1, 100000]",
+		                       def->solver.max_iterations);
+	if (def->solver.max_substep_halvings < 0 || def->solver.max_substep_halvings > 12)
+		return plume_error_set(err, PLUME_ERROR_SPEC, "$.solver.max_substep_halvings is %d, allowed [0, 12]",
+		                       def->solver.max_substep_halvings);
+	return PLUME_OK;
+}
+
+// ---------------------------------------------------------------------------
+// Set-up
+
+typedef struct half_edge {
+	int low, high;
+	int face;
+	int local; ///< edge k of the face: (faces[3f+k], faces[3f+(k+1)%3])
+} half_edge;
+
+static int compare_half_edges(const void *a, const void *b)
+{
+	const half_edge *p = a, *q = b;
+	if (p->low != q->low)
+		return p->low < q->low ? -1 : 1;
+	if (p->high != q->high)
+		return p->high < q->high ? -1 : 1;
+	return (p->face > q->face) - (p->face < q->face);
+}
+
+static int compare_pairs(const void *a, const void *b)
+{
+	const int *p = a, *q = b;
+	if (p[0] != q[0])
+		return p[0] < q[0] ? -1 : 1;
+	return (p[1] > q[1]) - (p[1] < q[1]);
+}
+
+/// Sorted unique edges (low, high) of the faces' barb-edge marks that pass the filter.
+static int collect_barb_edges(const plume_mesh *mesh, const plume_sim_def *def, bool constrained_only, int **out)
+{
+	int *pairs = plume_alloc(sizeof(int) * 2 * (size_t)(mesh->face_count > 0 ? mesh->face_count : 1));
+	if (pairs == NULL)
+		return -1;
+	int count = 0;
+	for (int f = 0; f < mesh->face_count; ++f) {
+		int k = mesh->barb_edge[f];
+		if (k < 0)
+			continue;
+		const plume_material *material = def->materials + mesh->material[f];
+		if (constrained_only && !(material->kind == PLUME_MATERIAL_ORTHOTROPIC && material->barb_constraint))
+			continue;
+		int a = mesh->faces[3 * f + k], b = mesh->faces[3 * f + (k + 1) % 3];
+		pairs[2 * count] = a < b ? a : b;
+		pairs[2 * count + 1] = a < b ? b : a;
+		++count;
+	}
+	qsort(pairs, (size_t)count, 2 * sizeof(int), compare_pairs);
+	int unique = 0;
+	for (int e = 0; e < count; ++e)
+		if (unique == 0 || compare_pairs(pairs + 2 * (unique - 1), pairs + 2 * e) != 0) {
+			pairs[2 * unique] = pairs[2 * e];
+			pairs[2 * unique + 1] = pairs[2 * e + 1];
+			++unique;
+		}
+	*out = pairs;
+	return unique;
+}
+
+static void face_voigt(const plume_material *material, double barb_angle, double voigt[9])
+{
+	if (material->kind == PLUME_MATERIAL_ISOTROPIC) {
+		plume_isotropic_tensor(material->youngs_modulus, material->poisson_ratio, voigt);
+		return;
+	}
+	// With the constraint, E_vv is no stiffness any more (paper footnote 3: set to E_ww).
+	double along = material->barb_constraint ? material->E_ww : material->E_vv;
+	plume_orthotropic_tensor(along, material->E_ww, material->E_vw, barb_angle, voigt);
+}
+
+static void bending_moduli(const plume_material *material, double *along, double *across)
+{
+	*along = material->bending_along;
+	*across = material->bending_across >= 0 ? material->bending_across : material->bending_along;
+}
+
+static double harmonic_mean(double a, double b) { return a + b > 0 ? 2 * a * b / (a + b) : 0; }
+
+static plume_status build_hinges(plume_sim *sim, const plume_mesh *mesh, plume_error *err)
+{
+	int count = 3 * mesh->face_count;
+	half_edge *edges = plume_alloc(sizeof(half_edge) * (size_t)(count > 0 ? count : 1));
+	sim->hinges = plume_alloc(sizeof(plume_hinge) * (size_t)(count / 2 + 1));
+	if (edges == NULL || sim->hinges == NULL) {
+		plume_free(edges);
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory building hinges");
+	}
+	for (int f = 0; f < mesh->face_count; ++f)
+		for (int k = 0; k < 3; ++k) {
+			int a = mesh->faces[3 * f + k], b = mesh->faces[3 * f + (k + 1) % 3];
+			edges[3 * f + k] = (half_edge){a < b ? a : b, a < b ? b : a, f, k};
+		}
+	qsort(edges, (size_t)count, sizeof *edges, compare_half_edges);
+	for (int e = 0; e + 1 < count; ++e) {
+		const half_edge *p = edges + e, *q = edges + e + 1;
+		if (p->low != q->low || p->high != q->high)
+			continue;
+		// Skip non-manifold fans: only plain two-face edges bend.
+		if ((e + 2 < count && edges[e + 2].low == p->low && edges[e + 2].high == p->high) ||
+		    (e > 0 && edges[e - 1].low == p->low && edges[e - 1].high == p->high))
+			continue;
+		const int *fa = mesh->faces + 3 * p->face, *fb = mesh->faces + 3 * q->face;
+		int vertices[4] = {fa[p->local], fa[(p->local + 1) % 3], fa[(p->local + 2) % 3], fb[(q->local + 2) % 3]};
+		plume_vec2 reference[4];
+		plume_vec3 rest[4];
+		for (int i = 0; i < 4; ++i) {
+			reference[i] = mesh->reference[vertices[i]];
+			rest[i] = mesh->rest[vertices[i]];
+		}
+		double along_a, across_a, along_b, across_b;
+		bending_moduli(sim->def.materials + mesh->material[p->face], &along_a, &across_a);
+		bending_moduli(sim->def.materials + mesh->material[q->face], &along_b, &across_b);
+		// A hinge between two materials (the rachis border) bends where the softer side
+		// bends: the harmonic mean, about twice the softer modulus when they differ a lot.
+		if (plume_hinge_init(sim->hinges + sim->hinge_count, vertices, reference, rest, mesh->barb_angle[p->face],
+		                     mesh->barb_angle[q->face], harmonic_mean(along_a, along_b),
+		                     harmonic_mean(across_a, across_b)))
+			++sim->hinge_count;
+		++e;
+	}
+	plume_free(edges);
+	return PLUME_OK;
+}
+
+static plume_status build_elements(plume_sim *sim, const plume_mesh *mesh, plume_error *err)
+{
+	int faces = mesh->face_count;
+	sim->membranes = plume_alloc(sizeof(plume_membrane_element) * (size_t)faces);
+	if (sim->membranes == NULL)
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory building elements");
+	for (int f = 0; f < faces; ++f) {
+		const plume_material *material = sim->def.materials + mesh->material[f];
+		const int *vertices = mesh->faces + 3 * f;
+		plume_vec2 reference[3] = {mesh->reference[vertices[0]], mesh->reference[vertices[1]],
+		                           mesh->reference[vertices[2]]};
+		double voigt[9];
+		face_voigt(material, mesh->barb_angle[f], voigt);
+		if (!plume_membrane_element_init(sim->membranes + f, vertices, reference, material->thickness, voigt,
+		                                 material->compression_coefficient))
+			return plume_error_set(err, PLUME_ERROR_NUMERIC, "mesh face %d is degenerate in the reference plane", f);
+		double share = material->surface_density * sim->membranes[f].area / 3;
+		for (int i = 0; i < 3; ++i) {
+			sim->mass[vertices[i]] += share;
+			sim->vertex_area[vertices[i]] += sim->membranes[f].area / 3;
+		}
+	}
+	return build_hinges(sim, mesh, err);
+}
+
+static plume_status copy_groups(plume_sim *sim, const plume_mesh *mesh, plume_error *err)
+{
+	sim->groups = plume_calloc((size_t)(mesh->group_count > 0 ? mesh->group_count : 1), sizeof(plume_vertex_group));
+	if (sim->groups == NULL)
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory copying vertex groups");
+	for (int g = 0; g < mesh->group_count; ++g) {
+		plume_vertex_group *copy = sim->groups + g;
+		*copy = mesh->groups[g];
+		copy->vertices = plume_alloc(sizeof(int) * (size_t)(copy->count > 0 ? copy->count : 1));
+		if (copy->vertices == NULL)
+			return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory copying vertex groups");
+		memcpy(copy->vertices, mesh->groups[g].vertices, sizeof(int) * (size_t)copy->count);
+		sim->group_count = g + 1;
+	}
+	return PLUME_OK;
+}
+
+static bool allocate_state(plume_sim *sim)
+{
+	size_t n = (size_t)sim->vertex_count, f = (size_t)(sim->face_count > 0 ? sim->face_count : 1);
+	size_t unknowns = 3 * n + (size_t)sim->constraint_count;
+	sim->x = plume_alloc(sizeof(plume_vec3) * n);
+	sim->v = plume_calloc(n, sizeof(plume_vec3));
+	sim->rest = plume_alloc(sizeof(plume_vec3) * n);
+	sim->mass = plume_calloc(n, sizeof(double));
+	sim->load = plume_calloc(n, sizeof(plume_vec3));
+	sim->vertex_area = plume_calloc(n, sizeof(double));
+	sim->fixed = plume_calloc(3 * n, 1);
+	sim->face_energy = plume_alloc(sizeof(double) * f);
+	sim->face_gradient = plume_alloc(sizeof(double) * 9 * f);
+	sim->face_hessian = plume_alloc(sizeof(double) * 81 * f);
+	sim->gradient = plume_alloc(sizeof(double) * unknowns);
+	sim->residual = plume_alloc(sizeof(double) * unknowns);
+	sim->rhs = plume_alloc(sizeof(double) * unknowns);
+	sim->step = plume_alloc(sizeof(double) * unknowns);
+	sim->trial = plume_alloc(sizeof(plume_vec3) * n);
+	sim->scratch = plume_alloc(sizeof(plume_vec3) * n);
+	sim->saved_x = plume_alloc(sizeof(plume_vec3) * n);
+	sim->saved_v = plume_alloc(sizeof(plume_vec3) * n);
+	sim->previous = plume_alloc(sizeof(plume_vec3) * n);
+	sim->predicted = plume_alloc(sizeof(plume_vec3) * n);
+	sim->normals = plume_alloc(sizeof(plume_vec3) * n);
+	sim->lambda = plume_calloc((size_t)(sim->constraint_count > 0 ? sim->constraint_count : 1), sizeof(double));
+	return sim->x && sim->v && sim->rest && sim->mass && sim->load && sim->vertex_area && sim->fixed &&
+	       sim->face_energy && sim->face_gradient && sim->face_hessian && sim->gradient && sim->residual && sim->rhs &&
+	       sim->step && sim->trial && sim->scratch && sim->saved_x && sim->saved_v && sim->previous && sim->predicted &&
+	       sim->normals && sim->lambda;
+}
+
+static bool allocate_hinge_buffers(plume_sim *sim)
+{
+	size_t h = (size_t)(sim->hinge_count > 0 ? sim->hinge_count : 1);
+	sim->hinge_energy = plume_alloc(sizeof(double) * h);
+	sim->hinge_gradient = plume_alloc(sizeof(double) * 12 * h);
+	sim->hinge_hessian = plume_alloc(sizeof(double) * 144 * h);
+	return sim->hinge_energy && sim->hinge_gradient && sim->hinge_hessian;
+}
+
+static double bounding_diagonal(const plume_mesh *mesh)
+{
+	plume_vec2 lo = mesh->reference[0], hi = mesh->reference[0];
+	for (int i = 1; i < mesh->vertex_count; ++i) {
+		plume_vec2 p = mesh->reference[i];
+		lo.x = fmin(lo.x, p.x), lo.y = fmin(lo.y, p.y);
+		hi.x = fmax(hi.x, p.x), hi.y = fmax(hi.y, p.y);
+	}
+	return hypot(hi.x - lo.x, hi.y - lo.y);
+}
+
+plume_status plume_sim_create(const plume_mesh *mesh, const plume_sim_def *def, plume_sim **out, plume_error *err)
+{
+	*out = NULL;
+	if (mesh->vertex_count < 3 || mesh->face_count < 1)
+		return plume_error_set(err, PLUME_ERROR_SPEC, "the mesh has no faces to simulate");
+	int material_count = 0;
+	for (int f = 0; f < mesh->face_count; ++f)
+		material_count = mesh->material[f] + 1 > material_count ? mesh->material[f] + 1 : material_count;
+	plume_status status = plume_sim_def_validate(def, material_count, err);
+	if (status != PLUME_OK)
+		return status;
+
+	plume_sim *sim = plume_calloc(1, sizeof *sim);
+	if (sim == NULL)
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory creating the simulation");
+	sim->def = *def;
+	sim->vertex_count = mesh->vertex_count;
+	sim->face_count = mesh->face_count;
+	sim->length_scale = bounding_diagonal(mesh);
+	sim->constraint_count = collect_barb_edges(mesh, def, true, &sim->constraint_vertices);
+	sim->barb_edge_count = collect_barb_edges(mesh, def, false, &sim->barb_edges);
+	if (sim->constraint_count < 0 || sim->barb_edge_count < 0 || !allocate_state(sim)) {
+		plume_sim_destroy(sim);
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory creating the simulation");
+	}
+	sim->constraint_length = plume_alloc(sizeof(double) * (size_t)(sim->constraint_count + 1));
+	sim->barb_length = plume_alloc(sizeof(double) * (size_t)(sim->barb_edge_count + 1));
+	sim->faces = plume_alloc(sizeof(int) * 3 * (size_t)mesh->face_count);
+	sim->face_material = plume_alloc((size_t)mesh->face_count);
+	if (!sim->constraint_length || !sim->barb_length || !sim->faces || !sim->face_material) {
+		plume_sim_destroy(sim);
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory creating the simulation");
+	}
+	memcpy(sim->faces, mesh->faces, sizeof(int) * 3 * (size_t)mesh->face_count);
+	memcpy(sim->face_material, mesh->material, (size_t)mesh->face_count);
+	for (int i = 0; i < mesh->vertex_count; ++i)
+		sim->x[i] = sim->rest[i] = mesh->rest[i];
+	// Barb lengths are material lengths: measured in the reference plane.
+	for (int k = 0; k < sim->constraint_count; ++k) {
+		plume_vec2 a = mesh->reference[sim->constraint_vertices[2 * k]],
+		           b = mesh->reference[sim->constraint_vertices[2 * k + 1]];
+		sim->constraint_length[k] = hypot(b.x - a.x, b.y - a.y);
+	}
+	for (int k = 0; k < sim->barb_edge_count; ++k) {
+		plume_vec2 a = mesh->reference[sim->barb_edges[2 * k]], b = mesh->reference[sim->barb_edges[2 * k + 1]];
+		sim->barb_length[k] = hypot(b.x - a.x, b.y - a.y);
+	}
+	if (def->planar)
+		for (int i = 0; i < mesh->vertex_count; ++i)
+			sim->fixed[3 * i + 2] = 1;
+
+	status = build_elements(sim, mesh, err);
+	if (status == PLUME_OK && !allocate_hinge_buffers(sim))
+		status = plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory creating the simulation");
+	if (status == PLUME_OK)
+		status = copy_groups(sim, mesh, err);
+	if (status == PLUME_OK)
+		status = plume_kkt_init(&sim->kkt, sim->vertex_count, sim->face_count, sim->faces,
+		                        def->bending ? sim->hinge_count : 0, sim->hinges[0].vertices, sizeof(plume_hinge),
+		                        sim->constraint_count, sim->constraint_vertices, err);
+	if (status != PLUME_OK) {
+		plume_sim_destroy(sim);
+		return status;
+	}
+	*out = sim;
+	return PLUME_OK;
+}
+
+void plume_sim_destroy(plume_sim *sim)
+{
+	if (sim == NULL)
+		return;
+	plume_kkt_free(&sim->kkt);
+	void *arrays[] = {sim->x,
+	                  sim->v,
+	                  sim->rest,
+	                  sim->mass,
+	                  sim->load,
+	                  sim->vertex_area,
+	                  sim->faces,
+	                  sim->face_material,
+	                  sim->membranes,
+	                  sim->hinges,
+	                  sim->constraint_vertices,
+	                  sim->constraint_length,
+	                  sim->lambda,
+	                  sim->barb_edges,
+	                  sim->barb_length,
+	                  sim->fixed,
+	                  sim->face_energy,
+	                  sim->face_gradient,
+	                  sim->face_hessian,
+	                  sim->hinge_energy,
+	                  sim->hinge_gradient,
+	                  sim->hinge_hessian,
+	                  sim->gradient,
+	                  sim->residual,
+	                  sim->rhs,
+	                  sim->step,
+	                  sim->trial,
+	                  sim->scratch,
+	                  sim->saved_x,
+	                  sim->saved_v,
+	                  sim->previous,
+	                  sim->predicted,
+	                  sim->normals};
+	for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i)
+		plume_free(arrays[i]);
+	for (int h = 0; h < sim->handle_count; ++h) {
+		plume_free(sim->handles[h].vertices);
+		plume_free(sim->handles[h].anchor);
+		plume_free(sim->handles[h].start);
+		plume_free(sim->handles[h].end);
+	}
+	plume_free(sim->handles);
+	for (int g = 0; g < sim->group_count; ++g)
+		plume_free(sim->groups[g].vertices);
+	plume_free(sim->groups);
+	plume_free(sim);
+}
+
+// ---------------------------------------------------------------------------
+// Handles
+
+static const plume_vertex_group *find_group(const plume_sim *sim, const char *name)
+{
+	for (int g = 0; g < sim->group_count; ++g)
+		if (strcmp(sim->groups[g].name, name) == 0)
+			return sim->groups + g;
+	return NULL;
+}
+
+int plume_sim_add_handle(plume_sim *sim, const char *group_name, plume_error *err)
+{
+	const plume_vertex_group *group = find_group(sim, group_name);
+	if (group == NULL) {
+		char known[512] = "";
+		for (int g = 0; g < sim->group_count; ++g) {
+			size_t used = strlen(known);
+			snprintf(known + used, sizeof known - used, "%s%s", g > 0 ? ", " : "", sim->groups[g].name);
+		}
+		plume_error_set(err, PLUME_ERROR_SPEC, "unknown vertex group \"%s\" (the mesh has: %s)", group_name, known);
+		return -1;
+	}
+	if (group->count == 0) {
+		plume_error_set(err, PLUME_ERROR_SPEC, "vertex group \"%s\" is empty", group_name);
+		return -1;
+	}
+	if (PLUME_GROW(sim->handles, sim->handle_capacity, sim->handle_count + 1) != 0) {
+		plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory adding a handle");
+		return -1;
+	}
+	sim_handle *handle = sim->handles + sim->handle_count;
+	size_t n = (size_t)group->count;
+	handle->count = group->count;
+	handle->vertices = plume_alloc(sizeof(int) * n);
+	handle->anchor = plume_alloc(sizeof(plume_vec3) * n);
+	handle->start = plume_alloc(sizeof(plume_vec3) * n);
+	handle->end = plume_alloc(sizeof(plume_vec3) * n);
+	if (!handle->vertices || !handle->anchor || !handle->start || !handle->end) {
+		plume_free(handle->vertices);
+		plume_free(handle->anchor);
+		plume_free(handle->start);
+		plume_free(handle->end);
+		plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory adding a handle");
+		return -1;
+	}
+	for (int i = 0; i < group->count; ++i) {
+		int v = group->vertices[i];
+		handle->vertices[i] = v;
+		handle->anchor[i] = handle->start[i] = handle->end[i] = sim->x[v];
+		sim->fixed[3 * v] = sim->fixed[3 * v + 1] = sim->fixed[3 * v + 2] = 1;
+		sim->v[v] = plume_v3(0, 0, 0);
+	}
+	return sim->handle_count++;
+}
+
+plume_status plume_sim_set_group_load(plume_sim *sim, const char *group_name, plume_vec3 force, plume_error *err)
+{
+	const plume_vertex_group *group = find_group(sim, group_name);
+	if (group == NULL || group->count == 0)
+		return plume_error_set(err, PLUME_ERROR_SPEC, "no vertices in group \"%s\" to load", group_name);
+	plume_vec3 share = plume_v3_scale(force, 1.0 / group->count);
+	for (int i = 0; i < group->count; ++i)
+		sim->load[group->vertices[i]] = share;
+	return PLUME_OK;
+}
+
+void plume_sim_set_handle(plume_sim *sim, int index, plume_vec3 translation, plume_mat3 rotation, plume_vec3 pivot)
+{
+	sim_handle *handle = sim->handles + index;
+	for (int i = 0; i < handle->count; ++i) {
+		plume_vec3 arm = plume_m3_apply(rotation, plume_v3_sub(handle->anchor[i], pivot));
+		handle->end[i] = plume_v3_add(plume_v3_add(pivot, arm), translation);
+	}
+}
+
+void plume_sim_place_handles(plume_sim *sim, double s)
+{
+	for (int h = 0; h < sim->handle_count; ++h) {
+		const sim_handle *handle = sim->handles + h;
+		for (int i = 0; i < handle->count; ++i)
+			sim->x[handle->vertices[i]] = s == 1 ? handle->end[i] : plume_v3_lerp(handle->start[i], handle->end[i], s);
+	}
+}
+
+static void finish_handles(plume_sim *sim)
+{
+	for (int h = 0; h < sim->handle_count; ++h)
+		memcpy(sim->handles[h].start, sim->handles[h].end, sizeof(plume_vec3) * (size_t)sim->handles[h].count);
+}
+
+// ---------------------------------------------------------------------------
+// Solves
+
+static void add_report(plume_solve_report *total, const plume_solve_report *part)
+{
+	total->newton_iterations += part->newton_iterations;
+	total->seconds_assembly += part->seconds_assembly;
+	total->seconds_factor += part->seconds_factor;
+	total->seconds_solve += part->seconds_solve;
+	total->gradient_norm = part->gradient_norm;
+	total->energy = part->energy;
+	total->converged = part->converged;
+}
+
+plume_status plume_sim_solve_static(plume_sim *sim, plume_solve_report *report, plume_error *err)
+{
+	plume_solve_report total = {0};
+	static const sim_problem statics = {false, 0, NULL, NULL, NULL};
+	size_t bytes = sizeof(plume_vec3) * (size_t)sim->vertex_count;
+	memcpy(sim->saved_x, sim->x, bytes);
+	plume_status status = PLUME_ERROR_NUMERIC;
+	// Load stepping: the handles' motion split into 1, 2, 4 ... increments.
+	for (int halvings = 0; halvings <= sim->def.solver.max_substep_halvings; ++halvings) {
+		int substeps = 1 << halvings;
+		if (halvings > 0)
+			memcpy(sim->x, sim->saved_x, bytes);
+		total.substeps = substeps;
+		for (int s = 1; s <= substeps; ++s) {
+			plume_solve_report part = {0};
+			plume_sim_place_handles(sim, (double)s / substeps);
+			status = plume_sim_newton(sim, &statics, &part, err);
+			add_report(&total, &part);
+			if (status != PLUME_OK)
+				break;
+		}
+		if (status == PLUME_OK)
+			break;
+	}
+	total.max_barb_strain = plume_sim_max_barb_strain(sim, sim->x);
+	if (status == PLUME_OK)
+		finish_handles(sim);
+	if (report != NULL)
+		*report = total;
+	return status;
+}
+
+static void vertex_normals(const plume_sim *sim, const plume_vec3 *x, plume_vec3 *normals)
+{
+	memset(normals, 0, sizeof(plume_vec3) * (size_t)sim->vertex_count);
+	for (int f = 0; f < sim->face_count; ++f) {
+		const int *v = sim->faces + 3 * f;
+		plume_vec3 n = plume_v3_cross(plume_v3_sub(x[v[1]], x[v[0]]), plume_v3_sub(x[v[2]], x[v[0]]));
+		for (int i = 0; i < 3; ++i)
+			normals[v[i]] = plume_v3_add(normals[v[i]], n);
+	}
+	for (int i = 0; i < sim->vertex_count; ++i)
+		normals[i] = plume_v3_normalize(normals[i]);
+}
+
+plume_status plume_sim_step(plume_sim *sim, plume_solve_report *report, plume_error *err)
+{
+	plume_solve_report total = {0};
+	size_t bytes = sizeof(plume_vec3) * (size_t)sim->vertex_count;
+	memcpy(sim->saved_x, sim->x, bytes);
+	memcpy(sim->saved_v, sim->v, bytes);
+	plume_status status = PLUME_ERROR_NUMERIC;
+	plume_error last = {0};
+	for (int halvings = 0; halvings <= sim->def.solver.max_substep_halvings; ++halvings) {
+		int substeps = 1 << halvings;
+		double h = sim->def.time_step / substeps;
+		memcpy(sim->x, sim->saved_x, bytes);
+		memcpy(sim->v, sim->saved_v, bytes);
+		total.substeps = substeps;
+		for (int s = 1; s <= substeps; ++s) {
+			memcpy(sim->previous, sim->x, bytes);
+			for (int i = 0; i < sim->vertex_count; ++i)
+				sim->predicted[i] = plume_v3_mad(sim->x[i], h, sim->v[i]);
+			if (sim->def.drag > 0)
+				vertex_normals(sim, sim->x, sim->normals);
+			// Free vertices start from the prediction, handle vertices at their targets.
+			memcpy(sim->x, sim->predicted, bytes);
+			plume_sim_place_handles(sim, (double)s / substeps);
+			sim_problem problem = {true, h, sim->predicted, sim->previous, sim->normals};
+			plume_solve_report part = {0};
+			status = plume_sim_newton(sim, &problem, &part, &last);
+			add_report(&total, &part);
+			if (status != PLUME_OK)
+				break;
+			for (int i = 0; i < sim->vertex_count; ++i)
+				sim->v[i] = plume_v3_scale(plume_v3_sub(sim->x[i], sim->previous[i]), 1 / h);
+		}
+		if (status == PLUME_OK)
+			break;
+	}
+	if (status != PLUME_OK) {
+		memcpy(sim->x, sim->saved_x, bytes);
+		memcpy(sim->v, sim->saved_v, bytes);
+		if (report != NULL)
+			*report = total;
+		return plume_error_set(err, status, "step at t = %.6g s failed with %d substeps: %s", sim->time, total.substeps,
+		                       last.message);
+	}
+	sim->time += sim->def.time_step;
+	finish_handles(sim);
+	total.max_barb_strain = plume_sim_max_barb_strain(sim, sim->x);
+	if (report != NULL)
+		*report = total;
+	return PLUME_OK;
+}
+
+// ---------------------------------------------------------------------------
+// Measurements
+
+int plume_sim_vertex_count(const plume_sim *sim) { return sim->vertex_count; }
+int plume_sim_constraint_count(const plume_sim *sim) { return sim->constraint_count; }
+const plume_vec3 *plume_sim_positions(const plume_sim *sim) { return sim->x; }
+const plume_vec3 *plume_sim_velocities(const plume_sim *sim) { return sim->v; }
+double plume_sim_time(const plume_sim *sim) { return sim->time; }
+
+bool plume_sim_group_reaction(plume_sim *sim, const char *group_name, plume_vec3 *force)
+{
+	const plume_vertex_group *group = find_group(sim, group_name);
+	if (group == NULL)
+		return false;
+	static const sim_problem statics = {false, 0, NULL, NULL, NULL};
+	double *g = sim->gradient;
+	plume_sim_potential(sim, &statics, sim->x, g, false, false);
+	for (int k = 0; k < sim->constraint_count; ++k) {
+		plume_vec3 d =
+		    plume_v3_sub(sim->x[sim->constraint_vertices[2 * k + 1]], sim->x[sim->constraint_vertices[2 * k]]);
+		plume_vec3 t = plume_v3_normalize(d);
+		const int *v = sim->constraint_vertices + 2 * k;
+		g[3 * v[0]] -= sim->lambda[k] * t.x, g[3 * v[0] + 1] -= sim->lambda[k] * t.y,
+		    g[3 * v[0] + 2] -= sim->lambda[k] * t.z;
+		g[3 * v[1]] += sim->lambda[k] * t.x, g[3 * v[1] + 1] += sim->lambda[k] * t.y,
+		    g[3 * v[1] + 2] += sim->lambda[k] * t.z;
+	}
+	plume_vec3 sum = {0, 0, 0};
+	for (int i = 0; i < group->count; ++i) {
+		int v = group->vertices[i];
+		sum = plume_v3_add(sum, plume_v3(g[3 * v], g[3 * v + 1], g[3 * v + 2]));
+	}
+	*force = sum;
+	return true;
+}
+
+plume_sim_energies plume_sim_energy(plume_sim *sim)
+{
+	plume_sim_energies out = {0};
+	for (int f = 0; f < sim->face_count; ++f) {
+		const plume_membrane_element *element = sim->membranes + f;
+		plume_vec3 local[3] = {sim->x[element->vertices[0]], sim->x[element->vertices[1]],
+		                       sim->x[element->vertices[2]]};
+		out.membrane += plume_membrane_energy(element, local, NULL, NULL);
+		if (element->compression > 0)
+			out.compression += plume_compression_energy(element, local, NULL, NULL);
+	}
+	for (int e = 0; sim->def.bending && e < sim->hinge_count; ++e) {
+		const plume_hinge *hinge = sim->hinges + e;
+		plume_vec3 local[4];
+		for (int i = 0; i < 4; ++i)
+			local[i] = sim->x[hinge->vertices[i]];
+		out.bending += plume_hinge_energy(hinge, local, NULL, NULL);
+	}
+	for (int i = 0; i < sim->vertex_count; ++i) {
+		out.gravity -= sim->mass[i] * plume_v3_dot(sim->def.gravity, sim->x[i]) + plume_v3_dot(sim->load[i], sim->x[i]);
+		out.kinetic += 0.5 * sim->mass[i] * plume_v3_dot(sim->v[i], sim->v[i]);
+	}
+	return out;
+}

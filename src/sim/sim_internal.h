@@ -1,0 +1,122 @@
+// Private: the simulation's state, shared by sim.c (lifecycle, handles),
+// potential.c (energy, gradient and Hessian assembly), kkt.c (the sparse
+// solver) and newton.c (the constrained Newton iteration and time stepping).
+#ifndef PLUME_SIM_INTERNAL_H
+#define PLUME_SIM_INTERNAL_H
+
+#include "plume/sim.h"
+#include "sim/bending.h"
+#include "sim/kkt.h"
+#include "sim/membrane.h"
+
+enum { PLUME_SIM_TRACE = 256 };
+
+typedef struct sim_handle {
+	int count;
+	int *vertices;
+	/// Vertex positions the motion is applied to (the rest shape at creation).
+	plume_vec3 *anchor;
+	/// Targets at the start and at the end of the current step; a substep interpolates.
+	plume_vec3 *start;
+	plume_vec3 *end;
+} sim_handle;
+
+/// What a solve minimises: statics (no inertia) or one implicit-Euler (sub)step.
+typedef struct sim_problem {
+	bool dynamic;
+	/// Step length, s (dynamic only).
+	double h;
+	/// x_hat = x_n + h v_n: where the vertices go without forces (dynamic only).
+	const plume_vec3 *predicted;
+	/// Positions at the start of the step, for drag (dynamic only).
+	const plume_vec3 *previous;
+	/// Vertex normals at the start of the step, for drag (dynamic only).
+	const plume_vec3 *drag_normals;
+} sim_problem;
+
+struct plume_sim {
+	plume_sim_def def;
+	int vertex_count;
+	plume_vec3 *x;
+	plume_vec3 *v;
+	plume_vec3 *rest;
+	double *mass;
+	/// External force on each vertex, N (plume_sim_set_group_load).
+	plume_vec3 *load;
+	/// Each vertex's third of its faces' reference area, m^2 (for drag).
+	double *vertex_area;
+
+	int face_count;
+	int *faces;
+	unsigned char *face_material;
+	plume_membrane_element *membranes;
+	int hinge_count;
+	plume_hinge *hinges;
+
+	/// Barb-aligned edges held at their reference length (constraint rows).
+	int constraint_count;
+	int *constraint_vertices;
+	double *constraint_length;
+	double *lambda;
+	/// Every barb-aligned edge, constrained or not, for the strain report.
+	int barb_edge_count;
+	int *barb_edges;
+	double *barb_length;
+
+	/// Per degree of freedom: held by a handle or by the planar restriction.
+	unsigned char *fixed;
+	int handle_count;
+	int handle_capacity;
+	sim_handle *handles;
+	int group_count;
+	plume_vertex_group *groups;
+
+	/// Length scale for convergence: the reference bounding box diagonal, m.
+	double length_scale;
+	double time;
+
+	plume_kkt kkt;
+	/// Per-element outputs, computed in parallel and summed in a fixed order.
+	double *face_energy;
+	double *face_gradient;
+	double *face_hessian;
+	double *hinge_energy;
+	double *hinge_gradient;
+	double *hinge_hessian;
+	/// Scratch vectors of 3 n + constraints.
+	double *gradient;
+	double *residual;
+	double *rhs;
+	double *step;
+	plume_vec3 *trial;
+	plume_vec3 *scratch;
+	/// Step state: positions and velocities before the step (restored on failure),
+	/// positions at the start of a substep, the inertial prediction, drag normals.
+	plume_vec3 *saved_x;
+	plume_vec3 *saved_v;
+	plume_vec3 *previous;
+	plume_vec3 *predicted;
+	plume_vec3 *normals;
+	/// Merit at each iteration of the last solve (tests check it decreases).
+	double trace[PLUME_SIM_TRACE];
+	int trace_count;
+};
+
+/// Potential of the problem at positions x: elastic + compression + bending + gravity
+/// (+ inertia and drag for a dynamic step). With gradient != NULL also fills the
+/// gradient (3 n); with the KKT matrix also fills its Hessian block (projected
+/// per element when project is true, exact otherwise). Returns NaN when the
+/// potential is not finite.
+double plume_sim_potential(plume_sim *sim, const sim_problem *problem, const plume_vec3 *x, double *gradient,
+                           bool hessian, bool project);
+
+/// Largest |l - L| / L over all barb-aligned edges at positions x.
+double plume_sim_max_barb_strain(const plume_sim *sim, const plume_vec3 *x);
+
+/// Minimises the problem from sim->x with handles at their targets for fraction s of the step.
+plume_status plume_sim_newton(plume_sim *sim, const sim_problem *problem, plume_solve_report *report, plume_error *err);
+
+/// Places the handle vertices of sim->x at their targets for the step fraction s in [0, 1].
+void plume_sim_place_handles(plume_sim *sim, double s);
+
+#endif

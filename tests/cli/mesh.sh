@@ -1,0 +1,78 @@
+#!/usr/bin/env bash
+# Scenario tests of `plume mesh`: a feather spec and a guides spec meshed into
+# DIR/mesh.obj, mesh.png and report.json; bad input fails clearly and writes nothing.
+# Usage: mesh.sh PLUME_BINARY SOURCE_DIR
+set -u
+plume=$1
+source_dir=$2
+scratch=$(mktemp -d /tmp/plume-cli-XXXXXX)
+trap 'rm -rf "$scratch"' EXIT
+passed=0
+failed=0
+
+check() { # check NAME CONDITION...
+	local name=$1
+	shift
+	if "$@"; then
+		passed=$((passed + 1))
+	else
+		failed=$((failed + 1))
+		echo "FAIL: $name" >&2
+	fi
+}
+
+expect_failure() { # NAME EXIT_CODE MESSAGE_FRAGMENT COMMAND...
+	local name=$1 code=$2 fragment=$3
+	shift 3
+	"$@" >"$scratch/out.txt" 2>"$scratch/err.txt"
+	local got=$?
+	check "$name: exit $code (got $got)" test "$got" -eq "$code"
+	if grep -qF -- "$fragment" "$scratch/err.txt"; then
+		passed=$((passed + 1))
+	else
+		failed=$((failed + 1))
+		echo "FAIL: $name: stderr lacks '$fragment': $(cat "$scratch/err.txt")" >&2
+	fi
+}
+
+# A feather spec, twice: the same bytes.
+"$plume" mesh "$source_dir/examples/franco-walter/hawk.json" -o "$scratch/hawk" 2>"$scratch/err.txt"
+check "hawk: exit 0" test $? -eq 0
+for name in mesh.obj mesh.png report.json; do
+	check "hawk: $name written" test -s "$scratch/hawk/$name"
+done
+check "hawk: aligned fraction 1" grep -q '"aligned_fraction": 1,' "$scratch/hawk/report.json"
+check "hawk: triangles only" bash -c "! grep -E '^f( [^ ]+){4,}' '$scratch/hawk/mesh.obj'"
+"$plume" mesh "$source_dir/examples/franco-walter/hawk.json" -o "$scratch/hawk2" 2>/dev/null
+check "hawk: deterministic obj" cmp -s "$scratch/hawk/mesh.obj" "$scratch/hawk2/mesh.obj"
+check "hawk: deterministic report" cmp -s "$scratch/hawk/report.json" "$scratch/hawk2/report.json"
+
+# --edge-length: a finer mesh has more vertices.
+"$plume" mesh "$source_dir/examples/franco-walter/hawk.json" -o "$scratch/fine" --edge-length 0.0025 2>/dev/null
+check "fine: exit 0" test $? -eq 0
+coarse=$(grep -c '^v ' "$scratch/hawk/mesh.obj")
+fine=$(grep -c '^v ' "$scratch/fine/mesh.obj")
+check "fine: more vertices ($fine > 2 x $coarse)" test "$fine" -gt $((2 * coarse))
+check "fine: edge length in report" grep -q '"edge_length": 0.0025' "$scratch/fine/report.json"
+
+# A guides spec.
+"$plume" mesh "$source_dir/examples/meshes/guides.json" -o "$scratch/guides" 2>"$scratch/err.txt"
+check "guides: exit 0" test $? -eq 0
+check "guides: aligned fraction 1" grep -q '"aligned_fraction": 1,' "$scratch/guides/report.json"
+
+# Bad input: clear message, exit code, nothing written.
+expect_failure "missing -o" 2 "missing -o DIR" "$plume" mesh "$source_dir/examples/meshes/guides.json"
+expect_failure "bad edge length" 2 "--edge-length '-1'" "$plume" mesh "$source_dir/examples/meshes/guides.json" \
+	-o "$scratch/bad" --edge-length -1
+check "bad edge length: nothing written" test ! -e "$scratch/bad"
+printf '{"guides": [[[0,0],[1,1]]], "rachis": [[0,0],[0,1]], "boundary": [[0,0],[1,0],[1,1]], "mesh": {"edge_lenght": 1}}' \
+	>"$scratch/typo.json"
+expect_failure "typo key" 3 "typo.json: \$.mesh" "$plume" mesh "$scratch/typo.json" -o "$scratch/typo"
+check "typo key: nothing written" test ! -e "$scratch/typo"
+expect_failure "missing file" 4 "nope.json" "$plume" mesh "$scratch/nope.json" -o "$scratch/nope"
+check "missing file: nothing written" test ! -e "$scratch/nope"
+"$plume" help mesh >"$scratch/help.txt" 2>&1
+check "help mentions guides spec" grep -q "guides spec" "$scratch/help.txt"
+
+echo "$passed passed, $failed failed"
+test "$failed" -eq 0

@@ -1,0 +1,94 @@
+#!/usr/bin/env bash
+# Scenario tests of `plume simulate`: a short scene writes its mesh, feather,
+# frames, stats and summary; bad scenes write nothing and name the key.
+# Usage: simulate.sh PLUME_BINARY SOURCE_DIR
+set -u
+plume=$1
+source_dir=$2
+scratch=$(mktemp -d /tmp/plume-cli-XXXXXX)
+trap 'rm -rf "$scratch"' EXIT
+passed=0
+failed=0
+
+check() { # check NAME CONDITION...
+	local name=$1
+	shift
+	if "$@"; then
+		passed=$((passed + 1))
+	else
+		failed=$((failed + 1))
+		echo "FAIL: $name" >&2
+	fi
+}
+
+expect_failure() { # expect_failure NAME EXIT_CODE MESSAGE_FRAGMENT COMMAND...
+	local name=$1 code=$2 fragment=$3
+	shift 3
+	"$@" >"$scratch/out.txt" 2>"$scratch/err.txt"
+	local got=$?
+	check "$name: exit $code (got $got)" test "$got" -eq "$code"
+	if ! grep -qF -- "$fragment" "$scratch/err.txt"; then
+		failed=$((failed + 1))
+		echo "FAIL: $name: stderr lacks '$fragment': $(cat "$scratch/err.txt")" >&2
+	else
+		passed=$((passed + 1))
+	fi
+}
+
+# A short swing: the blue feather held at its base, 5 steps, PNG frames.
+cat >"$scratch/swing.json" <<JSON
+{
+  "feather": "$source_dir/examples/franco-walter/blue.json",
+  "mesh": {"edge_length": 0.01},
+  "handles": [{"group": "rachis_clamp"}],
+  "gravity": [0, 0, -9.81],
+  "duration": 0.055,
+  "frame_every": 2
+}
+JSON
+out=$scratch/swing
+"$plume" simulate "$scratch/swing.json" -o "$out" --png --size 200x200 >"$scratch/out.txt" 2>"$scratch/err.txt"
+check "simulate succeeds ($(cat "$scratch/err.txt"))" test $? -eq 0
+for f in mesh.obj feather.json stats.csv summary.json frames/0000.obj frames/0001.obj frames/0002.obj frames/0003.obj \
+	frames/0000.png frames/0003.png; do
+	check "writes $f" test -s "$out/$f"
+done
+check "frame 3 is the last (steps 0, 2, 4, 5)" test ! -e "$out/frames/0004.obj"
+check "stats has a header and 5 steps" test "$(wc -l <"$out/stats.csv")" -eq 6
+check "summary says completed" grep -q '"completed": true' "$out/summary.json"
+check "summary has steps" grep -q '"steps": 5' "$out/summary.json"
+check "summary has max_barb_strain" grep -q '"max_barb_strain"' "$out/summary.json"
+check "summary has rachis_tip_deflection" grep -q '"rachis_tip_deflection"' "$out/summary.json"
+check "stdout reports the run" grep -q "5 steps" "$scratch/out.txt"
+check "frames keep the mesh's vertex count" test "$(grep -c '^v ' "$out/frames/0003.obj")" -eq "$(grep -c '^v ' "$out/mesh.obj")"
+
+# Determinism: the same scene twice gives the same frames.
+"$plume" simulate "$scratch/swing.json" -o "$scratch/again" >/dev/null 2>&1
+check "same scene, same frames" cmp -s "$out/frames/0003.obj" "$scratch/again/frames/0003.obj"
+
+# Rerunning into the same folder replaces the frames and keeps other files.
+echo keep >"$scratch/again/notes.txt"
+"$plume" simulate "$scratch/swing.json" -o "$scratch/again" >/dev/null 2>&1
+check "rerun keeps the user's files" test -s "$scratch/again/notes.txt"
+check "rerun leaves no staging" test -z "$(ls -A "$scratch/again" | grep plume)"
+
+# Bad scenes: clear error, exit 3, nothing written.
+bad() { # bad NAME FRAGMENT JSON-MEMBERS
+	printf '{"feather": "%s/examples/franco-walter/blue.json", "mesh": {"edge_length": 0.01}, %s}\n' "$source_dir" "$3" >"$scratch/bad.json"
+	expect_failure "$1" 3 "$2" "$plume" simulate "$scratch/bad.json" -o "$scratch/bad-out"
+	check "$1: nothing written" test ! -e "$scratch/bad-out"
+}
+bad "unknown group" '$.handles[0].group: unknown vertex group "rachis_bse"' '"handles": [{"group": "rachis_bse"}]'
+bad "negative modulus" '$.materials.vane.E_ww is -1, allowed > 0' '"materials": {"vane": {"E_ww": -1}}'
+bad "negative thickness" '$.materials.rachis.thickness is -0.001, allowed > 0' '"materials": {"rachis": {"thickness": -0.001}}'
+bad "zero time step" '$.time_step is 0, allowed > 0' '"time_step": 0'
+bad "negative time step" '$.time_step is -1, allowed > 0' '"time_step": -1'
+bad "unknown key" 'did you mean "duration"' '"durations": 1'
+expect_failure "missing scene" 4 "missing.json" "$plume" simulate "$scratch/missing.json" -o "$scratch/none"
+check "missing scene: nothing written" test ! -e "$scratch/none"
+expect_failure "no output" 2 "missing -o DIR" "$plume" simulate "$scratch/swing.json"
+"$plume" help simulate | grep -q "frames/NNNN.obj"
+check "help describes the outputs" test $? -eq 0
+
+echo "$passed passed, $failed failed"
+test "$failed" -eq 0
