@@ -224,3 +224,33 @@ void plume_project_psd_translation_free(double *matrix, int vertex_count)
 					matrix[(3 * j + q) * n + 3 * i + p] = sum;
 				}
 }
+
+bool plume_is_positive_semidefinite(const double *matrix, int n)
+{
+	double work[144], scale = 0;
+	for (int i = 0; i < n; ++i)
+		scale = fmax(scale, fabs(matrix[i * n + i]));
+	if (scale == 0)
+		return true;
+	double threshold = 1e-12 * scale;
+	memcpy(work, matrix, sizeof(double) * (size_t)(n * n));
+	// Right-looking LDL^T: a pivot within the threshold of zero is a null direction
+	// (rigid motions make element Hessians singular); its column must then vanish too.
+	for (int k = 0; k < n; ++k) {
+		double pivot = work[k * n + k];
+		if (pivot < -threshold)
+			return false;
+		if (pivot <= threshold) {
+			for (int i = k + 1; i < n; ++i)
+				if (fabs(work[i * n + k]) > threshold)
+					return false;
+			continue;
+		}
+		for (int i = k + 1; i < n; ++i) {
+			double factor = work[i * n + k] / pivot;
+			for (int j = k + 1; j <= i; ++j)
+				work[i * n + j] -= factor * work[j * n + k];
+		}
+	}
+	return true;
+}

@@ -2,6 +2,8 @@
 #ifndef PLUME_SIM_DENSE_H
 #define PLUME_SIM_DENSE_H
 
+#include <stdbool.h>
+
 enum { PLUME_DENSE_MAX = 12 };
 
 /// Eigen-decomposition of a symmetric n x n matrix (row-major, n <= 12) by Householder
@@ -24,5 +26,10 @@ void plume_project_psd(double *matrix, int n);
 /// non-zero spectrum lives: the same result as plume_project_psd up to rounding, about
 /// 2.5 (hinges) to 3 (triangles) times faster.
 void plume_project_psd_translation_free(double *matrix, int vertex_count);
+
+/// True when the symmetric n x n matrix (n <= 12) is positive semidefinite to rounding:
+/// an LDL^T factorisation without pivoting meets no pivot below -1e-12 of the largest
+/// diagonal. A cheap test that spares the eigen-decomposition of most tension elements.
+bool plume_is_positive_semidefinite(const double *matrix, int n);
 
 #endif // PLUME_SIM_DENSE_H

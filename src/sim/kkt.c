@@ -120,7 +120,7 @@ plume_status plume_kkt_init(plume_kkt *kkt, int vertex_count, int face_count, co
 		kkt->common.supernodal = CHOLMOD_SIMPLICIAL;
 		kkt->common.final_ll = 0;
 	} else {
-		kkt->common.supernodal = CHOLMOD_SUPERNODAL;
+		kkt->common.supernodal = CHOLMOD_AUTO;
 	}
 	kkt->matrix =
 	    cholmod_allocate_sparse((size_t)size, (size_t)size, (size_t)unique, 1, 1, 1, CHOLMOD_REAL, &kkt->common);

@@ -4,9 +4,13 @@
 // c_k = |x_j - x_i| - L_k for every constrained barb edge:
 //   [ H  C^T ] [ dx      ]   [ -grad Phi ]
 //   [ C  -dI ] [ lambda+ ] = [ -c        ]
-// with H the per-element projected Hessian plus lambda_k's constraint curvature
-// where lambda_k > 0 (a barb in tension; the compressed part is left out so H
-// stays positive semidefinite). A backtracking line search on the exact l1
+// with H the Hessian of the Lagrangian: element Hessians plus each barb's constraint
+// curvature lambda_k (I - t t^T) / l. Each solve starts with per-element Hessians
+// projected to positive semidefinite and only the curvature of barbs in tension
+// (lambda_k > 0), which makes every step a descent step; once a full step is
+// accepted it switches to the exact H, and falls back when that does not factor or
+// gives no descent. A backtracking
+// line search on the exact l1
 // merit Phi + mu |c|_1 (mu above the largest multiplier) keeps every accepted
 // step a descent step; a second-order correction avoids the Maratos effect that
 // would otherwise reject full steps near the solution.
@@ -97,7 +101,7 @@ static double mean_diagonal(const plume_sim *sim)
 /// Adds the constraint rows to the assembled matrix and the Lagrangian terms to the
 /// gradient; fills the right-hand side [-g; -c]. Returns the residual's infinity norm
 /// over free unknowns (with the current multipliers).
-static double add_constraints(plume_sim *sim, const plume_vec3 *x, double *gradient, double *rhs)
+static double add_constraints(plume_sim *sim, const plume_vec3 *x, double *gradient, double *rhs, bool exact)
 {
 	int n3 = 3 * sim->vertex_count;
 	double *values = plume_kkt_values(&sim->kkt);
@@ -125,8 +129,10 @@ static double add_constraints(plume_sim *sim, const plume_vec3 *x, double *gradi
 			residual[dof] += sim->lambda[k] * jacobian;
 		}
 		rhs[n3 + k] = -c;
-		// Curvature of a stretched barb: lambda (I - t t^T) / l on the pair, PSD for lambda > 0.
-		if (sim->lambda[k] > 0) {
+		// Curvature of the constraint: lambda (I - t t^T) / l on the pair, PSD for lambda > 0
+		// (a barb in tension). A compressed barb's part is indefinite: only the exact
+		// Hessian takes it (the fallback to projection leaves it out).
+		if (sim->lambda[k] > 0 || (exact && sim->lambda[k] != 0)) {
 			double block[36];
 			for (int a = 0; a < 6; ++a)
 				for (int b = 0; b < 6; ++b) {
@@ -211,7 +217,7 @@ static plume_status newton_system(plume_sim *sim, const sim_problem *problem, bo
 	for (int i = 0; i < n3; ++i)
 		if (sim->fixed[i])
 			g[i] = 0;
-	*residual = add_constraints(sim, sim->x, g, sim->rhs);
+	*residual = add_constraints(sim, sim->x, g, sim->rhs, exact);
 	report->seconds_assembly += seconds_now() - t0;
 	return PLUME_OK;
 }

@@ -40,7 +40,7 @@ static void evaluate_faces(plume_sim *sim, const plume_vec3 *x, bool gradient, b
 			for (int i = 0; h != NULL && i < 81; ++i)
 				h[i] += hc[i];
 		}
-		if (h != NULL && project)
+		if (h != NULL && project && !plume_is_positive_semidefinite(h, 9))
 			plume_project_psd_translation_free(h, 3);
 		sim->face_energy[f] = energy;
 	}
@@ -54,10 +54,23 @@ static void evaluate_hinges(plume_sim *sim, const plume_vec3 *x, bool gradient, 
 		const plume_hinge *hinge = sim->hinges + e;
 		plume_vec3 local[4];
 		gather(x, hinge->vertices, 4, local);
+		double *g = gradient ? sim->hinge_gradient + 12 * e : NULL;
 		double *h = hessian ? sim->hinge_hessian + 144 * e : NULL;
-		sim->hinge_energy[e] = plume_hinge_energy(hinge, local, gradient ? sim->hinge_gradient + 12 * e : NULL, h);
-		if (h != NULL && project)
-			plume_project_psd_translation_free(h, 4);
+		if (h == NULL || !project) {
+			sim->hinge_energy[e] = plume_hinge_energy(hinge, local, g, h);
+			continue;
+		}
+		// The positive semidefinite part of E = k (s chi - eta0)^2 is its Gauss–Newton
+		// term 2 k s^2 grad chi grad chi^T; the rest, 2 k s (s chi - eta0) Hess chi, is the
+		// indefinite part a projection would clamp anyway. This is far cheaper than an
+		// eigen-decomposition of the 12 x 12 block, and exact at the rest angle.
+		sim->hinge_energy[e] = plume_hinge_energy(hinge, local, g, NULL);
+		double chi_gradient[12];
+		plume_dihedral_angle_derivatives(local, chi_gradient, NULL);
+		double k = 2 * hinge->stiffness * hinge->scale * hinge->scale;
+		for (int a = 0; a < 12; ++a)
+			for (int b = 0; b < 12; ++b)
+				h[12 * a + b] = k * chi_gradient[a] * chi_gradient[b];
 	}
 }
 
