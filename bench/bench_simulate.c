@@ -30,11 +30,20 @@ static int run(const char *name, double edge_length)
 			plume_scene_destroy(scene);
 			return 1;
 		}
-		// The handle groups were derived from the old mesh: redo them by name.
+		// Handles that select vertices near a point are selected again on the new mesh.
+		for (int h = 0; h < scene->handle_count; ++h) {
+			plume_scene_handle *handle = scene->handles + h;
+			if (handle->near_given &&
+			    plume_mesh_add_group_near(mesh, handle->group, handle->source_group, handle->near, handle->radius,
+			                              &err) != PLUME_OK) {
+				fprintf(stderr, "%s\n", err.message);
+				plume_mesh_destroy(mesh);
+				plume_scene_destroy(scene);
+				return 1;
+			}
+		}
 		plume_mesh_destroy(scene->mesh);
 		scene->mesh = mesh;
-		fprintf(stderr, "(finer mesh: the vane-tip handle uses the whole left_edge group near the tip)\n");
-		snprintf(scene->handles[1].group, sizeof scene->handles[1].group, "vane_tip");
 	}
 	plume_scene_summary summary;
 	plume_status status = plume_scene_run(scene, NULL, NULL, &summary, &err);

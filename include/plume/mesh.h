@@ -144,6 +144,11 @@ plume_mesh *plume_mesh_create(int vertex_count, int face_count);
 /// Adds a vertex group (copies the indices). Names are at most 31 bytes.
 plume_status plume_mesh_add_group(plume_mesh *mesh, const char *name, const int *vertices, int count, plume_error *err);
 
+/// Adds group `name` holding the vertices of group `source` whose reference position lies
+/// within radius (m) of near. PLUME_ERROR_SPEC when source is unknown or no vertex is that close.
+plume_status plume_mesh_add_group_near(plume_mesh *mesh, const char *name, const char *source, plume_vec2 near,
+                                       double radius, plume_error *err);
+
 /// Rebuilds barb_edges from the faces' barb_edge marks (unique edges, sorted).
 plume_status plume_mesh_collect_barb_edges(plume_mesh *mesh, plume_error *err);
 

@@ -31,7 +31,10 @@ typedef enum plume_interpolation {
 /// A Dirichlet handle: a vertex group, optionally only its vertices within `radius`
 /// of `near` (reference plane, m), moved by keyframes (none: held still).
 typedef struct plume_scene_handle {
+	/// The group the handle holds (for a `near` selection, the derived group "handle N").
 	char group[32];
+	/// With `near`: the group named in the spec that the selection was taken from.
+	char source_group[32];
 	bool near_given;
 	plume_vec2 near;
 	double radius;

@@ -189,33 +189,19 @@ static void unknown_group(plume_spec_reader *reader, const char *path, const cha
 	                count > 0 ? plume_spec_nearest(name, names) : "", list);
 }
 
-/// Adds the group of the vertices of `group` within radius of near, named "handle N".
+/// Adds the group of the vertices of the handle's group within radius of near, named "handle N".
 static void add_near_group(plume_spec_reader *reader, const char *path, plume_mesh *mesh, plume_scene_handle *handle,
                            int index)
 {
-	const plume_vertex_group *group = plume_mesh_find_group(mesh, handle->group);
-	int *picked = plume_alloc(sizeof(int) * (size_t)(group->count > 0 ? group->count : 1));
-	if (picked == NULL) {
-		plume_spec_fail(reader, path, "out of memory");
+	char name[32];
+	snprintf(name, sizeof name, "handle %d", index);
+	plume_error local = {0};
+	if (plume_mesh_add_group_near(mesh, name, handle->group, handle->near, handle->radius, &local) != PLUME_OK) {
+		plume_spec_fail(reader, path, "%s", local.message);
 		return;
 	}
-	int count = 0;
-	for (int i = 0; i < group->count; ++i) {
-		plume_vec2 p = mesh->reference[group->vertices[i]];
-		if (hypot(p.x - handle->near.x, p.y - handle->near.y) <= handle->radius)
-			picked[count++] = group->vertices[i];
-	}
-	if (count == 0) {
-		plume_spec_fail(reader, path, "no vertex of group \"%s\" lies within radius %g m of (%g, %g)", handle->group,
-		                handle->radius, handle->near.x, handle->near.y);
-	} else {
-		char name[32];
-		snprintf(name, sizeof name, "handle %d", index);
-		if (plume_mesh_add_group(mesh, name, picked, count, NULL) != PLUME_OK)
-			plume_spec_fail(reader, path, "out of memory");
-		snprintf(handle->group, sizeof handle->group, "%s", name);
-	}
-	plume_free(picked);
+	snprintf(handle->source_group, sizeof handle->source_group, "%s", handle->group);
+	snprintf(handle->group, sizeof handle->group, "%s", name);
 }
 
 static void read_handles(plume_spec_reader *reader, const json_t *root, plume_scene *scene)

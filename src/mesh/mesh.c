@@ -171,3 +171,27 @@ plume_mesh_report plume_mesh_measure(const plume_mesh *mesh)
 	report.aligned_fraction = vane_faces > 0 ? (double)aligned / vane_faces : 1.0;
 	return report;
 }
+
+plume_status plume_mesh_add_group_near(plume_mesh *mesh, const char *name, const char *source, plume_vec2 near,
+                                       double radius, plume_error *err)
+{
+	const plume_vertex_group *group = plume_mesh_find_group(mesh, source);
+	if (group == NULL)
+		return plume_error_set(err, PLUME_ERROR_SPEC, "unknown vertex group \"%s\"", source);
+	int *picked = plume_alloc(sizeof(int) * (size_t)(group->count > 0 ? group->count : 1));
+	if (picked == NULL)
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory selecting vertices");
+	int count = 0;
+	for (int i = 0; i < group->count; ++i) {
+		plume_vec2 p = mesh->reference[group->vertices[i]];
+		if (hypot(p.x - near.x, p.y - near.y) <= radius)
+			picked[count++] = group->vertices[i];
+	}
+	plume_status status =
+	    count == 0 ? plume_error_set(err, PLUME_ERROR_SPEC,
+	                                 "no vertex of group \"%s\" lies within radius %g m of (%g, %g)", source, radius,
+	                                 near.x, near.y)
+	               : plume_mesh_add_group(mesh, name, picked, count, err);
+	plume_free(picked);
+	return status;
+}
