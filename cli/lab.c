@@ -1,17 +1,340 @@
-// PLACEHOLDER: replaced by `plume lab` (issue in progress).
+// plume lab traction LAB.json -o DIR
+// plume lab calibrate --phi PHI --Eb E_b --EB E_B [--aspect A] [--period T] ...
+// plume lab study locking|conditioning|angles|size -o DIR [--scale S]
+#define _POSIX_C_SOURCE 200809L
+#include <errno.h>
+#include <getopt.h>
+#include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
 
 #include "cli.h"
-
-int cli_lab(int argc, char **argv)
-{
-	(void)argc;
-	(void)argv;
-	fprintf(stderr, "plume lab: not built yet\n");
-	return CLI_EXIT_FAILURE;
-}
+#include "plume/lab.h"
 
 void cli_help_lab(void)
 {
-	printf("plume lab: not built yet\n");
+	puts("Usage: plume lab traction LAB.json -o DIR\n"
+	     "       plume lab calibrate --phi PHI --Eb E_b --EB E_B [options]\n"
+	     "       plume lab study locking|conditioning|angles|size -o DIR [--scale S]\n"
+	     "\n"
+	     "The virtual feather lab of Jouve's thesis (chapters 3-5): traction tests on\n"
+	     "rectangular vane samples, the mesoscale band model, the calibration of the\n"
+	     "membrane moduli and the numerical studies. docs/lab.md describes them.\n"
+	     "\n"
+	     "traction: runs the test LAB.json describes and writes DIR/traction.csv (strain,\n"
+	     "  stress, displacement, Newton iterations, convergence), DIR/traction.json (the\n"
+	     "  slope) and the stress-strain plot DIR/traction.png and DIR/traction.svg.\n"
+	     "\n"
+	     "calibrate: prints JSON with E_vv, E_ww, E_vw (Pa), the slopes it matched and\n"
+	     "  the number of solves.\n"
+	     "  --phi PHI              barb fraction Phi_B, in (0, 1) (required)\n"
+	     "  --Eb PA                barbule modulus E_b, Pa (required)\n"
+	     "  --EB PA                barb modulus E_B, Pa (required)\n"
+	     "  --aspect A             H/W of the tilted test (default 1.3)\n"
+	     "  --period T             band period, m (default 4e-4)\n"
+	     "  --width W              tilted sample width, m (default 4e-3)\n"
+	     "  --elements N           mesoscale tilted mesh size (default 8000)\n"
+	     "  --macro-elements N     macroscale tilted mesh size (default 2000)\n"
+	     "  --unconstrained        fit E_vw without the barb constraint\n"
+	     "\n"
+	     "study: writes DIR/<study>.csv, .png and .svg and prints a JSON summary.\n"
+	     "  --scale S              element counts times S (default 1; e.g. 0.25 for a quick look)\n"
+	     "\n"
+	     "  -o, --output DIR       output folder (created if missing; all files or none)\n"
+	     "  -h, --help             this help");
+}
+
+static bool parse_double(const char *option, const char *text, double *out)
+{
+	char *end = NULL;
+	errno = 0;
+	double value = strtod(text, &end);
+	if (end == text || *end != '\0' || errno != 0 || !isfinite(value)) {
+		cli_usage_error("lab", "%s expects a number, got '%s'", option, text);
+		return false;
+	}
+	*out = value;
+	return true;
+}
+
+static bool parse_int(const char *option, const char *text, int *out)
+{
+	double value;
+	if (!parse_double(option, text, &value))
+		return false;
+	if (value != floor(value) || value < 1 || value > 1e8) {
+		cli_usage_error("lab", "%s expects a whole number >= 1, got '%s'", option, text);
+		return false;
+	}
+	*out = (int)value;
+	return true;
+}
+
+// ---------------------------------------------------------------------------
+// traction
+
+static plume_status write_traction(cli_output *output, const plume_traction_result *r, const plume_lab_spec *spec,
+                                   plume_error *err)
+{
+	char path[4352], svg[4352];
+	double *iterations = malloc(sizeof(double) * (size_t)r->count);
+	double *converged = malloc(sizeof(double) * (size_t)r->count);
+	if (iterations == NULL || converged == NULL) {
+		free(iterations);
+		free(converged);
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory");
+	}
+	for (int i = 0; i < r->count; ++i) {
+		iterations[i] = r->iterations[i];
+		converged[i] = r->converged[i] ? 1.0 : 0.0;
+	}
+	const double *columns[5] = {r->strain, r->stress, r->displacement, iterations, converged};
+	plume_status status =
+	    plume_lab_write_csv(cli_output_path(output, "traction.csv", path, sizeof path),
+	                        "strain,stress_pa,displacement_m,newton_iterations,converged", columns, 5, r->count, err);
+	free(iterations);
+	free(converged);
+	if (status != PLUME_OK)
+		return status;
+	FILE *file = fopen(cli_output_path(output, "traction.json", path, sizeof path), "wb");
+	bool written = file != NULL &&
+	               fprintf(file,
+	                       "{\"slope_pa\": %.10g, \"strain_max\": %.10g, \"steps\": %d, "
+	                       "\"newton_iterations\": %d, \"lateral_strain\": %.6g, "
+	                       "\"model\": \"%s\", \"barb_angle_deg\": %.10g}\n",
+	                       r->slope, spec->traction.strain_max, spec->traction.steps, r->newton_iterations,
+	                       r->lateral_strain, spec->material.model == PLUME_LAB_MESOSCALE ? "mesoscale" : "macroscale",
+	                       spec->sample.barb_angle * 180.0 / 3.14159265358979323846) >= 0;
+	if (file != NULL && fclose(file) != 0)
+		written = false;
+	if (!written)
+		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write", path);
+	// The measured curve and the fitted line through the origin.
+	double line_x[2] = {0.0, r->strain[r->count - 1]};
+	double line_y[2] = {0.0, r->slope * r->strain[r->count - 1]};
+	char fit_label[64];
+	snprintf(fit_label, sizeof fit_label, "slope %.6g Pa", r->slope);
+	plume_plot_series series[2] = {
+	    {"measured", r->strain, r->stress, r->count, true, false},
+	    {fit_label, line_x, line_y, 2, false, true},
+	};
+	plume_plot plot = {
+	    .title = "Traction test",
+	    .x_label = "measured strain #fi#ge#fn#d#fiyy#fn#u",
+	    .y_label = "measured stress #fi#gs#fn#d#fiyy#fn#u [Pa]",
+	    .series_count = 2,
+	    .series = series,
+	};
+	return plume_lab_plot(&plot, cli_output_path(output, "traction.png", path, sizeof path),
+	                      cli_output_path(output, "traction.svg", svg, sizeof svg), err);
+}
+
+static int run_traction(int argc, char **argv)
+{
+	static const struct option options[] = {
+	    {"output", required_argument, NULL, 'o'}, {"help", no_argument, NULL, 'h'}, {NULL, 0, NULL, 0}};
+	const char *output_dir = NULL;
+	int option;
+	optind = 1;
+	opterr = 0;
+	while ((option = getopt_long(argc, argv, ":o:h", options, NULL)) != -1) {
+		switch (option) {
+		case 'o': output_dir = optarg; break;
+		case 'h': cli_help_lab(); return CLI_EXIT_OK;
+		case ':': return cli_usage_error("lab", "option '%s' needs a value", argv[optind - 1]);
+		default: return cli_usage_error("lab", "unknown option '%s'", argv[optind - 1]);
+		}
+	}
+	if (optind >= argc)
+		return cli_usage_error("lab", "missing LAB.json");
+	if (optind + 1 < argc)
+		return cli_usage_error("lab", "unexpected argument '%s'", argv[optind + 1]);
+	if (output_dir == NULL)
+		return cli_usage_error("lab", "missing -o DIR");
+	plume_error err = {0};
+	plume_lab_spec spec;
+	plume_status status = plume_lab_spec_load(argv[optind], &spec, &err);
+	if (status != PLUME_OK)
+		return cli_fail(&err);
+	plume_traction_result result;
+	status = plume_lab_traction(&spec.material, &spec.sample, &spec.traction, &result, &err);
+	if (status != PLUME_OK) {
+		plume_error_prefix(&err, argv[optind]);
+		return cli_fail(&err);
+	}
+	cli_output output;
+	status = cli_output_begin(&output, output_dir, &err);
+	if (status == PLUME_OK) {
+		status = write_traction(&output, &result, &spec, &err);
+		if (status == PLUME_OK)
+			status = cli_output_commit(&output, &err);
+		else
+			cli_output_abort(&output);
+	}
+	if (status == PLUME_OK)
+		printf("slope: %.10g Pa\n", result.slope);
+	plume_traction_result_free(&result);
+	return status == PLUME_OK ? CLI_EXIT_OK : cli_fail(&err);
+}
+
+// ---------------------------------------------------------------------------
+// calibrate
+
+static int run_calibrate(int argc, char **argv)
+{
+	static const struct option options[] = {
+	    {"phi", required_argument, NULL, 'p'},
+	    {"Eb", required_argument, NULL, 'b'},
+	    {"EB", required_argument, NULL, 'B'},
+	    {"aspect", required_argument, NULL, 'a'},
+	    {"period", required_argument, NULL, 'T'},
+	    {"width", required_argument, NULL, 'w'},
+	    {"elements", required_argument, NULL, 'e'},
+	    {"macro-elements", required_argument, NULL, 'm'},
+	    {"unconstrained", no_argument, NULL, 'u'},
+	    {"help", no_argument, NULL, 'h'},
+	    {NULL, 0, NULL, 0},
+	};
+	plume_calibration_def def = plume_calibration_default_def();
+	bool phi_given = false, Eb_given = false, EB_given = false;
+	int option;
+	optind = 1;
+	opterr = 0;
+	while ((option = getopt_long(argc, argv, ":h", options, NULL)) != -1) {
+		bool ok = true;
+		switch (option) {
+		case 'p':
+			ok = parse_double("--phi", optarg, &def.mesoscale.bands.barb_fraction);
+			phi_given = true;
+			break;
+		case 'b':
+			ok = parse_double("--Eb", optarg, &def.mesoscale.E_b);
+			Eb_given = true;
+			break;
+		case 'B':
+			ok = parse_double("--EB", optarg, &def.mesoscale.E_B);
+			EB_given = true;
+			break;
+		case 'a': ok = parse_double("--aspect", optarg, &def.aspect_ratio); break;
+		case 'T': ok = parse_double("--period", optarg, &def.mesoscale.bands.period); break;
+		case 'w': ok = parse_double("--width", optarg, &def.sample.width); break;
+		case 'e': ok = parse_int("--elements", optarg, &def.sample.element_count); break;
+		case 'm': ok = parse_int("--macro-elements", optarg, &def.macroscale_elements); break;
+		case 'u': def.barb_constraint = false; break;
+		case 'h': cli_help_lab(); return CLI_EXIT_OK;
+		case ':': return cli_usage_error("lab", "option '%s' needs a value", argv[optind - 1]);
+		default: return cli_usage_error("lab", "unknown option '%s'", argv[optind - 1]);
+		}
+		if (!ok)
+			return CLI_EXIT_USAGE;
+	}
+	if (optind < argc)
+		return cli_usage_error("lab", "unexpected argument '%s'", argv[optind]);
+	if (!phi_given || !Eb_given || !EB_given)
+		return cli_usage_error("lab", "calibrate needs --phi, --Eb and --EB");
+	plume_error err = {0};
+	if (!(def.mesoscale.bands.barb_fraction > 0.0 && def.mesoscale.bands.barb_fraction < 1.0)) {
+		fprintf(stderr, "plume: --phi is %g, allowed in (0, 1)\n", def.mesoscale.bands.barb_fraction);
+		return CLI_EXIT_INPUT;
+	}
+	plume_calibration_result r;
+	plume_status status = plume_lab_calibrate(&def, &r, &err);
+	if (status != PLUME_OK)
+		return cli_fail(&err);
+	printf("{\n  \"E_vv\": %.6g,\n  \"E_ww\": %.6g,\n  \"E_vw\": %.6g,\n", r.E_vv, r.E_ww, r.E_vw);
+	printf("  \"slopes\": {\"longitudinal\": %.8g, \"transverse\": %.8g, \"tilted_mesoscale\": %.8g, "
+	       "\"tilted_macroscale\": %.8g},\n",
+	       r.slope_longitudinal, r.slope_transverse, r.slope_tilted, r.slope_tilted_macroscale);
+	printf("  \"phi\": %.6g,\n  \"E_b\": %.6g,\n  \"E_B\": %.6g,\n  \"aspect\": %.6g,\n  \"period\": %.6g,\n",
+	       def.mesoscale.bands.barb_fraction, def.mesoscale.E_b, def.mesoscale.E_B, def.aspect_ratio,
+	       def.mesoscale.bands.period);
+	printf(
+	    "  \"barb_constraint\": %s,\n  \"traction_tests\": %d,\n  \"solves\": %d,\n  \"bisection_iterations\": %d\n}\n",
+	    def.barb_constraint ? "true" : "false", r.traction_count, r.solve_count, r.bisection_iterations);
+	return CLI_EXIT_OK;
+}
+
+// ---------------------------------------------------------------------------
+// study
+
+static int run_study(int argc, char **argv)
+{
+	static const struct option options[] = {{"output", required_argument, NULL, 'o'},
+	                                        {"scale", required_argument, NULL, 's'},
+	                                        {"help", no_argument, NULL, 'h'},
+	                                        {NULL, 0, NULL, 0}};
+	const char *output_dir = NULL;
+	plume_study_def def = plume_study_default_def(PLUME_STUDY_LOCKING);
+	double scale = 1.0;
+	int option;
+	optind = 1;
+	opterr = 0;
+	while ((option = getopt_long(argc, argv, ":o:h", options, NULL)) != -1) {
+		switch (option) {
+		case 'o': output_dir = optarg; break;
+		case 's':
+			if (!parse_double("--scale", optarg, &scale))
+				return CLI_EXIT_USAGE;
+			break;
+		case 'h': cli_help_lab(); return CLI_EXIT_OK;
+		case ':': return cli_usage_error("lab", "option '%s' needs a value", argv[optind - 1]);
+		default: return cli_usage_error("lab", "unknown option '%s'", argv[optind - 1]);
+		}
+	}
+	if (optind >= argc)
+		return cli_usage_error("lab", "missing the study: locking, conditioning, angles or size");
+	if (optind + 1 < argc)
+		return cli_usage_error("lab", "unexpected argument '%s'", argv[optind + 1]);
+	const char *name = argv[optind];
+	plume_study_kind kind;
+	if (!plume_study_kind_from_name(name, &kind))
+		return cli_usage_error("lab", "unknown study '%s': locking, conditioning, angles or size", name);
+	if (output_dir == NULL)
+		return cli_usage_error("lab", "missing -o DIR");
+	if (!(scale > 0.0 && scale <= 16.0))
+		return cli_usage_error("lab", "--scale is %g, allowed in (0, 16]", scale);
+	def = plume_study_default_def(kind);
+	def.scale = scale;
+	plume_error err = {0};
+	cli_output output;
+	plume_status status = cli_output_begin(&output, output_dir, &err);
+	if (status != PLUME_OK)
+		return cli_fail(&err);
+	char stage_csv[4352], stage_png[4352], stage_svg[4352], file[64];
+	snprintf(file, sizeof file, "%s.csv", name);
+	cli_output_path(&output, file, stage_csv, sizeof stage_csv);
+	snprintf(file, sizeof file, "%s.png", name);
+	cli_output_path(&output, file, stage_png, sizeof stage_png);
+	snprintf(file, sizeof file, "%s.svg", name);
+	cli_output_path(&output, file, stage_svg, sizeof stage_svg);
+	char summary[1024];
+	status = plume_lab_study(&def, stage_csv, stage_png, stage_svg, summary, sizeof summary, &err);
+	if (status == PLUME_OK)
+		status = cli_output_commit(&output, &err);
+	else
+		cli_output_abort(&output);
+	if (status != PLUME_OK)
+		return cli_fail(&err);
+	printf("%s\n", summary);
+	return CLI_EXIT_OK;
+}
+
+int cli_lab(int argc, char **argv)
+{
+	// argv[0] is "lab"; argv[1] the action.
+	if (argc < 2)
+		return cli_usage_error("lab", "missing the action: traction, calibrate or study");
+	const char *action = argv[1];
+	if (strcmp(action, "--help") == 0 || strcmp(action, "-h") == 0) {
+		cli_help_lab();
+		return CLI_EXIT_OK;
+	}
+	if (strcmp(action, "traction") == 0)
+		return run_traction(argc - 1, argv + 1);
+	if (strcmp(action, "calibrate") == 0)
+		return run_calibrate(argc - 1, argv + 1);
+	if (strcmp(action, "study") == 0)
+		return run_study(argc - 1, argv + 1);
+	return cli_usage_error("lab", "unknown action '%s': traction, calibrate or study", action);
 }

@@ -112,6 +112,8 @@ plume_status plume_kkt_init(plume_kkt *kkt, int vertex_count, int face_count, co
 
 	cholmod_start(&kkt->common);
 	kkt->started = true;
+	// The library never prints: failures come back through the status (DESIGN.md).
+	kkt->common.print = 0;
 	// Deterministic and fast enough at feather sizes; METIS is not needed.
 	kkt->common.nmethods = 1;
 	kkt->common.method[0].ordering = CHOLMOD_AMD;

@@ -1,0 +1,78 @@
+// Benchmark: the lab's calibration (thesis 5.2-5.3) at Phi_B = 0.12, 0.14, 0.16
+// with thesis Table 5.1's moduli, and each study at its default size. Prints
+// the wall time of each and the calibrated moduli.
+//
+// Usage: bench_lab [calibration|studies|all] [OUTPUT_DIR]   (defaults: all, /tmp)
+#define _POSIX_C_SOURCE 200809L
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "plume/lab.h"
+
+static double now(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void check(plume_status status, const plume_error *err)
+{
+	if (status != PLUME_OK) {
+		fprintf(stderr, "bench_lab: %s\n", err->message);
+		exit(1);
+	}
+}
+
+static void calibrations(void)
+{
+	static const double phis[3] = {0.12, 0.14, 0.16}, E_b[3] = {4.04e4, 3.92e4, 3.79e4},
+	                    E_B[3] = {2.8e9, 2.57e9, 2.25e9};
+	printf("calibration (thesis Table 5.1 -> Table 5.2), default meshes, barb constraint on:\n");
+	printf("%6s %12s %12s %12s %10s %8s %8s\n", "Phi_B", "E_vv [Pa]", "E_ww [Pa]", "E_vw [Pa]", "seconds", "tests",
+	       "solves");
+	for (int k = 0; k < 3; ++k) {
+		plume_calibration_def def = plume_calibration_default_def();
+		def.mesoscale.bands.barb_fraction = phis[k];
+		def.mesoscale.E_b = E_b[k];
+		def.mesoscale.E_B = E_B[k];
+		plume_calibration_result r;
+		plume_error err = {0};
+		double t0 = now();
+		check(plume_lab_calibrate(&def, &r, &err), &err);
+		printf("%6.2f %12.5g %12.5g %12.5g %10.2f %8d %8d\n", phis[k], r.E_vv, r.E_ww, r.E_vw, now() - t0,
+		       r.traction_count, r.solve_count);
+		fflush(stdout);
+	}
+}
+
+static void studies(const char *dir)
+{
+	printf("studies at their default sizes:\n");
+	for (int k = 0; k < 4; ++k) {
+		plume_study_def def = plume_study_default_def((plume_study_kind)k);
+		const char *name = plume_study_name(def.kind);
+		char csv[1024], png[1024], svg[1024], summary[1024];
+		snprintf(csv, sizeof csv, "%s/bench-lab-%s.csv", dir, name);
+		snprintf(png, sizeof png, "%s/bench-lab-%s.png", dir, name);
+		snprintf(svg, sizeof svg, "%s/bench-lab-%s.svg", dir, name);
+		plume_error err = {0};
+		double t0 = now();
+		check(plume_lab_study(&def, csv, png, svg, summary, sizeof summary, &err), &err);
+		printf("  %-13s %8.2f s  %s\n", name, now() - t0, summary);
+		fflush(stdout);
+	}
+}
+
+int main(int argc, char **argv)
+{
+	const char *what = argc > 1 ? argv[1] : "all";
+	const char *dir = argc > 2 ? argv[2] : "/tmp";
+	if (strcmp(what, "calibration") == 0 || strcmp(what, "all") == 0)
+		calibrations();
+	if (strcmp(what, "studies") == 0 || strcmp(what, "all") == 0)
+		studies(dir);
+	return 0;
+}

@@ -1,0 +1,240 @@
+// Calibration of the membrane moduli (Jouve thesis 5.2-5.3): the mesoscale
+// model's longitudinal and transverse slopes are E_vv and E_ww; E_vw is the
+// shear modulus that makes the macroscale model's tilted slope match the
+// mesoscale one at the thesis's aspect ratio (a bracketed search on E_vw).
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "plume/lab.h"
+
+static const double PI = 3.14159265358979323846;
+
+plume_calibration_def plume_calibration_default_def(void)
+{
+	plume_calibration_def def;
+	memset(&def, 0, sizeof def);
+	def.mesoscale = plume_lab_material_default(PLUME_LAB_MESOSCALE);
+	def.sample = plume_sample_default_def();
+	// A 4 mm wide tilted sample (thesis Table 3.1c: 3 to 16 mm) holds 10 barb periods of
+	// 0.4 mm: small enough for the mesoscale model to be solved in seconds.
+	def.sample.width = 4e-3;
+	def.sample.element_count = 8000;
+	def.aspect_ratio = 1.3;
+	def.longitudinal_strain_max = 0.01;
+	def.transverse_strain_max = 0.4;
+	def.steps = 10;
+	def.barb_constraint = true;
+	def.tolerance = 1e-4;
+	def.macroscale_elements = 2000;
+	return def;
+}
+
+static plume_status check(const plume_calibration_def *def, plume_error *err)
+{
+	const plume_sample_def *s = &def->sample;
+	if (!(def->aspect_ratio > 0.0 && isfinite(def->aspect_ratio)))
+		return plume_error_set(err, PLUME_ERROR_SPEC, "aspect ratio is %g, allowed > 0", def->aspect_ratio);
+	// The tilted sample must hold at least one barb period across and two mesh rows along.
+	double height = def->aspect_ratio * s->width;
+	double spacing = sqrt(2.0 * s->width * height / fmax(def->macroscale_elements, 1));
+	if (height < 2.0 * spacing || s->width < 2.0 * spacing || height > 1e3 * s->width || s->width > 1e3 * height)
+		return plume_error_set(err, PLUME_ERROR_SPEC,
+		                       "aspect ratio %g: a %g m wide sample %g m high cannot be meshed with %d elements "
+		                       "(allowed: both sides at least two element sizes, ratio within 1e-3..1e3)",
+		                       def->aspect_ratio, s->width, height, def->macroscale_elements);
+	if (def->mesoscale.bands.period > fmin(s->width, height))
+		return plume_error_set(err, PLUME_ERROR_SPEC,
+		                       "band period %g m is larger than the %g x %g m sample: it holds no whole barb",
+		                       def->mesoscale.bands.period, s->width, height);
+	if (!(def->longitudinal_strain_max > 0.0) || !(def->transverse_strain_max > 0.0))
+		return plume_error_set(err, PLUME_ERROR_SPEC,
+		                       "strain_max is %g (longitudinal) and %g (transverse), allowed > 0",
+		                       def->longitudinal_strain_max, def->transverse_strain_max);
+	if (def->steps < 2)
+		return plume_error_set(err, PLUME_ERROR_SPEC, "steps is %d, allowed >= 2", def->steps);
+	if (!(def->tolerance > 0.0 && def->tolerance < 1.0))
+		return plume_error_set(err, PLUME_ERROR_SPEC, "tolerance is %g, allowed in (0, 1)", def->tolerance);
+	if (def->macroscale_elements < 2)
+		return plume_error_set(err, PLUME_ERROR_SPEC, "macroscale elements is %d, allowed >= 2",
+		                       def->macroscale_elements);
+	plume_lab_material material = def->mesoscale;
+	material.model = PLUME_LAB_MESOSCALE;
+	return plume_lab_validate(&material, s, NULL, err);
+}
+
+// Runs one traction test and returns its slope.
+static plume_status slope_of(const plume_lab_material *material, const plume_sample_def *sample, double strain_max,
+                             int steps, plume_calibration_result *result, double *slope, plume_error *err)
+{
+	plume_traction_def traction = plume_traction_default_def();
+	traction.strain_max = strain_max;
+	traction.steps = steps;
+	// The slope needs a few significant digits; 1e-6 of the force scale is plenty and
+	// keeps the stiff tilted problems from stalling on round-off.
+	traction.solver.tolerance = 1e-6;
+	// Newton can stall in the stiff tilted problems once the barbules go into compression
+	// (a shear band forms): a stalled step whose gradient is below 1e-3 of the clamp force
+	// moves that sample's stress, and the slope, by about that much at most, well inside the
+	// mesoscale mesh's own error.
+	traction.accept_residual = 1e-3;
+	plume_traction_result run;
+	plume_status status = plume_lab_traction(material, sample, &traction, &run, err);
+	if (status != PLUME_OK) {
+		char context[160];
+		if (material->model == PLUME_LAB_MACROSCALE)
+			snprintf(context, sizeof context, "macroscale, E_vw = %.6g Pa, barbs at %.4g deg", material->E_vw,
+			         sample->barb_angle * 180.0 / PI);
+		else
+			snprintf(context, sizeof context, "mesoscale, barbs at %.4g deg", sample->barb_angle * 180.0 / PI);
+		plume_error_prefix(err, context);
+		return status;
+	}
+	result->traction_count += 1;
+	result->solve_count += run.solve_count;
+	*slope = run.slope;
+	plume_traction_result_free(&run);
+	return PLUME_OK;
+}
+
+// A size that holds a whole number of band periods (at least one), so that the barbs
+// cover exactly Phi_B of the longitudinal and transverse samples, as eqs. 5.2 and 5.5 assume.
+static double whole_periods(double size, double period)
+{
+	double count = fmax(1.0, round(size / period));
+	return count * period;
+}
+
+plume_status plume_lab_calibrate(const plume_calibration_def *def, plume_calibration_result *result, plume_error *err)
+{
+	memset(result, 0, sizeof *result);
+	plume_status status = check(def, err);
+	if (status != PLUME_OK)
+		return status;
+	plume_lab_material meso = def->mesoscale;
+	meso.model = PLUME_LAB_MESOSCALE;
+	double width = def->sample.width, height = def->aspect_ratio * def->sample.width;
+
+	// Longitudinal and transverse: the bands deform uniformly, any mesh that resolves them is exact.
+	plume_sample_def straight = def->sample;
+	straight.width = whole_periods(width, meso.bands.period);
+	straight.height = whole_periods(height, meso.bands.period);
+	straight.element_count = 200;
+	straight.barb_angle = 0.0;
+	status =
+	    slope_of(&meso, &straight, def->longitudinal_strain_max, def->steps, result, &result->slope_longitudinal, err);
+	if (status == PLUME_OK) {
+		straight.barb_angle = 0.5 * PI;
+		status =
+		    slope_of(&meso, &straight, def->transverse_strain_max, def->steps, result, &result->slope_transverse, err);
+	}
+	plume_sample_def tilted = def->sample;
+	tilted.height = height;
+	tilted.barb_angle = 0.25 * PI;
+	if (status == PLUME_OK)
+		status = slope_of(&meso, &tilted, def->transverse_strain_max, def->steps, result, &result->slope_tilted, err);
+	if (status != PLUME_OK) {
+		plume_error_prefix(err, "calibration");
+		return status;
+	}
+
+	plume_lab_material macro = plume_lab_material_default(PLUME_LAB_MACROSCALE);
+	macro.E_vv = result->slope_longitudinal;
+	macro.E_ww = result->slope_transverse;
+	macro.barb_constraint = def->barb_constraint;
+	tilted.element_count = def->macroscale_elements;
+	double target = result->slope_tilted;
+
+	// The tilted slope grows with E_vw. Bracket the target in log E_vw, then shrink the
+	// bracket: the Illinois variant of false position, with a bisection step whenever it
+	// would shrink the bracket by less than half.
+	// The search starts at E_ww / 4, near where the thesis's parameters put E_vw, and
+	// widens by doubling: very stiff shear makes the tilted test hard for Newton, so the
+	// bracket should not reach further than it needs.
+	double lo = log(0.25 * macro.E_ww), hi = lo, f_lo = 0.0, f_hi = 0.0, slope = 0.0;
+	macro.E_vw = exp(lo);
+	status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, result, &slope, err);
+	f_lo = f_hi = slope - target;
+	double step = log(2.0);
+	for (int expand = 0; expand < 12 && status == PLUME_OK && (f_lo > 0.0) == (f_hi > 0.0); ++expand) {
+		double x = f_lo > 0.0 ? lo - step : hi + step;
+		macro.E_vw = exp(x);
+		status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, result, &slope, err);
+		// Newton may fail on a very stiff trial: step out by half as far and try again.
+		for (int retry = 0; retry < 4 && status == PLUME_ERROR_NUMERIC; ++retry) {
+			step *= 0.5;
+			x = f_lo > 0.0 ? lo - step : hi + step;
+			macro.E_vw = exp(x);
+			status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, result, &slope, err);
+		}
+		if (f_lo > 0.0) {
+			hi = lo, f_hi = f_lo;
+			lo = x, f_lo = slope - target;
+		} else {
+			lo = hi, f_lo = f_hi;
+			hi = x, f_hi = slope - target;
+		}
+		step *= 1.5;
+	}
+	if (status == PLUME_OK && (f_lo > 0.0) == (f_hi > 0.0))
+		status = plume_error_set(err, PLUME_ERROR_NUMERIC,
+		                         "no E_vw between %g and %g Pa gives the mesoscale tilted slope %g Pa", exp(lo),
+		                         exp(hi), target);
+	int side = 0;
+	while (status == PLUME_OK && hi - lo > log1p(def->tolerance)) {
+		double x = (lo * f_hi - hi * f_lo) / (f_hi - f_lo);
+		double width_before = hi - lo;
+		if (!(x > lo && x < hi))
+			x = 0.5 * (lo + hi);
+		macro.E_vw = exp(x);
+		status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, result, &slope, err);
+		double f = slope - target;
+		result->bisection_iterations += 1;
+		if (f == 0.0) {
+			lo = hi = x;
+			break;
+		}
+		if ((f > 0.0) == (f_hi > 0.0)) {
+			hi = x, f_hi = f;
+			if (side == -1)
+				f_lo *= 0.5; // Illinois: halve the stale end's value
+			side = -1;
+		} else {
+			lo = x, f_lo = f;
+			if (side == 1)
+				f_hi *= 0.5;
+			side = 1;
+		}
+		if (hi - lo > 0.5 * width_before) {
+			// Slow progress: bisect once.
+			double mid = 0.5 * (lo + hi);
+			macro.E_vw = exp(mid);
+			status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, result, &slope, err);
+			result->bisection_iterations += 1;
+			if ((slope - target > 0.0) == (f_hi > 0.0))
+				hi = mid, f_hi = slope - target;
+			else
+				lo = mid, f_lo = slope - target;
+			side = 0;
+		}
+	}
+	if (status != PLUME_OK) {
+		plume_error_prefix(err, "calibration");
+		return status;
+	}
+	// The final modulus: the bracket's false-position point, and its slope.
+	double x = fabs(f_hi - f_lo) > 0.0 ? (lo * f_hi - hi * f_lo) / (f_hi - f_lo) : 0.5 * (lo + hi);
+	if (!(x >= lo && x <= hi))
+		x = 0.5 * (lo + hi);
+	macro.E_vw = exp(x);
+	status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, result, &result->slope_tilted_macroscale,
+	                  err);
+	if (status != PLUME_OK) {
+		plume_error_prefix(err, "calibration");
+		return status;
+	}
+	result->E_vv = macro.E_vv;
+	result->E_ww = macro.E_ww;
+	result->E_vw = macro.E_vw;
+	return PLUME_OK;
+}

@@ -1,0 +1,245 @@
+// The traction scenario (Jouve thesis 4.2, eq. 4.2): bottom edge clamped, top
+// edge moved along y, sides free, solved as a sequence of static problems at
+// evenly spaced measured strains, each warm-started from the previous one.
+#include <math.h>
+#include <string.h>
+
+#include "core/alloc.h"
+#include "plume/lab.h"
+
+plume_lab_material plume_lab_material_default(plume_lab_model model)
+{
+	return (plume_lab_material){
+	    .model = model,
+	    .E_vv = 3.60e8,
+	    .E_ww = 4.80e4,
+	    .E_vw = 4.80e4,
+	    .barb_constraint = false,
+	    .E_B = 2.57e9,
+	    .E_b = 3.92e4,
+	    .bands = plume_band_default_def(),
+	};
+}
+
+plume_traction_def plume_traction_default_def(void)
+{
+	return (plume_traction_def){
+	    .strain_max = 0.4,
+	    .steps = 20,
+	    .solver = plume_sim_default_def().solver,
+	    .require_convergence = true,
+	    .compression = false,
+	    .accept_residual = 0.0,
+	};
+}
+
+plume_sim_def plume_lab_sim_def(const plume_lab_material *material, double thickness, const plume_solver_def *solver)
+{
+	plume_sim_def def = plume_sim_default_def();
+	def.gravity = plume_v3(0.0, 0.0, 0.0);
+	def.bending = false;
+	def.planar = true;
+	if (solver != NULL)
+		def.solver = *solver;
+	// The lab measures the membrane alone: no bending, no Kikuuwe compression term, no mass.
+	plume_material base = plume_material_vane();
+	base.thickness = thickness;
+	base.surface_density = 0.0;
+	base.compression_coefficient = 0.0;
+	if (material->model == PLUME_LAB_MACROSCALE) {
+		plume_material vane = base;
+		vane.kind = PLUME_MATERIAL_ORTHOTROPIC;
+		vane.E_vv = material->barb_constraint ? material->E_ww : material->E_vv;
+		vane.E_ww = material->E_ww;
+		vane.E_vw = material->E_vw;
+		vane.barb_constraint = material->barb_constraint;
+		def.materials[0] = vane;
+		def.materials[1] = vane;
+	} else {
+		// Thesis 5.2: isotropic bands with zero Poisson ratio (no Poisson effect, section 3.3).
+		plume_material band = base;
+		band.kind = PLUME_MATERIAL_ISOTROPIC;
+		band.poisson_ratio = 0.0;
+		band.barb_constraint = false;
+		band.youngs_modulus = material->E_b;
+		def.materials[PLUME_BAND_BARBULE] = band;
+		band.youngs_modulus = material->E_B;
+		def.materials[PLUME_BAND_BARB] = band;
+	}
+	def.material_count = 2;
+	return def;
+}
+
+static bool positive(double value) { return value > 0.0 && isfinite(value); }
+
+plume_status plume_lab_validate(const plume_lab_material *material, const plume_sample_def *sample,
+                                const plume_traction_def *traction, plume_error *err)
+{
+#define REQUIRE(condition, format, ...)                                                                                \
+	if (!(condition))                                                                                                  \
+		return plume_error_set(err, PLUME_ERROR_SPEC, format, __VA_ARGS__);
+	if (material != NULL) {
+		if (material->model == PLUME_LAB_MACROSCALE) {
+			REQUIRE(positive(material->E_ww), "material.E_ww is %g Pa, allowed > 0", material->E_ww);
+			REQUIRE(positive(material->E_vw), "material.E_vw is %g Pa, allowed > 0", material->E_vw);
+			REQUIRE(material->barb_constraint || positive(material->E_vv),
+			        "material.E_vv is %g Pa, allowed > 0 (or barb_constraint true)", material->E_vv);
+			REQUIRE(!material->barb_constraint || sample == NULL || sample->mesh == PLUME_SAMPLE_ALIGNED, "%s",
+			        "material.barb_constraint needs an aligned mesh (sample.mesh \"aligned\")");
+		} else if (material->model == PLUME_LAB_MESOSCALE) {
+			REQUIRE(positive(material->E_B), "material.E_B is %g Pa, allowed > 0", material->E_B);
+			REQUIRE(positive(material->E_b), "material.E_b is %g Pa, allowed > 0", material->E_b);
+			REQUIRE(material->bands.barb_fraction > 0.0 && material->bands.barb_fraction < 1.0,
+			        "material.barb_fraction is %g, allowed in (0, 1)", material->bands.barb_fraction);
+			REQUIRE(positive(material->bands.period), "material.band_period is %g m, allowed > 0",
+			        material->bands.period);
+			REQUIRE(sample == NULL || sample->mesh == PLUME_SAMPLE_ALIGNED, "%s",
+			        "sample.mesh is unaligned, but the mesoscale model needs an aligned mesh that resolves its bands");
+		} else {
+			REQUIRE(false, "material.model is %d, allowed macroscale or mesoscale", (int)material->model);
+		}
+	}
+	if (traction != NULL) {
+		REQUIRE(positive(traction->strain_max) && traction->strain_max <= 10.0,
+		        "traction.strain_max is %g, allowed in (0, 10]", traction->strain_max);
+		REQUIRE(traction->steps >= 1 && traction->steps <= 100000, "traction.steps is %d, allowed in [1, 100000]",
+		        traction->steps);
+		REQUIRE(positive(traction->solver.tolerance), "traction.tolerance is %g, allowed > 0",
+		        traction->solver.tolerance);
+		REQUIRE(traction->solver.max_iterations >= 1, "traction.max_iterations is %d, allowed >= 1",
+		        traction->solver.max_iterations);
+		REQUIRE(traction->accept_residual >= 0.0 && traction->accept_residual < 1.0,
+		        "traction.accept_residual is %g, allowed in [0, 1)", traction->accept_residual);
+		REQUIRE(traction->solver.max_substep_halvings >= 0 && traction->solver.max_substep_halvings <= 16,
+		        "traction.max_substep_halvings is %d, allowed in [0, 16]", traction->solver.max_substep_halvings);
+	}
+#undef REQUIRE
+	return PLUME_OK;
+}
+
+void plume_traction_result_free(plume_traction_result *result)
+{
+	plume_free(result->strain);
+	plume_free(result->stress);
+	plume_free(result->displacement);
+	plume_free(result->iterations);
+	plume_free(result->converged);
+	plume_free(result->residual);
+	plume_free(result->positions);
+	memset(result, 0, sizeof *result);
+}
+
+static plume_status allocate_result(plume_traction_result *r, int count, int vertex_count, plume_error *err)
+{
+	memset(r, 0, sizeof *r);
+	r->count = count;
+	r->vertex_count = vertex_count;
+	r->strain = plume_calloc((size_t)count, sizeof *r->strain);
+	r->stress = plume_calloc((size_t)count, sizeof *r->stress);
+	r->displacement = plume_calloc((size_t)count, sizeof *r->displacement);
+	r->iterations = plume_calloc((size_t)count, sizeof *r->iterations);
+	r->converged = plume_calloc((size_t)count, sizeof *r->converged);
+	r->residual = plume_calloc((size_t)count, sizeof *r->residual);
+	r->positions = plume_calloc((size_t)vertex_count, sizeof *r->positions);
+	if (!r->strain || !r->stress || !r->displacement || !r->iterations || !r->converged || !r->residual ||
+	    !r->positions) {
+		plume_traction_result_free(r);
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory for the traction results");
+	}
+	return PLUME_OK;
+}
+
+// Relative change of the sample's width: mean x of the right side's vertices minus that of
+// the left side's, over W.
+static double lateral_strain(const plume_mesh *mesh, const plume_vec3 *x, double width)
+{
+	double tolerance = 1e-9 * width, left = 0.0, right = 0.0;
+	int left_count = 0, right_count = 0;
+	for (int i = 0; i < mesh->vertex_count; ++i) {
+		if (fabs(mesh->reference[i].x) <= tolerance) {
+			left += x[i].x;
+			++left_count;
+		} else if (fabs(mesh->reference[i].x - width) <= tolerance) {
+			right += x[i].x;
+			++right_count;
+		}
+	}
+	if (left_count == 0 || right_count == 0)
+		return 0.0;
+	return (right / right_count - left / left_count) / width - 1.0;
+}
+
+plume_status plume_lab_traction(const plume_lab_material *material, const plume_sample_def *sample,
+                                const plume_traction_def *def, plume_traction_result *result, plume_error *err)
+{
+	memset(result, 0, sizeof *result);
+	plume_status status = plume_lab_validate(material, sample, def, err);
+	if (status != PLUME_OK)
+		return status;
+	plume_mesh *mesh = NULL;
+	status = plume_sample_mesh(sample, material->model == PLUME_LAB_MESOSCALE ? &material->bands : NULL, &mesh, err);
+	if (status != PLUME_OK)
+		return status;
+	plume_sim_def sim_def = plume_lab_sim_def(material, sample->thickness, &def->solver);
+	plume_sim *sim = NULL;
+	status = plume_sim_create(mesh, &sim_def, &sim, err);
+	if (status != PLUME_OK) {
+		plume_mesh_destroy(mesh);
+		return status;
+	}
+	int bottom = plume_sim_add_handle(sim, "bottom", err);
+	int top = bottom >= 0 ? plume_sim_add_handle(sim, "top", err) : -1;
+	if (top < 0) {
+		plume_sim_destroy(sim);
+		plume_mesh_destroy(mesh);
+		return err != NULL && err->status != PLUME_OK ? err->status : PLUME_ERROR_NUMERIC;
+	}
+	plume_traction_result r;
+	status = allocate_result(&r, def->steps + 1, mesh->vertex_count, err);
+	double W = sample->width, H = sample->height, b = sample->thickness;
+	plume_vec3 origin = plume_v3(0.0, 0.0, 0.0);
+	plume_mat3 identity = plume_m3_identity();
+	if (status == PLUME_OK)
+		r.converged[0] = true;
+	for (int i = 1; i <= def->steps && status == PLUME_OK; ++i) {
+		// Evenly spaced measured strains (the slope's quadrature needs them evenly spaced).
+		double strain = (def->compression ? -1.0 : 1.0) * def->strain_max * i / def->steps;
+		double d = plume_lab_displacement_for_strain(H, strain);
+		plume_sim_set_handle(sim, bottom, origin, identity, origin);
+		plume_sim_set_handle(sim, top, plume_v3(0.0, d, 0.0), identity, origin);
+		plume_solve_report report = {0};
+		plume_error step_err = {0};
+		plume_status solved = plume_sim_solve_static(sim, &report, &step_err);
+		r.solve_count += report.substeps > 0 ? report.substeps : 1;
+		r.newton_iterations += report.newton_iterations;
+		r.iterations[i] = report.newton_iterations;
+		r.converged[i] = solved == PLUME_OK;
+		plume_vec3 force = {0.0, 0.0, 0.0};
+		plume_sim_group_reaction(sim, "top", &force);
+		r.residual[i] = report.gradient_norm / fmax(fabs(force.y), 1e-300);
+		bool accepted = solved == PLUME_OK || (solved == PLUME_ERROR_NUMERIC && r.residual[i] <= def->accept_residual);
+		if (!accepted && (def->require_convergence || solved != PLUME_ERROR_NUMERIC)) {
+			status = plume_error_set(err, solved, "traction step %d of %d (strain %g) failed: %s", i, def->steps,
+			                         strain, step_err.message);
+			break;
+		}
+		r.strain[i] = plume_lab_measured_strain(H, d);
+		r.displacement[i] = d;
+		// f: the y force the clamp applies on the sample (the reaction the sim reports).
+		r.stress[i] = plume_lab_measured_stress(W, H, b, d, force.y);
+		if (!isfinite(r.stress[i]))
+			status = plume_error_set(err, PLUME_ERROR_NUMERIC, "traction step %d of %d gave a stress of %g", i,
+			                         def->steps, r.stress[i]);
+	}
+	if (status == PLUME_OK) {
+		memcpy(r.positions, plume_sim_positions(sim), sizeof(plume_vec3) * (size_t)mesh->vertex_count);
+		r.slope = plume_lab_slope(r.strain, r.stress, r.count);
+		r.lateral_strain = lateral_strain(mesh, r.positions, W);
+		*result = r;
+	} else if (r.strain != NULL) {
+		plume_traction_result_free(&r);
+	}
+	plume_sim_destroy(sim);
+	plume_mesh_destroy(mesh);
+	return status;
+}

@@ -1,0 +1,112 @@
+#!/usr/bin/env bash
+# Scenario tests of `plume lab`: a traction test from a lab file, the
+# calibration's usage errors, bad lab files that write nothing, a quick study.
+# Usage: lab.sh PLUME_BINARY SOURCE_DIR
+set -u
+plume=$1
+source_dir=$2
+examples=$source_dir/examples/lab
+scratch=$(mktemp -d /tmp/plume-cli-lab-XXXXXX)
+trap 'rm -rf "$scratch"' EXIT
+export OMP_NUM_THREADS=${OMP_NUM_THREADS:-1}
+passed=0
+failed=0
+
+check() { # check NAME CONDITION...
+	local name=$1
+	shift
+	if "$@"; then
+		passed=$((passed + 1))
+	else
+		failed=$((failed + 1))
+		echo "FAIL: $name" >&2
+	fi
+}
+
+# expect_failure NAME EXIT_CODE MESSAGE_FRAGMENT COMMAND...: the exit code and the message on stderr.
+expect_failure() {
+	local name=$1 code=$2 fragment=$3
+	shift 3
+	"$@" >"$scratch/out.txt" 2>"$scratch/err.txt"
+	local got=$?
+	check "$name: exit $code (got $got)" test "$got" -eq "$code"
+	if ! grep -qF -- "$fragment" "$scratch/err.txt"; then
+		failed=$((failed + 1))
+		echo "FAIL: $name: stderr lacks '$fragment': $(cat "$scratch/err.txt")" >&2
+	else
+		passed=$((passed + 1))
+	fi
+}
+
+# --- traction: the transverse mesoscale test gives eq. 5.5 -------------------
+out=$scratch/transverse
+"$plume" lab traction "$examples/transverse-mesoscale.json" -o "$out" >"$scratch/out.txt" 2>"$scratch/err.txt"
+check "traction succeeds ($(cat "$scratch/err.txt"))" test $? -eq 0
+for file in traction.csv traction.json traction.png traction.svg; do
+	check "traction: $file written" test -s "$out/$file"
+done
+check "traction: only the four files" test "$(ls -A "$out" | wc -l)" -eq 4
+check "traction: 21 rows and a header" test "$(wc -l <"$out/traction.csv")" -eq 22
+check "traction: CSV header" grep -q '^strain,stress_pa,displacement_m,newton_iterations,converged$' "$out/traction.csv"
+check "traction: PNG signature" bash -c "head -c 8 '$out/traction.png' | od -An -tx1 | grep -q '89 50 4e 47 0d 0a 1a 0a'"
+check "traction: SVG root" grep -q '<svg' "$out/traction.svg"
+# Eq. 5.5: 1.22452 E_b = 48001 Pa at E_b = 3.92e4 Pa, within 1e-3.
+slope=$(sed -n 's/.*"slope_pa": \([0-9.e+-]*\).*/\1/p' "$out/traction.json")
+check "traction: slope $slope within 1e-3 of eq. 5.5" awk -v s="$slope" 'BEGIN { r = s / (1.2245181125 * 39200); exit !(r > 0.999 && r < 1.001) }'
+check "traction: slope printed" grep -q '^slope: ' "$scratch/out.txt"
+# Same input, same bytes.
+"$plume" lab traction "$examples/transverse-mesoscale.json" -o "$scratch/again" >/dev/null 2>&1
+for file in traction.csv traction.json traction.png traction.svg; do
+	check "traction: $file deterministic" cmp -s "$out/$file" "$scratch/again/$file"
+done
+
+# --- bad lab files: clear errors, nothing written ----------------------------
+bad() { # bad NAME JSON FRAGMENT
+	printf '%s\n' "$2" >"$scratch/bad.json"
+	expect_failure "$1" 3 "$3" "$plume" lab traction "$scratch/bad.json" -o "$scratch/bad-out"
+	check "$1: nothing written" test ! -e "$scratch/bad-out"
+}
+bad "barb fraction 0" '{"material": {"model": "mesoscale", "barb_fraction": 0}}' 'bad.json: $.material.barb_fraction is 0, allowed in (0, 1)'
+bad "barb fraction 1" '{"material": {"model": "mesoscale", "barb_fraction": 1}}' '$.material.barb_fraction'
+bad "negative modulus" '{"material": {"model": "mesoscale", "E_b": -1}}' '$.material.E_b is -1 Pa, allowed > 0'
+bad "zero E_ww" '{"material": {"E_ww": 0}}' '$.material.E_ww'
+bad "negative width" '{"sample": {"width": -1}}' '$.sample.width is -1 m, allowed > 0'
+bad "zero thickness" '{"sample": {"thickness": 0}}' '$.sample.thickness'
+bad "zero strain" '{"traction": {"strain_max": 0}}' '$.traction.strain_max is 0'
+bad "unknown key" '{"traction": {"strain_mx": 0.1}}' 'strain_max'
+bad "bad mesh" '{"sample": {"mesh": "random"}}' '$.sample.mesh'
+expect_failure "missing file" 4 "missing.json" "$plume" lab traction "$scratch/missing.json" -o "$scratch/x"
+check "missing file: nothing written" test ! -e "$scratch/x"
+expect_failure "no output" 2 "missing -o DIR" "$plume" lab traction "$examples/transverse-mesoscale.json"
+expect_failure "no action" 2 "missing the action" "$plume" lab
+expect_failure "unknown action" 2 "unknown action 'pull'" "$plume" lab pull
+
+# --- calibrate: usage and value errors ---------------------------------------
+expect_failure "calibrate without moduli" 2 "needs --phi, --Eb and --EB" "$plume" lab calibrate --phi 0.14
+expect_failure "calibrate phi 0" 3 "allowed in (0, 1)" "$plume" lab calibrate --phi 0 --Eb 3.92e4 --EB 2.57e9
+expect_failure "calibrate phi 1.5" 3 "allowed in (0, 1)" "$plume" lab calibrate --phi 1.5 --Eb 3.92e4 --EB 2.57e9
+expect_failure "calibrate negative Eb" 3 "E_b is -1" "$plume" lab calibrate --phi 0.14 --Eb -1 --EB 2.57e9
+expect_failure "calibrate aspect" 3 "aspect ratio" "$plume" lab calibrate --phi 0.14 --Eb 3.92e4 --EB 2.57e9 --aspect 0.0001
+expect_failure "calibrate not a number" 2 "--aspect expects a number" "$plume" lab calibrate --phi 0.14 --Eb 3.92e4 --EB 2.57e9 --aspect tall
+# A coarse, quick calibration: E_vv and E_ww of thesis Table 5.2.
+"$plume" lab calibrate --phi 0.14 --Eb 3.92e4 --EB 2.57e9 --elements 600 --macro-elements 300 --unconstrained >"$scratch/cal.json" 2>"$scratch/err.txt"
+check "calibrate succeeds ($(cat "$scratch/err.txt"))" test $? -eq 0
+check "calibrate: JSON" python3 -c "
+import json, sys
+text = open('$scratch/cal.json').read()
+r = json.loads(text[text.index('{'):])  # CHOLMOD (sim) may print warnings on stdout first
+assert abs(r['E_vv'] / 3.60e8 - 1) < 0.01 and abs(r['E_ww'] / 4.80e4 - 1) < 0.01 and r['E_vw'] > 0
+assert r['solves'] > 0 and 'tilted_mesoscale' in r['slopes']
+"
+
+# --- study ---------------------------------------------------------------------
+expect_failure "unknown study" 2 "unknown study 'bending'" "$plume" lab study bending -o "$scratch/s"
+"$plume" lab study size -o "$scratch/size" --scale 0.25 >"$scratch/out.txt" 2>"$scratch/err.txt"
+check "size study succeeds ($(cat "$scratch/err.txt"))" test $? -eq 0
+for file in size.csv size.png size.svg; do
+	check "size study: $file written" test -s "$scratch/size/$file"
+done
+check "size study: summary" grep -q '"study": "size"' "$scratch/out.txt"
+
+echo "$passed passed, $failed failed"
+test "$failed" -eq 0
