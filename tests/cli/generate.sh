@@ -2,41 +2,8 @@
 # Scenario tests of `plume generate`, `plume demo` and the help: what a user
 # runs, what they get back, and that bad input changes nothing.
 # Usage: generate.sh PLUME_BINARY SOURCE_DIR
-set -u
-plume=$1
-source_dir=$2
+source "$(dirname "$0")/../cli_support.sh" "$@"
 presets=$source_dir/examples/franco-walter
-scratch=$(mktemp -d /tmp/plume-cli-XXXXXX)
-trap 'rm -rf "$scratch"' EXIT
-passed=0
-failed=0
-
-check() { # check NAME CONDITION...
-	local name=$1
-	shift
-	if "$@"; then
-		passed=$((passed + 1))
-	else
-		failed=$((failed + 1))
-		echo "FAIL: $name" >&2
-	fi
-}
-
-# expect_failure NAME EXIT_CODE MESSAGE_FRAGMENT COMMAND...: the exit code, the
-# message on stderr, and no output folder left behind.
-expect_failure() {
-	local name=$1 code=$2 fragment=$3
-	shift 3
-	"$@" >"$scratch/out.txt" 2>"$scratch/err.txt"
-	local got=$?
-	check "$name: exit $code (got $got)" test "$got" -eq "$code"
-	if ! grep -qF -- "$fragment" "$scratch/err.txt"; then
-		failed=$((failed + 1))
-		echo "FAIL: $name: stderr lacks '$fragment': $(cat "$scratch/err.txt")" >&2
-	else
-		passed=$((passed + 1))
-	fi
-}
 
 no_leftovers() { # nothing but the expected entries in the scratch folder
 	! ls -A "$scratch" | grep -q 'plume-staging'
@@ -134,5 +101,4 @@ done
 "$plume" demo -o "$scratch/demo2" >/dev/null
 check "demo is deterministic" cmp -s "$scratch/plume-demo/feather.json" "$scratch/demo2/feather.json"
 
-echo "$passed passed, $failed failed"
-[ "$failed" -eq 0 ]
+finish

@@ -2,41 +2,8 @@
 # Scenario tests of `plume lab`: a traction test from a lab file, the
 # calibration's usage errors, bad lab files that write nothing, a quick study.
 # Usage: lab.sh PLUME_BINARY SOURCE_DIR
-set -u
-plume=$1
-source_dir=$2
+source "$(dirname "$0")/../cli_support.sh" "$@"
 examples=$source_dir/examples/lab
-scratch=$(mktemp -d /tmp/plume-cli-lab-XXXXXX)
-trap 'rm -rf "$scratch"' EXIT
-export OMP_NUM_THREADS=${OMP_NUM_THREADS:-1}
-passed=0
-failed=0
-
-check() { # check NAME CONDITION...
-	local name=$1
-	shift
-	if "$@"; then
-		passed=$((passed + 1))
-	else
-		failed=$((failed + 1))
-		echo "FAIL: $name" >&2
-	fi
-}
-
-# expect_failure NAME EXIT_CODE MESSAGE_FRAGMENT COMMAND...: the exit code and the message on stderr.
-expect_failure() {
-	local name=$1 code=$2 fragment=$3
-	shift 3
-	"$@" >"$scratch/out.txt" 2>"$scratch/err.txt"
-	local got=$?
-	check "$name: exit $code (got $got)" test "$got" -eq "$code"
-	if ! grep -qF -- "$fragment" "$scratch/err.txt"; then
-		failed=$((failed + 1))
-		echo "FAIL: $name: stderr lacks '$fragment': $(cat "$scratch/err.txt")" >&2
-	else
-		passed=$((passed + 1))
-	fi
-}
 
 # --- traction: the transverse mesoscale test gives eq. 5.5 -------------------
 out=$scratch/transverse
@@ -108,5 +75,4 @@ for file in size.csv size.png size.svg; do
 done
 check "size study: summary" grep -q '"study": "size"' "$scratch/out.txt"
 
-echo "$passed passed, $failed failed"
-test "$failed" -eq 0
+finish

@@ -2,38 +2,7 @@
 # Scenario tests of `plume mesh`: a feather spec and a guides spec meshed into
 # DIR/mesh.obj, mesh.png and report.json; bad input fails clearly and writes nothing.
 # Usage: mesh.sh PLUME_BINARY SOURCE_DIR
-set -u
-plume=$1
-source_dir=$2
-scratch=$(mktemp -d /tmp/plume-cli-XXXXXX)
-trap 'rm -rf "$scratch"' EXIT
-passed=0
-failed=0
-
-check() { # check NAME CONDITION...
-	local name=$1
-	shift
-	if "$@"; then
-		passed=$((passed + 1))
-	else
-		failed=$((failed + 1))
-		echo "FAIL: $name" >&2
-	fi
-}
-
-expect_failure() { # NAME EXIT_CODE MESSAGE_FRAGMENT COMMAND...
-	local name=$1 code=$2 fragment=$3
-	shift 3
-	"$@" >"$scratch/out.txt" 2>"$scratch/err.txt"
-	local got=$?
-	check "$name: exit $code (got $got)" test "$got" -eq "$code"
-	if grep -qF -- "$fragment" "$scratch/err.txt"; then
-		passed=$((passed + 1))
-	else
-		failed=$((failed + 1))
-		echo "FAIL: $name: stderr lacks '$fragment': $(cat "$scratch/err.txt")" >&2
-	fi
-}
+source "$(dirname "$0")/../cli_support.sh" "$@"
 
 # A feather spec, twice: the same bytes.
 "$plume" mesh "$source_dir/examples/franco-walter/hawk.json" -o "$scratch/hawk" 2>"$scratch/err.txt"
@@ -74,5 +43,4 @@ check "missing file: nothing written" test ! -e "$scratch/nope"
 "$plume" help mesh >"$scratch/help.txt" 2>&1
 check "help mentions guides spec" grep -q "guides spec" "$scratch/help.txt"
 
-echo "$passed passed, $failed failed"
-test "$failed" -eq 0
+finish

@@ -3,45 +3,9 @@
 # a two-triangle shell and a turned copy of it as frames), same bytes on a second run, and bad inputs that
 # leave nothing behind.
 # Usage: render.sh PLUME_BINARY SOURCE_DIR
-set -u
-plume=$1
-source_dir=$2
+source "$(dirname "$0")/../cli_support.sh" "$@"
 presets=$source_dir/examples/franco-walter
-scratch=$(mktemp -d /tmp/plume-cli-render-XXXXXX)
-trap 'rm -rf "$scratch"' EXIT
-passed=0
-failed=0
-
-check() { # check NAME CONDITION...
-	local name=$1
-	shift
-	if "$@"; then
-		passed=$((passed + 1))
-	else
-		failed=$((failed + 1))
-		echo "FAIL: $name" >&2
-	fi
-}
-
 differs() { ! cmp -s "$1" "$2"; }
-
-# expect_failure NAME EXIT_CODE MESSAGE_FRAGMENT OUTPUT_DIR COMMAND...: the exit code, the message on
-# stderr, and no output folder left behind.
-expect_failure() {
-	local name=$1 code=$2 fragment=$3 out=$4
-	shift 4
-	"$@" >"$scratch/out.txt" 2>"$scratch/err.txt"
-	local got=$?
-	check "$name: exit $code (got $got)" test "$got" -eq "$code"
-	if ! grep -qF -- "$fragment" "$scratch/err.txt"; then
-		failed=$((failed + 1))
-		echo "FAIL: $name: stderr lacks '$fragment': $(cat "$scratch/err.txt")" >&2
-	else
-		passed=$((passed + 1))
-	fi
-	check "$name: nothing written" test ! -e "$out"
-	check "$name: no staging left" test -z "$(ls -A "$scratch" | grep plume-staging)"
-}
 
 # --- a feather spec
 "$plume" render "$presets/figure6a.json" -o "$scratch/spec" --spp 2 --size 64x96 2>"$scratch/err.txt"
@@ -100,37 +64,37 @@ png_width() { od -An -tu1 -j16 -N4 "$1" | awk '{print $1 * 16777216 + $2 * 65536
 check "sim --strip: strip.png two frames wide" test "$(png_width "$scratch/strip/strip.png")" -eq 96
 
 # --- bad inputs
-expect_failure "missing input" 4 "cannot read" "$scratch/o1" "$plume" render "$scratch/nothing.json" -o "$scratch/o1"
+expect_no_output "missing input" 4 "cannot read" "$scratch/o1" "$plume" render "$scratch/nothing.json" -o "$scratch/o1"
 mkdir -p "$scratch/nosim"
 cp "$sim/feather.json" "$sim/mesh.obj" "$scratch/nosim/"
 touch "$scratch/nosim/frames" # a file, not a folder
-expect_failure "unreadable frames folder" 4 "cannot read the frames folder" "$scratch/o2" \
+expect_no_output "unreadable frames folder" 4 "cannot read the frames folder" "$scratch/o2" \
 	"$plume" render "$scratch/nosim" -o "$scratch/o2"
 mkdir -p "$scratch/badframe/frames"
 cp "$sim/feather.json" "$sim/mesh.obj" "$scratch/badframe/"
 printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' >"$scratch/badframe/frames/0000.obj"
-expect_failure "frame with other vertices" 3 "frames must keep the shell's vertices" "$scratch/o3" \
+expect_no_output "frame with other vertices" 3 "frames must keep the shell's vertices" "$scratch/o3" \
 	"$plume" render "$scratch/badframe" -o "$scratch/o3"
 printf '{"camera": {"eye": [0, 0.04, 0], "target": [0, 0.04, -1]}}' >"$scratch/inside.json"
-expect_failure "camera inside" 3 "inside the scene's bounds" "$scratch/o4" \
+expect_no_output "camera inside" 3 "inside the scene's bounds" "$scratch/o4" \
 	"$plume" render "$presets/figure6a.json" -o "$scratch/o4" -c "$scratch/inside.json" --size 32x32
 printf '{"camera": {"eye": [0, 0.04, 0.5], "target": [0, 0.04, 1]}}' >"$scratch/away.json"
-expect_failure "camera looking at nothing" 3 "sees none of the scene" "$scratch/o5" \
+expect_no_output "camera looking at nothing" 3 "sees none of the scene" "$scratch/o5" \
 	"$plume" render "$presets/figure6a.json" -o "$scratch/o5" -c "$scratch/away.json" --size 32x32
-expect_failure "camera looking at nothing (sim)" 3 "sees none of the scene" "$scratch/o5b" \
+expect_no_output "camera looking at nothing (sim)" 3 "sees none of the scene" "$scratch/o5b" \
 	"$plume" render "$sim" -o "$scratch/o5b" -c "$scratch/away.json" --size 32x32
 printf 'not an image' >"$scratch/bad.png"
-expect_failure "unreadable texture" 3 "bad.png" "$scratch/o6" \
+expect_no_output "unreadable texture" 3 "bad.png" "$scratch/o6" \
 	"$plume" render "$presets/figure6a.json" -o "$scratch/o6" -t "$scratch/bad.png"
-expect_failure "missing texture" 4 "missing.png" "$scratch/o7" \
+expect_no_output "missing texture" 4 "missing.png" "$scratch/o7" \
 	"$plume" render "$presets/figure6a.json" -o "$scratch/o7" -t "$scratch/missing.png"
 printf '{"camera": {"fov": 30}}' >"$scratch/typo.json"
-expect_failure "camera key typo" 3 'typo.json: $.camera.fov: unknown key' "$scratch/o8" \
+expect_no_output "camera key typo" 3 'typo.json: $.camera.fov: unknown key' "$scratch/o8" \
 	"$plume" render "$presets/figure6a.json" -o "$scratch/o8" -c "$scratch/typo.json"
-expect_failure "bad spp" 2 "--spp" "$scratch/o9" "$plume" render "$presets/figure6a.json" -o "$scratch/o9" --spp 0
-expect_failure "strip of a spec" 2 "--strip needs a simulation folder" "$scratch/o11" \
+expect_no_output "bad spp" 2 "--spp" "$scratch/o9" "$plume" render "$presets/figure6a.json" -o "$scratch/o9" --spp 0
+expect_no_output "strip of a spec" 2 "--strip needs a simulation folder" "$scratch/o11" \
 	"$plume" render "$presets/figure6a.json" -o "$scratch/o11" --strip 3
-expect_failure "turntable of a sim" 2 "--turntable needs a feather spec" "$scratch/o10" \
+expect_no_output "turntable of a sim" 2 "--turntable needs a feather spec" "$scratch/o10" \
 	"$plume" render "$sim" -o "$scratch/o10" --turntable 3
 
 # An existing output folder keeps what it had when a render fails.
@@ -139,5 +103,4 @@ echo keep >"$scratch/keep/note.txt"
 "$plume" render "$presets/figure6a.json" -o "$scratch/keep" -c "$scratch/away.json" 2>/dev/null
 check "failed render keeps the folder as it was" test "$(ls -A "$scratch/keep")" = "note.txt"
 
-echo "$passed passed, $failed failed"
-test "$failed" -eq 0
+finish

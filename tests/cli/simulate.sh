@@ -2,38 +2,7 @@
 # Scenario tests of `plume simulate`: a short scene writes its mesh, feather,
 # frames, stats and summary; bad scenes write nothing and name the key.
 # Usage: simulate.sh PLUME_BINARY SOURCE_DIR
-set -u
-plume=$1
-source_dir=$2
-scratch=$(mktemp -d /tmp/plume-cli-XXXXXX)
-trap 'rm -rf "$scratch"' EXIT
-passed=0
-failed=0
-
-check() { # check NAME CONDITION...
-	local name=$1
-	shift
-	if "$@"; then
-		passed=$((passed + 1))
-	else
-		failed=$((failed + 1))
-		echo "FAIL: $name" >&2
-	fi
-}
-
-expect_failure() { # expect_failure NAME EXIT_CODE MESSAGE_FRAGMENT COMMAND...
-	local name=$1 code=$2 fragment=$3
-	shift 3
-	"$@" >"$scratch/out.txt" 2>"$scratch/err.txt"
-	local got=$?
-	check "$name: exit $code (got $got)" test "$got" -eq "$code"
-	if ! grep -qF -- "$fragment" "$scratch/err.txt"; then
-		failed=$((failed + 1))
-		echo "FAIL: $name: stderr lacks '$fragment': $(cat "$scratch/err.txt")" >&2
-	else
-		passed=$((passed + 1))
-	fi
-}
+source "$(dirname "$0")/../cli_support.sh" "$@"
 
 # A short swing: the blue feather held at its base, 5 steps, PNG frames.
 cat >"$scratch/swing.json" <<JSON
@@ -90,5 +59,4 @@ expect_failure "no output" 2 "missing -o DIR" "$plume" simulate "$scratch/swing.
 "$plume" help simulate | grep -q "frames/NNNN.obj"
 check "help describes the outputs" test $? -eq 0
 
-echo "$passed passed, $failed failed"
-test "$failed" -eq 0
+finish

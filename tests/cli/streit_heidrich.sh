@@ -3,44 +3,9 @@
 # `plume grow` and of `plume coat`: what a user runs, what they get back, and
 # that bad input changes nothing.
 # Usage: streit_heidrich.sh PLUME_BINARY SOURCE_DIR
-set -u
-plume=$1
-source_dir=$2
+source "$(dirname "$0")/../cli_support.sh" "$@"
 presets=$source_dir/examples/streit-heidrich
 coats=$source_dir/examples/coats
-scratch=$(mktemp -d /tmp/plume-cli-sh-XXXXXX)
-trap 'rm -rf "$scratch"' EXIT
-passed=0
-failed=0
-
-check() { # check NAME CONDITION...
-	local name=$1
-	shift
-	if "$@"; then
-		passed=$((passed + 1))
-	else
-		failed=$((failed + 1))
-		echo "FAIL: $name" >&2
-	fi
-}
-
-# expect_failure NAME EXIT_CODE MESSAGE_FRAGMENT OUTPUT_DIR COMMAND...: the exit code, the message on
-# stderr, and no output folder or staging folder left behind.
-expect_failure() {
-	local name=$1 code=$2 fragment=$3 out=$4
-	shift 4
-	"$@" >"$scratch/out.txt" 2>"$scratch/err.txt"
-	local got=$?
-	check "$name: exit $code (got $got)" test "$got" -eq "$code"
-	if ! grep -qF -- "$fragment" "$scratch/err.txt"; then
-		failed=$((failed + 1))
-		echo "FAIL: $name: stderr lacks '$fragment': $(cat "$scratch/err.txt")" >&2
-	else
-		passed=$((passed + 1))
-	fi
-	check "$name: nothing written" test ! -e "$out"
-	check "$name: no staging left" bash -c "! ls -A '$scratch' | grep -q plume-staging"
-}
 
 # --- every preset generates ---------------------------------------------------
 for spec in "$presets"/*.json; do
@@ -80,13 +45,13 @@ check "grow: one frame is the finished feather" cmp -s "$scratch/grow1/frame-000
 check "grow --style strips" test -s "$scratch/grow-strips/frame-0001.png"
 check "help grow" bash -c "'$plume' help grow | grep -q -- '--frames'"
 
-expect_failure "grow: --unfurl on streit-heidrich" 1 "no unfurling" "$scratch/g1" \
+expect_no_output "grow: --unfurl on streit-heidrich" 1 "no unfurling" "$scratch/g1" \
 	"$plume" grow "$presets/contour.json" -o "$scratch/g1" --frames 3 --unfurl
-expect_failure "grow: frames missing" 2 "missing --frames" "$scratch/g2" \
+expect_no_output "grow: frames missing" 2 "missing --frames" "$scratch/g2" \
 	"$plume" grow "$presets/contour.json" -o "$scratch/g2"
-expect_failure "grow: frames 0" 2 "--frames '0'" "$scratch/g3" \
+expect_no_output "grow: frames 0" 2 "--frames '0'" "$scratch/g3" \
 	"$plume" grow "$presets/contour.json" -o "$scratch/g3" --frames 0
-expect_failure "grow: unknown style" 2 "--style 'paint'" "$scratch/g4" \
+expect_no_output "grow: unknown style" 2 "--style 'paint'" "$scratch/g4" \
 	"$plume" grow "$presets/contour.json" -o "$scratch/g4" --frames 2 --style paint
 
 mkdir -p "$scratch/existing"
@@ -120,36 +85,35 @@ check "help coat" bash -c "'$plume' help coat | grep -q 'COAT.json'"
 bad=$scratch/bad
 mkdir -p "$bad"
 printf '{"model": "streit-heidrich", "key_barbs": [{"position": 0.7, "cvs": [[0,0,0],[1,0,0]]}, {"position": 0.3, "cvs": [[0,0,0],[1,0,0]]}]}' >"$bad/order.json"
-expect_failure "key barbs out of order" 3 'order.json: $.key_barbs[1].position is 0.3, below the key barb before it' \
+expect_no_output "key barbs out of order" 3 'order.json: $.key_barbs[1].position is 0.3, below the key barb before it' \
 	"$scratch/o1" "$plume" generate "$bad/order.json" -o "$scratch/o1"
 printf '{"model": "streit-heidrich", "key_barbs": [{"position": 1.5, "cvs": [[0,0,0],[1,0,0]]}]}' >"$bad/outside.json"
-expect_failure "key barb outside [0, 1]" 3 '$.key_barbs[0].position is 1.5, allowed [0, 1]' "$scratch/o2" \
+expect_no_output "key barb outside [0, 1]" 3 '$.key_barbs[0].position is 1.5, allowed [0, 1]' "$scratch/o2" \
 	"$plume" generate "$bad/outside.json" -o "$scratch/o2"
 printf '{"model": "streit-heidrich", "key_barbs": [{"position": 0.5, "cvs": [[0,0,0]]}]}' >"$bad/one.json"
-expect_failure "one control vertex" 3 '$.key_barbs[0].cvs: a key barb needs 2 to 32 control vertices' "$scratch/o3" \
+expect_no_output "one control vertex" 3 '$.key_barbs[0].cvs: a key barb needs 2 to 32 control vertices' "$scratch/o3" \
 	"$plume" generate "$bad/one.json" -o "$scratch/o3"
 printf '{"model": "streit-heidrich", "rachis_length": -0.1}' >"$bad/negative.json"
-expect_failure "negative length" 3 '$.rachis_length is -0.1, must be a positive length' "$scratch/o4" \
+expect_no_output "negative length" 3 '$.rachis_length is -0.1, must be a positive length' "$scratch/o4" \
 	"$plume" generate "$bad/negative.json" -o "$scratch/o4"
 printf '{"model": "streit-heidrich", "barb_length_scan": {"image": "nothing.png", "base_px": [1, 50], "tip_px": [1, 2]}}' >"$bad/scan.json"
-expect_failure "unreadable scan" 4 'nothing.png: cannot read' "$scratch/o5" \
+expect_no_output "unreadable scan" 4 'nothing.png: cannot read' "$scratch/o5" \
 	"$plume" generate "$bad/scan.json" -o "$scratch/o5"
 printf 'not a png' >"$bad/empty.png"
 printf '{"model": "streit-heidrich", "barb_length_scan": {"image": "empty.png", "base_px": [1, 50], "tip_px": [1, 2]}}' >"$bad/scan2.json"
-expect_failure "undecodable scan" 3 'empty.png: not an image' "$scratch/o6" \
+expect_no_output "undecodable scan" 3 'empty.png: not an image' "$scratch/o6" \
 	"$plume" generate "$bad/scan2.json" -o "$scratch/o6"
-expect_failure "grow a bad spec" 3 '$.rachis_length is -0.1' "$scratch/o7" \
+expect_no_output "grow a bad spec" 3 '$.rachis_length is -0.1' "$scratch/o7" \
 	"$plume" grow "$bad/negative.json" -o "$scratch/o7" --frames 3
 printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n' >"$bad/quad.obj"
 printf '{"model": "coat", "surface": {"type": "mesh", "obj": "quad.obj"}, "follicles": {"layout": "poisson", "spacing": 0.1}, "key_feathers": [{"at": [0, 0, 0], "feather": "%s/key-plume.json"}]}' "$coats" >"$bad/coat-quad.json"
-expect_failure "coat on a non-triangle OBJ" 3 'quad.obj' "$scratch/o8" \
+expect_no_output "coat on a non-triangle OBJ" 3 'quad.obj' "$scratch/o8" \
 	"$plume" coat "$bad/coat-quad.json" -o "$scratch/o8"
 printf '{"model": "coat", "surface": {"type": "plane", "size": [0.05, 0.05]}, "follicles": {"spacing": 0}, "key_feathers": [{"at": [0, 0], "feather": "%s/key-plume.json"}]}' "$coats" >"$bad/coat-zero.json"
-expect_failure "coat with zero spacing" 3 '$.follicles.spacing: is 0' "$scratch/o9" \
+expect_no_output "coat with zero spacing" 3 '$.follicles.spacing: is 0' "$scratch/o9" \
 	"$plume" coat "$bad/coat-zero.json" -o "$scratch/o9"
-expect_failure "coat given a feather spec" 3 'plume coat reads "model": "coat"' "$scratch/o10" \
+expect_no_output "coat given a feather spec" 3 'plume coat reads "model": "coat"' "$scratch/o10" \
 	"$plume" coat "$presets/down.json" -o "$scratch/o10"
-expect_failure "coat: missing -o" 2 "missing -o DIR" "$scratch/o11" "$plume" coat "$coats/sphere.json"
+expect_no_output "coat: missing -o" 2 "missing -o DIR" "$scratch/o11" "$plume" coat "$coats/sphere.json"
 
-echo "$passed passed, $failed failed"
-test "$failed" -eq 0
+finish

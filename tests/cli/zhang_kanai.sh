@@ -4,25 +4,8 @@
 # snapping, growth and unfurling sequences, determinism, and bad specs fail
 # with a clear message and write nothing.
 # Usage: zhang_kanai.sh PLUME_BINARY SOURCE_DIR
-set -u
-plume=$1
-source_dir=$2
+source "$(dirname "$0")/../cli_support.sh" "$@"
 examples=$source_dir/examples/zhang-kanai
-scratch=$(mktemp -d /tmp/plume-zk-XXXXXX)
-trap 'rm -rf "$scratch"' EXIT
-passed=0
-failed=0
-
-check() { # check NAME CONDITION...
-	local name=$1
-	shift
-	if "$@"; then
-		passed=$((passed + 1))
-	else
-		failed=$((failed + 1))
-		echo "FAIL: $name" >&2
-	fi
-}
 
 # --- every example generates, with a summary --------------------------------
 for spec in "$examples"/*.json; do
@@ -103,5 +86,4 @@ bad collar '$.collar.points: has 3 control points' '"collar": {"points": [[0, -0
 bad unknown-key 'did you mean "barb_speed"' '"barb_sped": 0.01'
 bad angle '$.theta_distal_deg is 0, allowed (0, 180)' '"theta_distal_deg": 0'
 
-echo "$passed passed, $failed failed"
-test "$failed" -eq 0
+finish
