@@ -12,26 +12,7 @@
 
 #include "plume/coat.h"
 #include "plume/plume.h"
-
-static double now(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static double cpu_now(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static int compare(const void *a, const void *b)
-{
-	double x = *(const double *)a, y = *(const double *)b;
-	return (x > y) - (x < y);
-}
+#include "bench_support.h"
 
 /// Median seconds to build the coat of spec over runs; prints its size.
 static double time_coat(const char *name, const char *spec, int runs)
@@ -43,21 +24,21 @@ static double time_coat(const char *name, const char *spec, int runs)
 		plume_coat *coat = NULL;
 		plume_error err = {0};
 		plume_spec_options options = {0};
-		double start = now(), cpu_start = cpu_now();
+		double start = bench_now(), cpu_start = bench_cpu_now();
 		if (plume_coat_spec_generate(spec, &options, &coat, &err) != PLUME_OK) {
 			fprintf(stderr, "bench_coat: %s\n", err.message);
 			exit(1);
 		}
-		times[r] = now() - start;
-		cpu[r] = cpu_now() - cpu_start;
+		times[r] = bench_now() - start;
+		cpu[r] = bench_cpu_now() - cpu_start;
 		feathers = plume_coat_feather_count(coat);
 		points = 0;
 		for (int i = 0; i < feathers; ++i)
 			points += plume_feather_get_info(plume_coat_feather(coat, i)).point_count;
 		plume_coat_destroy(coat);
 	}
-	qsort(times, (size_t)runs, sizeof times[0], compare);
-	qsort(cpu, (size_t)runs, sizeof cpu[0], compare);
+	qsort(times, (size_t)runs, sizeof times[0], bench_compare);
+	qsort(cpu, (size_t)runs, sizeof cpu[0], bench_compare);
 	double median = times[runs / 2];
 	// CPU time (all threads) tells what the cores did when other processes share them.
 	printf("%-30s %6d feathers %9lld barb points  median %8.2f ms wall, %8.2f ms CPU (%d runs)\n", name, feathers,

@@ -11,33 +11,7 @@
 #include <time.h>
 
 #include "plume/plume.h"
-
-static double now(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static int compare(const void *a, const void *b)
-{
-	double x = *(const double *)a, y = *(const double *)b;
-	return (x > y) - (x < y);
-}
-
-static double median(double *values, int count)
-{
-	qsort(values, (size_t)count, sizeof *values, compare);
-	return count % 2 ? values[count / 2] : 0.5 * (values[count / 2 - 1] + values[count / 2]);
-}
-
-static void check(plume_status status, const plume_error *err)
-{
-	if (status != PLUME_OK) {
-		fprintf(stderr, "bench_generate: %s\n", err->message);
-		exit(1);
-	}
-}
+#include "bench_support.h"
 
 int main(int argc, char **argv)
 {
@@ -46,22 +20,22 @@ int main(int argc, char **argv)
 	plume_error err = {0};
 	plume_fw_def def;
 	uint64_t seed;
-	check(plume_fw_def_read(spec, &def, &seed, &err), &err);
+	bench_check("bench_generate", plume_fw_def_read(spec, &def, &seed, &err), &err);
 
 	enum { GENERATE_RUNS = 41, EXPORT_RUNS = 5, RENDER_RUNS = 3 };
 	double times[GENERATE_RUNS];
 	plume_feather *feather = NULL;
 	for (int i = 0; i < GENERATE_RUNS; ++i) {
 		plume_feather_destroy(feather);
-		double start = now();
-		check(plume_fw_generate(&def, seed, &feather, &err), &err);
-		times[i] = now() - start;
+		double start = bench_now();
+		bench_check("bench_generate", plume_fw_generate(&def, seed, &feather, &err), &err);
+		times[i] = bench_now() - start;
 	}
 	plume_feather_info info = plume_feather_get_info(feather);
 	printf("feather: %s\n", spec);
 	printf("  barbs %d (%d per vane), points %d, shaft samples %d, memory %.1f MiB\n", info.barb_count,
 	       info.barb_count_left, info.point_count, info.shaft_sample_count, plume_bytes_in_use() / 1048576.0);
-	double generate_median = median(times, GENERATE_RUNS); // sorts: times[0] is then the minimum
+	double generate_median = bench_median(times, GENERATE_RUNS); // sorts: times[0] is then the minimum
 	printf("generate            median %8.3f ms   (min %.3f ms, %d runs, one thread)\n", 1e3 * generate_median,
 	       1e3 * times[0], GENERATE_RUNS);
 
@@ -73,11 +47,11 @@ int main(int argc, char **argv)
 	mallopt(M_TRIM_THRESHOLD, 512 << 20);
 	for (int i = 0; i < GENERATE_RUNS; ++i) {
 		plume_feather_destroy(feather);
-		double start = now();
-		check(plume_fw_generate(&def, seed, &feather, &err), &err);
-		times[i] = now() - start;
+		double start = bench_now();
+		bench_check("bench_generate", plume_fw_generate(&def, seed, &feather, &err), &err);
+		times[i] = bench_now() - start;
 	}
-	generate_median = median(times, GENERATE_RUNS);
+	generate_median = bench_median(times, GENERATE_RUNS);
 	printf("generate, heap kept median %8.3f ms   (min %.3f ms, %d runs, one thread)\n", 1e3 * generate_median,
 	       1e3 * times[0], GENERATE_RUNS);
 
@@ -86,12 +60,12 @@ int main(int argc, char **argv)
 		char path[4096];
 		snprintf(path, sizeof path, "%s/bench-feather.%s", dir, names[format]);
 		for (int i = 0; i < EXPORT_RUNS; ++i) {
-			double start = now();
+			double start = bench_now();
 			plume_status status = format == 0   ? plume_write_obj(feather, path, &err)
 			                      : format == 1 ? plume_write_usda(feather, path, &err)
 			                                    : plume_write_json(feather, path, &err);
-			check(status, &err);
-			times[i] = now() - start;
+			bench_check("bench_generate", status, &err);
+			times[i] = bench_now() - start;
 		}
 		FILE *file = fopen(path, "rb");
 		long size = 0;
@@ -101,7 +75,7 @@ int main(int argc, char **argv)
 			fclose(file);
 		}
 		printf("export %-4s         median %8.1f ms   (%.1f MiB, %d runs)\n", names[format],
-		       1e3 * median(times, EXPORT_RUNS), size / 1048576.0, EXPORT_RUNS);
+		       1e3 * bench_median(times, EXPORT_RUNS), size / 1048576.0, EXPORT_RUNS);
 		remove(path);
 	}
 
@@ -110,11 +84,11 @@ int main(int argc, char **argv)
 	char path[4096];
 	snprintf(path, sizeof path, "%s/bench-feather.png", dir);
 	for (int i = 0; i < RENDER_RUNS; ++i) {
-		double start = now();
-		check(plume_render2d(feather, &render, PLUME_IMAGE_PNG, path, &err), &err);
-		times[i] = now() - start;
+		double start = bench_now();
+		bench_check("bench_generate", plume_render2d(feather, &render, PLUME_IMAGE_PNG, path, &err), &err);
+		times[i] = bench_now() - start;
 	}
-	printf("render PNG 2000x2000 median %8.1f ms   (%d runs)\n", 1e3 * median(times, RENDER_RUNS), RENDER_RUNS);
+	printf("render PNG 2000x2000 median %8.1f ms   (%d runs)\n", 1e3 * bench_median(times, RENDER_RUNS), RENDER_RUNS);
 	remove(path);
 
 	plume_feather_destroy(feather);

@@ -10,21 +10,7 @@
 #include <time.h>
 
 #include "plume/lab.h"
-
-static double now(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static void check(plume_status status, const plume_error *err)
-{
-	if (status != PLUME_OK) {
-		fprintf(stderr, "bench_lab: %s\n", err->message);
-		exit(1);
-	}
-}
+#include "bench_support.h"
 
 static void calibrations(void)
 {
@@ -40,9 +26,9 @@ static void calibrations(void)
 		def.mesoscale.E_B = E_B[k];
 		plume_calibration_result r;
 		plume_error err = {0};
-		double t0 = now();
-		check(plume_lab_calibrate(&def, &r, &err), &err);
-		printf("%6.2f %12.5g %12.5g %12.5g %10.2f %8d %8d\n", phis[k], r.E_vv, r.E_ww, r.E_vw, now() - t0,
+		double t0 = bench_now();
+		bench_check("bench_lab", plume_lab_calibrate(&def, &r, &err), &err);
+		printf("%6.2f %12.5g %12.5g %12.5g %10.2f %8d %8d\n", phis[k], r.E_vv, r.E_ww, r.E_vw, bench_now() - t0,
 		       r.traction_count, r.solve_count);
 		fflush(stdout);
 	}
@@ -59,9 +45,9 @@ static void studies(const char *dir)
 		snprintf(png, sizeof png, "%s/bench-lab-%s.png", dir, name);
 		snprintf(svg, sizeof svg, "%s/bench-lab-%s.svg", dir, name);
 		plume_error err = {0};
-		double t0 = now();
-		check(plume_lab_study(&def, csv, png, svg, summary, sizeof summary, &err), &err);
-		printf("  %-13s %8.2f s  %s\n", name, now() - t0, summary);
+		double t0 = bench_now();
+		bench_check("bench_lab", plume_lab_study(&def, csv, png, svg, summary, sizeof summary, &err), &err);
+		printf("  %-13s %8.2f s  %s\n", name, bench_now() - t0, summary);
 		fflush(stdout);
 	}
 }

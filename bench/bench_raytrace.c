@@ -13,14 +13,7 @@
 #include "plume/embed.h"
 #include "plume/plume.h"
 #include "plume/raytrace.h"
-
-static void check(plume_status status, const plume_error *err)
-{
-	if (status != PLUME_OK) {
-		fprintf(stderr, "bench_raytrace: %s\n", err->message);
-		exit(1);
-	}
-}
+#include "bench_support.h"
 
 int main(int argc, char **argv)
 {
@@ -30,7 +23,7 @@ int main(int argc, char **argv)
 	plume_error err = {0};
 	plume_feather *feather = NULL;
 	plume_spec_options options = {0};
-	check(plume_spec_generate(spec, &options, &feather, &err), &err);
+	bench_check("bench_raytrace", plume_spec_generate(spec, &options, &feather, &err), &err);
 	plume_feather_info info = plume_feather_get_info(feather);
 
 	const plume_feather *list[1] = {feather};
@@ -45,7 +38,7 @@ int main(int argc, char **argv)
 	plume_raytrace_stats stats;
 	double start = omp_get_wtime();
 	clock_t cpu_start = clock();
-	check(plume_raytrace_render_png(&scene, &def, path, &stats, &err), &err);
+	bench_check("bench_raytrace", plume_raytrace_render_png(&scene, &def, path, &stats, &err), &err);
 	double total = omp_get_wtime() - start;
 	double cpu = (double)(clock() - cpu_start) / CLOCKS_PER_SEC;
 	printf("hawk: %d barbs, %d points, %d curve segments\n", info.barb_count, info.point_count, stats.curve_segments);
@@ -56,10 +49,10 @@ int main(int argc, char **argv)
 	// A sequence: mesh the feather, embed its barbs, turn the shell rigidly, rebuild and render each frame.
 	plume_mesh *mesh = NULL;
 	plume_mesh_def mesh_def = plume_mesh_default_def();
-	check(plume_mesh_from_feather(feather, &mesh_def, &mesh, NULL, &err), &err);
+	bench_check("bench_raytrace", plume_mesh_from_feather(feather, &mesh_def, &mesh, NULL, &err), &err);
 	plume_barb_embedding *embedding = NULL;
 	start = omp_get_wtime();
-	check(plume_embedding_create(feather, mesh, &embedding, &err), &err);
+	bench_check("bench_raytrace", plume_embedding_create(feather, mesh, &embedding, &err), &err);
 	double embed_seconds = omp_get_wtime() - start;
 	plume_vec3 *positions = malloc((size_t)mesh->vertex_count * sizeof *positions);
 	const int frames = 4;
@@ -73,13 +66,13 @@ int main(int argc, char **argv)
 			positions[i] = plume_m3_apply(rotation, mesh->rest[i]);
 		plume_feather *moved = NULL;
 		start = omp_get_wtime();
-		check(plume_embedding_apply(embedding, positions, &moved, &err), &err);
+		bench_check("bench_raytrace", plume_embedding_apply(embedding, positions, &moved, &err), &err);
 		apply_seconds += omp_get_wtime() - start;
 		const plume_feather *frame_list[1] = {moved};
 		plume_raytrace_scene frame = {1, frame_list, NULL, NULL};
 		snprintf(path, sizeof path, "%s/bench_raytrace_frame%d.png", dir, f);
 		start = omp_get_wtime();
-		check(plume_raytrace_render_png(&frame, &def, path, NULL, &err), &err);
+		bench_check("bench_raytrace", plume_raytrace_render_png(&frame, &def, path, NULL, &err), &err);
 		render_seconds += omp_get_wtime() - start;
 		plume_feather_destroy(moved);
 	}

@@ -33,9 +33,8 @@ static int run(const char *name, double edge_length)
 		// Handles that select vertices near a point are selected again on the new mesh.
 		for (int h = 0; h < scene->handle_count; ++h) {
 			plume_scene_handle *handle = scene->handles + h;
-			if (handle->near_given &&
-			    plume_mesh_add_group_near(mesh, handle->group, handle->source_group, handle->near, handle->radius,
-			                              &err) != PLUME_OK) {
+			if (handle->near_given && plume_mesh_add_group_near(mesh, handle->group, handle->source_group, handle->near,
+			                                                    handle->radius, &err) != PLUME_OK) {
 				fprintf(stderr, "%s\n", err.message);
 				plume_mesh_destroy(mesh);
 				plume_scene_destroy(scene);

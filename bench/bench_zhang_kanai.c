@@ -11,33 +11,7 @@
 
 #include "plume/plume.h"
 #include "plume/zhang_kanai.h"
-
-static double now(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static int compare(const void *a, const void *b)
-{
-	double x = *(const double *)a, y = *(const double *)b;
-	return (x > y) - (x < y);
-}
-
-static double median(double *values, int count)
-{
-	qsort(values, (size_t)count, sizeof *values, compare);
-	return count % 2 ? values[count / 2] : 0.5 * (values[count / 2 - 1] + values[count / 2]);
-}
-
-static void check(plume_status status, const plume_error *err)
-{
-	if (status != PLUME_OK) {
-		fprintf(stderr, "bench_zhang_kanai: %s\n", err->message);
-		exit(1);
-	}
-}
+#include "bench_support.h"
 
 int main(void)
 {
@@ -56,9 +30,9 @@ int main(void)
 	enum { RUNS = 31, FRAMES = 100 };
 	double times[RUNS];
 	for (int i = 0; i < RUNS; ++i) {
-		double start = now();
-		check(plume_zk_generate(&def, 1, &feather, &report, &err), &err);
-		times[i] = now() - start;
+		double start = bench_now();
+		bench_check("bench_zhang_kanai", plume_zk_generate(&def, 1, &feather, &report, &err), &err);
+		times[i] = bench_now() - start;
 		if (i + 1 < RUNS) {
 			plume_feather_destroy(feather);
 			plume_zk_report_free(&report);
@@ -70,20 +44,20 @@ int main(void)
 	       info.barb_count_left, info.barb_count_right, info.barbule_count, info.point_count, report.t_end);
 	printf("  snapping: %d full, %d partial, %d unsnapped\n", report.snapped_count, report.partial_count,
 	       report.unsnapped_count);
-	double generate_median = median(times, RUNS);
+	double generate_median = bench_median(times, RUNS);
 	printf("generate            median %8.3f ms   (min %.3f ms, %d runs, one thread)\n", 1e3 * generate_median,
 	       1e3 * times[0], RUNS);
 	plume_feather_destroy(feather);
 	plume_zk_report_free(&report);
 
 	def.keep_barbules = false;
-	double start = now();
+	double start = bench_now();
 	for (int i = 0; i < FRAMES; ++i) {
 		def.growth_stage = (double)i / (FRAMES - 1);
-		check(plume_zk_generate(&def, 1, &feather, NULL, &err), &err);
+		bench_check("bench_zhang_kanai", plume_zk_generate(&def, 1, &feather, NULL, &err), &err);
 		plume_feather_destroy(feather);
 	}
-	double total = now() - start;
+	double total = bench_now() - start;
 	printf("growth sequence     %8.3f ms per frame (%d frames t_curr = 0 .. t_end, expansion, barbules not kept)\n",
 	       1e3 * total / FRAMES, FRAMES);
 	return 0;

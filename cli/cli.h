@@ -42,6 +42,13 @@ bool cli_parse_formats(const char *command, const char *list, unsigned *formats)
 /// Parses "WxH" with both in [16, 16384].
 bool cli_parse_size(const char *command, const char *text, int *width, int *height);
 
+/// After the options: exactly one positional argument (named input in the message,
+/// "SPEC.json") and an output folder. False after printing the usage error.
+bool cli_check_arguments(const char *command, int argc, char **argv, const char *input, const char *output_dir);
+
+/// Parses --style: lines or strips.
+bool cli_parse_style(const char *command, const char *text, plume_render_style *style);
+
 /// Parses a decimal seed.
 bool cli_parse_seed(const char *command, const char *text, uint64_t *seed);
 
@@ -79,13 +86,16 @@ typedef struct cli_barb_renderer {
 	plume_raytrace_def def;
 } cli_barb_renderer;
 
+/// The box a scene's sequence stays in: the rest shell grown by the largest handle
+/// translation (at least a tenth of its size), so every frame shares one framing.
+void cli_scene_bounds(const plume_scene *scene, plume_vec3 *lo, plume_vec3 *hi);
+
 /// Frames the box [lo, hi] (the whole sequence's reach) in a width x height image.
-plume_status cli_barb_renderer_begin(cli_barb_renderer *renderer, const plume_feather *feather,
-                                     const plume_mesh *mesh, plume_vec3 lo, plume_vec3 hi, int width, int height,
-                                     int spp, plume_error *err);
+plume_status cli_barb_renderer_begin(cli_barb_renderer *renderer, const plume_feather *feather, const plume_mesh *mesh,
+                                     plume_vec3 lo, plume_vec3 hi, int width, int height, int spp, plume_error *err);
 /// Renders the feather carried by the shell at positions to path (PNG).
-plume_status cli_barb_renderer_frame(const cli_barb_renderer *renderer, const plume_vec3 *positions,
-                                     const char *path, plume_error *err);
+plume_status cli_barb_renderer_frame(const cli_barb_renderer *renderer, const plume_vec3 *positions, const char *path,
+                                     plume_error *err);
 void cli_barb_renderer_end(cli_barb_renderer *renderer);
 
 int cli_generate(int argc, char **argv);

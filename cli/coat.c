@@ -108,12 +108,8 @@ int cli_coat(int argc, char **argv)
 				return CLI_EXIT_USAGE;
 			break;
 		case 'y':
-			if (strcmp(optarg, "lines") == 0)
-				image.style = PLUME_STYLE_LINES;
-			else if (strcmp(optarg, "strips") == 0)
-				image.style = PLUME_STYLE_STRIPS;
-			else
-				return cli_usage_error("coat", "--style '%s': allowed lines, strips", optarg);
+			if (!cli_parse_style("coat", optarg, &image.style))
+				return CLI_EXIT_USAGE;
 			break;
 		case 'g':
 			if (!parse_stage(optarg, &spec_options.stage))
@@ -125,12 +121,8 @@ int cli_coat(int argc, char **argv)
 		default: return cli_usage_error("coat", "unknown option '%s'", argv[optind - 1]);
 		}
 	}
-	if (optind >= argc)
-		return cli_usage_error("coat", "missing COAT.json");
-	if (optind + 1 < argc)
-		return cli_usage_error("coat", "unexpected argument '%s'", argv[optind + 1]);
-	if (output_dir == NULL)
-		return cli_usage_error("coat", "missing -o DIR");
+	if (!cli_check_arguments("coat", argc, argv, "COAT.json", output_dir))
+		return CLI_EXIT_USAGE;
 
 	plume_error err = {0};
 	plume_coat *coat = NULL;

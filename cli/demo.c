@@ -1,7 +1,6 @@
 // plume demo [-o DIR]: the whole path on a built-in feather, no input needed.
 #define _POSIX_C_SOURCE 200809L
 #include <getopt.h>
-#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -43,8 +42,8 @@ typedef struct demo_run {
 	int steps;
 } demo_run;
 
-static plume_status demo_step(void *user, int step, double time, const plume_sim *sim,
-                              const plume_solve_report *report, double wall_seconds, plume_error *err)
+static plume_status demo_step(void *user, int step, double time, const plume_sim *sim, const plume_solve_report *report,
+                              double wall_seconds, plume_error *err)
 {
 	(void)time, (void)report, (void)wall_seconds;
 	demo_run *run = user;
@@ -64,14 +63,8 @@ static plume_status simulate_demo(cli_output *output, plume_scene_summary *summa
 	if (status != PLUME_OK)
 		return status;
 	demo_run run = {output, {0}, (int)(scene->duration / scene->sim.time_step + 0.5)};
-	// Frame the feather and the handle's reach, as plume simulate does.
-	plume_vec3 lo = scene->mesh->rest[0], hi = lo;
-	for (int i = 1; i < scene->mesh->vertex_count; ++i) {
-		plume_vec3 p = scene->mesh->rest[i];
-		lo = plume_v3(fmin(lo.x, p.x), fmin(lo.y, p.y), fmin(lo.z, p.z));
-		hi = plume_v3(fmax(hi.x, p.x), fmax(hi.y, p.y), fmax(hi.z, p.z));
-	}
-	lo.x -= 0.03;
+	plume_vec3 lo, hi;
+	cli_scene_bounds(scene, &lo, &hi);
 	status = cli_barb_renderer_begin(&run.renderer, scene->feather, scene->mesh, lo, hi, 400, 640, 4, err);
 	if (status == PLUME_OK)
 		status = plume_scene_run(scene, demo_step, &run, summary, err);
@@ -128,8 +121,9 @@ int cli_demo(int argc, char **argv)
 		       info.shaft_length, info.barb_count, def.barb_samples);
 		printf("plume demo: Figure 1 on a %d-vertex barb-aligned shell: %d steps, %.1f Newton iterations a step, "
 		       "largest barb strain %.2g, rachis tip deflection %.1f mm\n",
-		       summary.vertex_count, summary.steps, (double)summary.newton_iterations / (summary.steps > 0 ? summary.steps : 1),
-		       summary.max_barb_strain, 1e3 * summary.rachis_tip_deflection);
+		       summary.vertex_count, summary.steps,
+		       (double)summary.newton_iterations / (summary.steps > 0 ? summary.steps : 1), summary.max_barb_strain,
+		       1e3 * summary.rachis_tip_deflection);
 		for (int i = 0; i < output.name_count; ++i)
 			printf("  %s/%s\n", output.dir, output.names[i]);
 	}

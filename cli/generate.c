@@ -88,12 +88,8 @@ int cli_generate(int argc, char **argv)
 		default: return cli_usage_error("generate", "unknown option '%s'", argv[optind - 1]);
 		}
 	}
-	if (optind >= argc)
-		return cli_usage_error("generate", "missing SPEC.json");
-	if (optind + 1 < argc)
-		return cli_usage_error("generate", "unexpected argument '%s'", argv[optind + 1]);
-	if (output_dir == NULL)
-		return cli_usage_error("generate", "missing -o DIR");
+	if (!cli_check_arguments("generate", argc, argv, "SPEC.json", output_dir))
+		return CLI_EXIT_USAGE;
 
 	plume_error err = {0};
 	plume_texture *texture = NULL;

@@ -165,24 +165,16 @@ int cli_grow(int argc, char **argv)
 				return CLI_EXIT_USAGE;
 			break;
 		case 'y':
-			if (strcmp(optarg, "lines") == 0)
-				image.style = PLUME_STYLE_LINES;
-			else if (strcmp(optarg, "strips") == 0)
-				image.style = PLUME_STYLE_STRIPS;
-			else
-				return cli_usage_error("grow", "--style '%s': allowed lines, strips", optarg);
+			if (!cli_parse_style("grow", optarg, &image.style))
+				return CLI_EXIT_USAGE;
 			break;
 		case 'h': cli_help_grow(); return CLI_EXIT_OK;
 		case ':': return cli_usage_error("grow", "option '%s' needs a value", argv[optind - 1]);
 		default: return cli_usage_error("grow", "unknown option '%s'", argv[optind - 1]);
 		}
 	}
-	if (optind >= argc)
-		return cli_usage_error("grow", "missing SPEC.json");
-	if (optind + 1 < argc)
-		return cli_usage_error("grow", "unexpected argument '%s'", argv[optind + 1]);
-	if (output_dir == NULL)
-		return cli_usage_error("grow", "missing -o DIR");
+	if (!cli_check_arguments("grow", argc, argv, "SPEC.json", output_dir))
+		return CLI_EXIT_USAGE;
 	if (frames == 0)
 		return cli_usage_error("grow", "missing --frames N");
 	cli_output output;

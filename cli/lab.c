@@ -146,12 +146,8 @@ static int run_traction(int argc, char **argv)
 		default: return cli_usage_error("lab", "unknown option '%s'", argv[optind - 1]);
 		}
 	}
-	if (optind >= argc)
-		return cli_usage_error("lab", "missing LAB.json");
-	if (optind + 1 < argc)
-		return cli_usage_error("lab", "unexpected argument '%s'", argv[optind + 1]);
-	if (output_dir == NULL)
-		return cli_usage_error("lab", "missing -o DIR");
+	if (!cli_check_arguments("lab", argc, argv, "LAB.json", output_dir))
+		return CLI_EXIT_USAGE;
 	plume_error err = {0};
 	plume_lab_spec spec;
 	plume_status status = plume_lab_spec_load(argv[optind], &spec, &err);

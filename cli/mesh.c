@@ -200,12 +200,8 @@ int cli_mesh(int argc, char **argv)
 		default: return cli_usage_error("mesh", "unknown option '%s'", argv[optind - 1]);
 		}
 	}
-	if (optind >= argc)
-		return cli_usage_error("mesh", "missing SPEC.json");
-	if (optind + 1 < argc)
-		return cli_usage_error("mesh", "unexpected argument '%s'", argv[optind + 1]);
-	if (output_dir == NULL)
-		return cli_usage_error("mesh", "missing -o DIR");
+	if (!cli_check_arguments("mesh", argc, argv, "SPEC.json", output_dir))
+		return CLI_EXIT_USAGE;
 
 	plume_error err = {0};
 	plume_mesh *mesh = NULL;

@@ -24,6 +24,32 @@ int cli_fail(const plume_error *err)
 	}
 }
 
+bool cli_check_arguments(const char *command, int argc, char **argv, const char *input, const char *output_dir)
+{
+	if (optind >= argc)
+		cli_usage_error(command, "missing %s", input);
+	else if (optind + 1 < argc)
+		cli_usage_error(command, "unexpected argument '%s'", argv[optind + 1]);
+	else if (output_dir == NULL)
+		cli_usage_error(command, "missing -o DIR");
+	else
+		return true;
+	return false;
+}
+
+bool cli_parse_style(const char *command, const char *text, plume_render_style *style)
+{
+	if (strcmp(text, "lines") == 0)
+		*style = PLUME_STYLE_LINES;
+	else if (strcmp(text, "strips") == 0)
+		*style = PLUME_STYLE_STRIPS;
+	else {
+		cli_usage_error(command, "--style '%s': allowed lines, strips", text);
+		return false;
+	}
+	return true;
+}
+
 int cli_usage_error(const char *command, const char *format, ...)
 {
 	va_list args;

@@ -146,12 +146,8 @@ static int parse_options(int argc, char **argv, render_options *o)
 		default: return cli_usage_error("render", "unknown option '%s'", argv[optind - 1]);
 		}
 	}
-	if (optind >= argc)
-		return cli_usage_error("render", "missing INPUT (a feather spec or a simulation folder)");
-	if (optind + 1 < argc)
-		return cli_usage_error("render", "unexpected argument '%s'", argv[optind + 1]);
-	if (o->output_dir == NULL)
-		return cli_usage_error("render", "missing -o DIR");
+	if (!cli_check_arguments("render", argc, argv, "INPUT (a feather spec or a simulation folder)", o->output_dir))
+		return CLI_EXIT_USAGE;
 	o->input = argv[optind];
 	return CLI_EXIT_OK;
 }

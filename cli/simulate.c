@@ -46,9 +46,8 @@ void cli_help_simulate(void)
 	     "Scenes are described in docs/scene.md; examples/scenes/ has ready ones.");
 }
 
-plume_status cli_barb_renderer_begin(cli_barb_renderer *renderer, const plume_feather *feather,
-                                     const plume_mesh *mesh, plume_vec3 lo, plume_vec3 hi, int width, int height,
-                                     int spp, plume_error *err)
+plume_status cli_barb_renderer_begin(cli_barb_renderer *renderer, const plume_feather *feather, const plume_mesh *mesh,
+                                     plume_vec3 lo, plume_vec3 hi, int width, int height, int spp, plume_error *err)
 {
 	renderer->embedding = NULL;
 	renderer->def = plume_raytrace_default_def();
@@ -59,8 +58,8 @@ plume_status cli_barb_renderer_begin(cli_barb_renderer *renderer, const plume_fe
 	return plume_embedding_create(feather, mesh, &renderer->embedding, err);
 }
 
-plume_status cli_barb_renderer_frame(const cli_barb_renderer *renderer, const plume_vec3 *positions,
-                                     const char *path, plume_error *err)
+plume_status cli_barb_renderer_frame(const cli_barb_renderer *renderer, const plume_vec3 *positions, const char *path,
+                                     plume_error *err)
 {
 	plume_feather *moved = NULL;
 	plume_status status = plume_embedding_apply(renderer->embedding, positions, &moved, err);
@@ -125,8 +124,8 @@ static void show_progress(const run_state *run, int step, double time)
 	fflush(stderr);
 }
 
-static plume_status on_step(void *user, int step, double time, const plume_sim *sim,
-                            const plume_solve_report *report, double wall_seconds, plume_error *err)
+static plume_status on_step(void *user, int step, double time, const plume_sim *sim, const plume_solve_report *report,
+                            double wall_seconds, plume_error *err)
 {
 	run_state *run = user;
 	if (report != NULL) {
@@ -142,24 +141,22 @@ static plume_status on_step(void *user, int step, double time, const plume_sim *
 	return PLUME_OK;
 }
 
-/// Bounds of the rest shell grown by the largest handle translation, so a sequence keeps one framing.
-static void frame_bounds(const plume_scene *scene, plume_shell_view_def *view)
+void cli_scene_bounds(const plume_scene *scene, plume_vec3 *lo, plume_vec3 *hi)
 {
 	const plume_mesh *mesh = scene->mesh;
-	plume_vec3 lo = mesh->rest[0], hi = mesh->rest[0];
+	*lo = *hi = mesh->rest[0];
 	for (int i = 1; i < mesh->vertex_count; ++i) {
 		plume_vec3 p = mesh->rest[i];
-		lo = plume_v3(fmin(lo.x, p.x), fmin(lo.y, p.y), fmin(lo.z, p.z));
-		hi = plume_v3(fmax(hi.x, p.x), fmax(hi.y, p.y), fmax(hi.z, p.z));
+		*lo = plume_v3(fmin(lo->x, p.x), fmin(lo->y, p.y), fmin(lo->z, p.z));
+		*hi = plume_v3(fmax(hi->x, p.x), fmax(hi->y, p.y), fmax(hi->z, p.z));
 	}
 	double reach = 0;
 	for (int h = 0; h < scene->handle_count; ++h)
 		for (int k = 0; k < scene->handles[h].keyframe_count; ++k)
 			reach = fmax(reach, plume_v3_length(scene->handles[h].keyframes[k].translation));
-	double size = plume_v3_length(plume_v3_sub(hi, lo));
-	double pad = fmax(reach, 0.1 * size);
-	view->bounds_min = plume_v3(lo.x - pad, lo.y - pad, lo.z - pad);
-	view->bounds_max = plume_v3(hi.x + pad, hi.y + pad, hi.z + pad);
+	double pad = fmax(reach, 0.1 * plume_v3_length(plume_v3_sub(*hi, *lo)));
+	*lo = plume_v3(lo->x - pad, lo->y - pad, lo->z - pad);
+	*hi = plume_v3(hi->x + pad, hi->y + pad, hi->z + pad);
 }
 
 static plume_status write_summary(cli_output *output, const plume_scene *scene, const plume_scene_summary *summary,
@@ -217,13 +214,13 @@ static void make_movie(cli_output *output)
 }
 
 /// Writes the rest shell and the feather, then runs the scene into frames/ and stats.csv.
-static plume_status simulate(const plume_scene *scene, cli_output *output, run_state *run,
-                             plume_scene_summary *summary, plume_error *failure, plume_error *err)
+static plume_status simulate(const plume_scene *scene, cli_output *output, run_state *run, plume_scene_summary *summary,
+                             plume_error *failure, plume_error *err)
 {
 	char path[4352];
 	run->output = output;
-	plume_status status = plume_mesh_write_obj(scene->mesh, NULL, cli_output_path(output, "mesh.obj", path, sizeof path),
-	                                           err);
+	plume_status status =
+	    plume_mesh_write_obj(scene->mesh, NULL, cli_output_path(output, "mesh.obj", path, sizeof path), err);
 	if (status == PLUME_OK && scene->feather != NULL)
 		status = plume_write_json(scene->feather, cli_output_path(output, "feather.json", path, sizeof path), err);
 	if (status != PLUME_OK)
@@ -252,11 +249,15 @@ static plume_status simulate(const plume_scene *scene, cli_output *output, run_s
 int cli_simulate(int argc, char **argv)
 {
 	static const struct option options[] = {
-	    {"output", required_argument, NULL, 'o'}, {"seed", required_argument, NULL, 's'},
-	    {"png", no_argument, NULL, 'p'},         {"size", required_argument, NULL, 'S'},
-	    {"view", required_argument, NULL, 'V'},  {"render", no_argument, NULL, 'R'},
+	    {"output", required_argument, NULL, 'o'},
+	    {"seed", required_argument, NULL, 's'},
+	    {"png", no_argument, NULL, 'p'},
+	    {"size", required_argument, NULL, 'S'},
+	    {"view", required_argument, NULL, 'V'},
+	    {"render", no_argument, NULL, 'R'},
 	    {"spp", required_argument, NULL, 'P'},
-	    {"help", no_argument, NULL, 'h'},        {NULL, 0, NULL, 0},
+	    {"help", no_argument, NULL, 'h'},
+	    {NULL, 0, NULL, 0},
 	};
 	const char *output_dir = NULL;
 	plume_spec_options spec_options = {0};
@@ -283,8 +284,8 @@ int cli_simulate(int argc, char **argv)
 			double azimuth, elevation;
 			char tail;
 			if (sscanf(optarg, "%lf,%lf%c", &azimuth, &elevation, &tail) != 2 || fabs(elevation) > 90)
-				return cli_usage_error("simulate", "--view takes AZIMUTH,ELEVATION in degrees (|elevation| <= 90), got '%s'",
-				                       optarg);
+				return cli_usage_error(
+				    "simulate", "--view takes AZIMUTH,ELEVATION in degrees (|elevation| <= 90), got '%s'", optarg);
 			run.view.azimuth = azimuth * acos(-1.0) / 180;
 			run.view.elevation = elevation * acos(-1.0) / 180;
 			break;
@@ -303,12 +304,8 @@ int cli_simulate(int argc, char **argv)
 		default: return cli_usage_error("simulate", "unknown option '%s'", argv[optind - 1]);
 		}
 	}
-	if (optind >= argc)
-		return cli_usage_error("simulate", "missing SCENE.json");
-	if (optind + 1 < argc)
-		return cli_usage_error("simulate", "unexpected argument '%s'", argv[optind + 1]);
-	if (output_dir == NULL)
-		return cli_usage_error("simulate", "missing -o DIR");
+	if (!cli_check_arguments("simulate", argc, argv, "SCENE.json", output_dir))
+		return CLI_EXIT_USAGE;
 
 	plume_error err = {0}, failure = {0};
 	plume_scene *scene = NULL;
@@ -320,17 +317,19 @@ int cli_simulate(int argc, char **argv)
 	run.progress = isatty(STDERR_FILENO);
 	// Handles keep the feather in place: one framing for the whole sequence. A free
 	// feather (falling) is followed frame by frame.
-	if (scene->handle_count > 0)
-		frame_bounds(scene, &run.view);
+	plume_vec3 lo, hi;
+	cli_scene_bounds(scene, &lo, &hi);
+	if (scene->handle_count > 0) {
+		run.view.bounds_min = lo;
+		run.view.bounds_max = hi;
+	}
 	if (run.render) {
 		if (scene->feather == NULL) {
 			plume_scene_destroy(scene);
 			return cli_usage_error("simulate", "--render needs a scene whose feather is generated (not guides)");
 		}
-		plume_shell_view_def box = run.view;
-		frame_bounds(scene, &box);
-		status = cli_barb_renderer_begin(&run.renderer, scene->feather, scene->mesh, box.bounds_min, box.bounds_max,
-		                                 run.view.width, run.view.height, spp, &err);
+		status = cli_barb_renderer_begin(&run.renderer, scene->feather, scene->mesh, lo, hi, run.view.width,
+		                                 run.view.height, spp, &err);
 		if (status != PLUME_OK) {
 			plume_scene_destroy(scene);
 			cli_barb_renderer_end(&run.renderer);

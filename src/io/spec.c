@@ -24,6 +24,23 @@ json_t *plume_spec_load(const char *path, plume_error *err)
 	return root;
 }
 
+json_t *plume_spec_load_model(const char *path, plume_status *status, plume_error *err)
+{
+	plume_error local = {0};
+	json_t *root = plume_spec_load(path, err != NULL ? err : &local);
+	if (root == NULL) {
+		*status = err != NULL ? err->status : local.status;
+		return NULL;
+	}
+	if (!json_is_object(root)) {
+		json_decref(root);
+		*status = plume_error_set(err, PLUME_ERROR_SPEC, "%s: $: expected an object with a \"model\" key", path);
+		return NULL;
+	}
+	*status = PLUME_OK;
+	return root;
+}
+
 plume_spec_reader plume_spec_reader_begin(const char *file, plume_error *err)
 {
 	return (plume_spec_reader){.file = file, .err = err, .status = PLUME_OK};

@@ -27,6 +27,10 @@ typedef struct plume_spec_reader {
 /// a missing file (PLUME_ERROR_IO) or bad JSON (PLUME_ERROR_SYNTAX).
 json_t *plume_spec_load(const char *path, plume_error *err);
 
+/// plume_spec_load for a model spec: also fails (PLUME_ERROR_SPEC) when the top level
+/// is not an object. *status receives the outcome; NULL on failure.
+json_t *plume_spec_load_model(const char *path, plume_status *status, plume_error *err);
+
 plume_spec_reader plume_spec_reader_begin(const char *file, plume_error *err);
 
 /// Records an error at path ("file: path: message").

@@ -20,14 +20,11 @@ static const char *const model_names[] = {"franco-walter", "streit-heidrich", "z
 
 plume_status plume_fw_def_read(const char *path, plume_fw_def *def, uint64_t *seed, plume_error *err)
 {
-	json_t *root = plume_spec_load(path, err);
-	if (root == NULL)
-		return err != NULL ? err->status : PLUME_ERROR_IO;
 	plume_status status;
-	if (!json_is_object(root))
-		status = plume_error_set(err, PLUME_ERROR_SPEC, "%s: $: expected an object with a \"model\" key", path);
-	else
-		status = plume_fw_def_from_json(path, root, def, seed, err);
+	json_t *root = plume_spec_load_model(path, &status, err);
+	if (root == NULL)
+		return status;
+	status = plume_fw_def_from_json(path, root, def, seed, err);
 	json_decref(root);
 	return status;
 }
@@ -66,8 +63,8 @@ plume_status plume_spec_generate_json(const char *file, const json_t *root, cons
 		if (strcmp(model, models[i].name) == 0)
 			return models[i].generate(file, root, options, out, err);
 	if (strcmp(model, "coat") == 0) {
-		plume_spec_fail(&reader, "$.model", "\"coat\" is a coat spec, not a feather: use `plume coat %s -o DIR` (docs/coats.md)",
-		                file);
+		plume_spec_fail(&reader, "$.model",
+		                "\"coat\" is a coat spec, not a feather: use `plume coat %s -o DIR` (docs/coats.md)", file);
 		return reader.status;
 	}
 	plume_spec_fail(&reader, "$.model", "unknown model \"%s\"; did you mean \"%s\"? (known: " MODEL_LIST ")", model,

@@ -471,14 +471,11 @@ plume_status plume_sh_def_from_json(const char *file, const json_t *root, plume_
 
 plume_status plume_sh_def_read(const char *path, plume_sh_def *def, uint64_t *seed, plume_sh_lod *lod, plume_error *err)
 {
-	json_t *root = plume_spec_load(path, err);
-	if (root == NULL)
-		return err != NULL ? err->status : PLUME_ERROR_IO;
 	plume_status status;
-	if (!json_is_object(root))
-		status = plume_error_set(err, PLUME_ERROR_SPEC, "%s: $: expected an object with a \"model\" key", path);
-	else
-		status = plume_sh_def_from_json(path, root, def, seed, lod, 0, err);
+	json_t *root = plume_spec_load_model(path, &status, err);
+	if (root == NULL)
+		return status;
+	status = plume_sh_def_from_json(path, root, def, seed, lod, 0, err);
 	json_decref(root);
 	return status;
 }

@@ -244,14 +244,11 @@ static plume_status def_from_json(const char *file, const json_t *root, plume_zk
 
 plume_status plume_zk_def_read(const char *path, plume_zk_def *def, uint64_t *seed, plume_error *err)
 {
-	json_t *root = plume_spec_load(path, err);
-	if (root == NULL)
-		return err != NULL ? err->status : PLUME_ERROR_IO;
 	plume_status status;
-	if (!json_is_object(root))
-		status = plume_error_set(err, PLUME_ERROR_SPEC, "%s: $: expected an object with a \"model\" key", path);
-	else
-		status = def_from_json(path, root, def, seed, err);
+	json_t *root = plume_spec_load_model(path, &status, err);
+	if (root == NULL)
+		return status;
+	status = def_from_json(path, root, def, seed, err);
 	json_decref(root);
 	return status;
 }

@@ -23,10 +23,9 @@
 // constraint exactly at every step and converges quadratically: on the Figure 1
 // scenario it holds every barb edge to < 1e-10 strain in a few iterations a step.
 #include <math.h>
-#include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
-#include <time.h>
+
+#include <omp.h>
 
 #include "sim/sim_internal.h"
 
@@ -37,13 +36,6 @@ enum { MAX_BACKTRACKS = 30 };
 static const double KKT_REGULARISATION = 1e-15;
 /// A solve also requires every constrained barb edge's strain below this.
 static const double STRAIN_TOLERANCE = 1e-10;
-
-static double seconds_now(void)
-{
-	struct timespec now;
-	clock_gettime(CLOCK_MONOTONIC, &now);
-	return (double)now.tv_sec + 1e-9 * (double)now.tv_nsec;
-}
 
 /// c_k and the unit edge direction t_k (the constraint gradient is -t on vertex i, +t on j).
 static double constraint_value(const plume_sim *sim, const plume_vec3 *x, int k, plume_vec3 *direction, double *length)
@@ -98,9 +90,9 @@ static double mean_diagonal(const plume_sim *sim)
 	return count > 0 && sum > 0 ? sum / count : 1;
 }
 
-/// Adds the constraint rows to the assembled matrix and the Lagrangian terms to the
-/// gradient; fills the right-hand side [-g; -c]. Returns the residual's infinity norm
-/// over free unknowns (with the current multipliers).
+/// Adds the constraint rows to the assembled matrix, puts the Lagrangian gradient
+/// g + C^T lambda in sim->residual and the right-hand side [-g; -c] in rhs. Returns
+/// the residual's infinity norm over free unknowns (with the current multipliers).
 static double add_constraints(plume_sim *sim, const plume_vec3 *x, double *gradient, double *rhs, bool exact)
 {
 	int n3 = 3 * sim->vertex_count;
@@ -108,6 +100,7 @@ static double add_constraints(plume_sim *sim, const plume_vec3 *x, double *gradi
 	double regularisation = KKT_REGULARISATION * mean_diagonal(sim);
 	double *residual = sim->residual;
 	memcpy(residual, gradient, sizeof(double) * (size_t)n3);
+	plume_sim_add_constraint_forces(sim, x, residual);
 	for (int k = 0; k < sim->constraint_count; ++k) {
 		plume_vec3 t;
 		double l;
@@ -121,13 +114,9 @@ static double add_constraints(plume_sim *sim, const plume_vec3 *x, double *gradi
 			rhs[n3 + k] = 0;
 			continue;
 		}
-		for (int a = 0; a < 6; ++a) {
-			int dof = 3 * vertices[a / 3] + a % 3;
-			double jacobian = (a < 3 ? -1 : 1) * tv[a % 3];
-			if (!sim->fixed[dof])
-				values[slots[a]] += jacobian;
-			residual[dof] += sim->lambda[k] * jacobian;
-		}
+		for (int a = 0; a < 6; ++a)
+			if (!sim->fixed[3 * vertices[a / 3] + a % 3])
+				values[slots[a]] += (a < 3 ? -1 : 1) * tv[a % 3];
 		rhs[n3 + k] = -c;
 		// Curvature of the constraint: lambda (I - t t^T) / l on the pair, PSD for lambda > 0
 		// (a barb in tension). A compressed barb's part is indefinite: only the exact
@@ -157,25 +146,29 @@ static double add_constraints(plume_sim *sim, const plume_vec3 *x, double *gradi
 	return norm;
 }
 
-static double residual_norm2(const plume_sim *sim, const double *gradient, const plume_vec3 *x)
+void plume_sim_add_constraint_forces(const plume_sim *sim, const plume_vec3 *x, double *forces)
 {
-	int n3 = 3 * sim->vertex_count;
-	double *residual = sim->residual;
-	memcpy(residual, gradient, sizeof(double) * (size_t)n3);
 	for (int k = 0; k < sim->constraint_count; ++k) {
+		if (constraint_held(sim, k))
+			continue;
 		plume_vec3 t;
 		constraint_value(sim, x, k, &t, NULL);
 		const int *v = sim->constraint_vertices + 2 * k;
 		const double tv[3] = {t.x, t.y, t.z};
 		for (int d = 0; d < 3; ++d) {
-			residual[3 * v[0] + d] -= sim->lambda[k] * tv[d];
-			residual[3 * v[1] + d] += sim->lambda[k] * tv[d];
+			forces[3 * v[0] + d] -= sim->lambda[k] * tv[d];
+			forces[3 * v[1] + d] += sim->lambda[k] * tv[d];
 		}
 	}
+}
+
+/// Euclidean norm of a vector over the free unknowns.
+static double free_norm2(const plume_sim *sim, const double *vector)
+{
 	double sum = 0;
-	for (int i = 0; i < n3; ++i)
+	for (int i = 0; i < 3 * sim->vertex_count; ++i)
 		if (!sim->fixed[i])
-			sum += residual[i] * residual[i];
+			sum += vector[i] * vector[i];
 	return sqrt(sum);
 }
 
@@ -205,12 +198,12 @@ static double force_scale(const plume_sim *sim, double initial_residual)
 /// Assembles at x (projected or exact Hessian), factors and solves for the step.
 /// Returns PLUME_ERROR_NUMERIC with exact Hessians that are not positive definite,
 /// so the caller can fall back to projection.
-static plume_status newton_system(plume_sim *sim, const sim_problem *problem, bool exact, double *phi,
-                                  double *residual, plume_solve_report *report, plume_error *err)
+static plume_status newton_system(plume_sim *sim, const sim_problem *problem, bool exact, double *phi, double *residual,
+                                  plume_solve_report *report, plume_error *err)
 {
 	int n3 = 3 * sim->vertex_count;
 	double *g = sim->gradient;
-	double t0 = seconds_now();
+	double t0 = omp_get_wtime();
 	*phi = plume_sim_potential(sim, problem, sim->x, g, true, !exact);
 	if (isnan(*phi))
 		return plume_error_set(err, PLUME_ERROR_NUMERIC, "the potential is not finite (NaN or infinite)");
@@ -218,20 +211,20 @@ static plume_status newton_system(plume_sim *sim, const sim_problem *problem, bo
 		if (sim->fixed[i])
 			g[i] = 0;
 	*residual = add_constraints(sim, sim->x, g, sim->rhs, exact);
-	report->seconds_assembly += seconds_now() - t0;
+	report->seconds_assembly += omp_get_wtime() - t0;
 	return PLUME_OK;
 }
 
 static plume_status factor_and_solve(plume_sim *sim, bool exact, plume_solve_report *report, plume_error *err)
 {
-	double t0 = seconds_now(), shift;
+	double t0 = omp_get_wtime(), shift;
 	plume_status status = plume_kkt_factor(&sim->kkt, !exact, &shift, err);
-	report->seconds_factor += seconds_now() - t0;
+	report->seconds_factor += omp_get_wtime() - t0;
 	if (status != PLUME_OK)
 		return status;
-	t0 = seconds_now();
+	t0 = omp_get_wtime();
 	status = plume_kkt_solve(&sim->kkt, sim->rhs, sim->step, err);
-	report->seconds_solve += seconds_now() - t0;
+	report->seconds_solve += omp_get_wtime() - t0;
 	return status;
 }
 
@@ -273,7 +266,7 @@ plume_status plume_sim_newton(plume_sim *sim, const sim_problem *problem, plume_
 		// Roundoff in the residual is relative to the forces that cancel in it.
 		double tolerance_scale = fmax(scale, largest_force(sim, g));
 		report->energy = phi;
-		report->gradient_norm = residual_norm2(sim, g, x);
+		report->gradient_norm = free_norm2(sim, sim->residual);
 		report->max_barb_strain = plume_sim_max_barb_strain(sim, x);
 		if (sim->trace_count < PLUME_SIM_TRACE)
 			sim->trace[sim->trace_count++] = phi + (m > 0 ? mu * constraint_norm1(sim, x) : 0);
@@ -353,17 +346,6 @@ plume_status plume_sim_newton(plume_sim *sim, const sim_problem *problem, plume_
 				}
 			}
 			alpha *= 0.5;
-		}
-		if (getenv("PLUME_DEBUG_NEWTON"))
-			fprintf(stderr, "newton %d: phi %.10g residual %.3g scale %.3g step %.3g slope %.3g alpha %g exact %d\n",
-			        iteration, phi, residual, scale, step_size, slope, alpha, exact);
-		if (!accepted && getenv("PLUME_DEBUG_NEWTON")) {
-			for (double a = 1; a > 1e-10; a *= 0.1) {
-				apply_step(sim, x, step, a, sim->trial);
-				double p = plume_sim_potential(sim, problem, sim->trial, NULL, false, false);
-				fprintf(stderr, "  alpha %g: dphi %.6e  dviol %.6e  predicted %.6e\n", a, p - phi,
-				        constraint_norm1(sim, sim->trial) - violation, a * (slope + mu * violation));
-			}
 		}
 		if (!accepted)
 			break;

@@ -2,7 +2,8 @@
 // step (or a static solve for quasi-static scenes), and the caller sees every step.
 #include <math.h>
 #include <string.h>
-#include <time.h>
+
+#include <omp.h>
 
 #include "core/alloc.h"
 #include "plume/scene.h"
@@ -25,8 +26,7 @@ static double ease(plume_interpolation interpolation, double s)
 	return interpolation == PLUME_INTERPOLATION_SMOOTH ? s * s * (3 - 2 * s) : s;
 }
 
-void plume_scene_handle_pose(const plume_scene_handle *handle, double t, plume_vec3 *translation,
-                             plume_mat3 *rotation)
+void plume_scene_handle_pose(const plume_scene_handle *handle, double t, plume_vec3 *translation, plume_mat3 *rotation)
 {
 	*translation = plume_v3(0, 0, 0);
 	*rotation = plume_m3_identity();
@@ -52,13 +52,6 @@ void plume_scene_handle_pose(const plume_scene_handle *handle, double t, plume_v
 	*translation = pose.translation;
 	if (pose.angle != 0)
 		*rotation = plume_m3_rotation(plume_v3_normalize(pose.axis), pose.angle);
-}
-
-static double seconds_now(void)
-{
-	struct timespec now;
-	clock_gettime(CLOCK_MONOTONIC, &now);
-	return (double)now.tv_sec + 1e-9 * (double)now.tv_nsec;
 }
 
 static void pose_handles(const plume_scene *scene, plume_sim *sim, const int *ids, double t)
@@ -88,7 +81,7 @@ plume_status plume_scene_run(const plume_scene *scene, plume_scene_step_fn *on_s
                              plume_scene_summary *summary, plume_error *err)
 {
 	memset(summary, 0, sizeof *summary);
-	double start = seconds_now();
+	double start = omp_get_wtime();
 	plume_sim *sim = NULL;
 	plume_status status = plume_sim_create(scene->mesh, &scene->sim, &sim, err);
 	if (status != PLUME_OK)
@@ -110,7 +103,7 @@ plume_status plume_scene_run(const plume_scene *scene, plume_scene_step_fn *on_s
 	summary->face_count = scene->mesh->face_count;
 	summary->constraint_count = plume_sim_constraint_count(sim);
 	if (status == PLUME_OK && on_step != NULL)
-		status = on_step(user, 0, 0, sim, NULL, seconds_now() - start, err);
+		status = on_step(user, 0, 0, sim, NULL, omp_get_wtime() - start, err);
 
 	double dt = scene->sim.time_step;
 	int steps = (int)ceil(scene->duration / dt - 1e-9);
@@ -118,7 +111,7 @@ plume_status plume_scene_run(const plume_scene *scene, plume_scene_step_fn *on_s
 		double t = n * dt;
 		pose_handles(scene, sim, ids, t);
 		plume_solve_report report;
-		double step_start = seconds_now();
+		double step_start = omp_get_wtime();
 		status = scene->quasi_static ? plume_sim_solve_static(sim, &report, err) : plume_sim_step(sim, &report, err);
 		if (status != PLUME_OK) {
 			plume_error_prefix(err, scene->quasi_static ? "quasi-static solve" : "simulation");
@@ -132,10 +125,10 @@ plume_status plume_scene_run(const plume_scene *scene, plume_scene_step_fn *on_s
 		summary->max_barb_strain = fmax(summary->max_barb_strain, report.max_barb_strain);
 		summary->retried_steps += report.substeps > 1;
 		if (on_step != NULL)
-			status = on_step(user, n, t, sim, &report, seconds_now() - step_start, err);
+			status = on_step(user, n, t, sim, &report, omp_get_wtime() - step_start, err);
 	}
 	summary->rachis_tip_deflection = rachis_tip_deflection(scene, sim);
-	summary->wall_seconds = seconds_now() - start;
+	summary->wall_seconds = omp_get_wtime() - start;
 	plume_free(ids);
 	plume_sim_destroy(sim);
 	return status;

@@ -653,16 +653,7 @@ bool plume_sim_group_reaction(plume_sim *sim, const char *group_name, plume_vec3
 	static const sim_problem statics = {false, 0, NULL, NULL, NULL};
 	double *g = sim->gradient;
 	plume_sim_potential(sim, &statics, sim->x, g, false, false);
-	for (int k = 0; k < sim->constraint_count; ++k) {
-		plume_vec3 d =
-		    plume_v3_sub(sim->x[sim->constraint_vertices[2 * k + 1]], sim->x[sim->constraint_vertices[2 * k]]);
-		plume_vec3 t = plume_v3_normalize(d);
-		const int *v = sim->constraint_vertices + 2 * k;
-		g[3 * v[0]] -= sim->lambda[k] * t.x, g[3 * v[0] + 1] -= sim->lambda[k] * t.y,
-		    g[3 * v[0] + 2] -= sim->lambda[k] * t.z;
-		g[3 * v[1]] += sim->lambda[k] * t.x, g[3 * v[1] + 1] += sim->lambda[k] * t.y,
-		    g[3 * v[1] + 2] += sim->lambda[k] * t.z;
-	}
+	plume_sim_add_constraint_forces(sim, sim->x, g);
 	plume_vec3 sum = {0, 0, 0};
 	for (int i = 0; i < group->count; ++i) {
 		int v = group->vertices[i];

@@ -110,6 +110,9 @@ struct plume_sim {
 double plume_sim_potential(plume_sim *sim, const sim_problem *problem, const plume_vec3 *x, double *gradient,
                            bool hessian, bool project);
 
+/// Adds C^T lambda, the constraint forces of the current multipliers, to forces (3 n).
+void plume_sim_add_constraint_forces(const plume_sim *sim, const plume_vec3 *x, double *forces);
+
 /// Largest |l - L| / L over all barb-aligned edges at positions x.
 double plume_sim_max_barb_strain(const plume_sim *sim, const plume_vec3 *x);
 
