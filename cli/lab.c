@@ -34,7 +34,8 @@ void cli_help_lab(void)
 	     "  --aspect A             H/W of the tilted test (default 1.3)\n"
 	     "  --period T             band period, m (default 4e-4)\n"
 	     "  --width W              tilted sample width, m (default 4e-3)\n"
-	     "  --elements N           mesoscale tilted mesh size (default 8000)\n"
+	     "  --elements N           mesoscale tilted mesh size (default 4000)\n"
+	     "  --phases K             band phases the tilted slope is averaged over (default 4)\n"
 	     "  --macro-elements N     macroscale tilted mesh size (default 2000)\n"
 	     "  --unconstrained        fit E_vw without the barb constraint\n"
 	     "\n"
@@ -188,6 +189,7 @@ static int run_calibrate(int argc, char **argv)
 	    {"width", required_argument, NULL, 'w'},
 	    {"elements", required_argument, NULL, 'e'},
 	    {"macro-elements", required_argument, NULL, 'm'},
+	    {"phases", required_argument, NULL, 'k'},
 	    {"unconstrained", no_argument, NULL, 'u'},
 	    {"help", no_argument, NULL, 'h'},
 	    {NULL, 0, NULL, 0},
@@ -217,6 +219,7 @@ static int run_calibrate(int argc, char **argv)
 		case 'w': ok = parse_double("--width", optarg, &def.sample.width); break;
 		case 'e': ok = parse_int("--elements", optarg, &def.sample.element_count); break;
 		case 'm': ok = parse_int("--macro-elements", optarg, &def.macroscale_elements); break;
+		case 'k': ok = parse_int("--phases", optarg, &def.phase_count); break;
 		case 'u': def.barb_constraint = false; break;
 		case 'h': cli_help_lab(); return CLI_EXIT_OK;
 		case ':': return cli_usage_error("lab", "option '%s' needs a value", argv[optind - 1]);
@@ -242,9 +245,10 @@ static int run_calibrate(int argc, char **argv)
 	printf("  \"slopes\": {\"longitudinal\": %.8g, \"transverse\": %.8g, \"tilted_mesoscale\": %.8g, "
 	       "\"tilted_macroscale\": %.8g},\n",
 	       r.slope_longitudinal, r.slope_transverse, r.slope_tilted, r.slope_tilted_macroscale);
-	printf("  \"phi\": %.6g,\n  \"E_b\": %.6g,\n  \"E_B\": %.6g,\n  \"aspect\": %.6g,\n  \"period\": %.6g,\n",
+	printf("  \"phi\": %.6g,\n  \"E_b\": %.6g,\n  \"E_B\": %.6g,\n  \"aspect\": %.6g,\n  \"period\": %.6g,\n"
+	       "  \"phases\": %d,\n",
 	       def.mesoscale.bands.barb_fraction, def.mesoscale.E_b, def.mesoscale.E_B, def.aspect_ratio,
-	       def.mesoscale.bands.period);
+	       def.mesoscale.bands.period, def.phase_count);
 	printf(
 	    "  \"barb_constraint\": %s,\n  \"traction_tests\": %d,\n  \"solves\": %d,\n  \"bisection_iterations\": %d\n}\n",
 	    def.barb_constraint ? "true" : "false", r.traction_count, r.solve_count, r.bisection_iterations);

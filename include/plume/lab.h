@@ -100,6 +100,10 @@ typedef struct plume_band_def {
 	double period;
 	/// Phi_B = w_B / T, in (0, 1). Default 0.14 (thesis 5.2).
 	double barb_fraction;
+	/// Shift of the band pattern across the barbs, in periods, [0, 1): barb bands are centred at
+	/// (k + 1/2 + phase) T from the sample's lowest corner. Where a sample holds few barbs its
+	/// tilted slope depends on where the bands meet its corners. Default 0.
+	double phase;
 	/// Element rows across each barb band, >= 1. Default 1.
 	int barb_divisions;
 	/// Element rows across each barbule band, >= 1. Default 3.
@@ -128,7 +132,8 @@ plume_status plume_sample_validate(const plume_sample_def *sample, const plume_b
 typedef enum plume_lab_model {
 	/// Orthotropic membrane (thesis eq. 4.1).
 	PLUME_LAB_MACROSCALE = 0,
-	/// Stiff and soft isotropic bands, zero Poisson ratio (thesis 5.2).
+	/// Stiff and soft isotropic bands, zero Poisson ratio (thesis 5.2), solved on quadratic
+	/// triangles (six nodes), which bend the barb bands without locking.
 	PLUME_LAB_MESOSCALE = 1,
 } plume_lab_model;
 
@@ -136,7 +141,7 @@ typedef struct plume_lab_material {
 	plume_lab_model model;
 	/// Macroscale moduli, Pa, > 0. Defaults: thesis Table 5.2, E_vv = 3.60e8, E_ww = 4.80e4,
 	/// E_vw = E_ww = 4.80e4 (the locking and conditioning studies use it; the calibrated value,
-	/// 1.44e4 with the barb constraint, is in docs/lab.md).
+	/// 1.02e4 with the barb constraint, is in docs/lab.md).
 	double E_vv;
 	double E_ww;
 	double E_vw;
@@ -147,6 +152,12 @@ typedef struct plume_lab_material {
 	double E_b;
 	/// Band geometry of the mesoscale model.
 	plume_band_def bands;
+	/// Kikuuwe's compression coefficient kappa, Pa, >= 0, in both models (thesis eq. 6.6).
+	/// Default: the simulator's vane, plume_material_vane().compression_coefficient (5.04e7,
+	/// thesis Table 6.1). The lab's samples are planar: without out-of-plane buckling,
+	/// compressed St-Venant-Kirchhoff elements collapse and invert (thesis Figure 6.7), the
+	/// solution localises on the mesh and Newton stalls; 0 gives that pure model.
+	double compression_coefficient;
 } plume_lab_material;
 
 plume_lab_material plume_lab_material_default(plume_lab_model model);
@@ -206,10 +217,6 @@ plume_status plume_lab_traction(const plume_lab_material *material, const plume_
 
 void plume_traction_result_free(plume_traction_result *result);
 
-/// The simulator definition the lab uses for a material: planar, no bending, no gravity,
-/// materials 0 (barbules or the vane) and 1 (barbs).
-plume_sim_def plume_lab_sim_def(const plume_lab_material *material, double thickness, const plume_solver_def *solver);
-
 /// Checks a material and a sample; messages name the field ("material.E_vw is -1, allowed > 0").
 plume_status plume_lab_validate(const plume_lab_material *material, const plume_sample_def *sample,
                                 const plume_traction_def *traction, plume_error *err);
@@ -247,6 +254,9 @@ typedef struct plume_calibration_def {
 	double tolerance;
 	/// Target number of triangles of the macroscale tilted sample. Default 2000.
 	int macroscale_elements;
+	/// Band phases (k / phase_count, k = 0 .. phase_count - 1) the mesoscale tilted slope is
+	/// averaged over, [1, 64]. Default 4.
+	int phase_count;
 } plume_calibration_def;
 
 plume_calibration_def plume_calibration_default_def(void);
@@ -256,7 +266,7 @@ typedef struct plume_calibration_result {
 	double E_vv;
 	double E_ww;
 	double E_vw;
-	/// Slopes of the mesoscale model, Pa: longitudinal, transverse, tilted.
+	/// Slopes of the mesoscale model, Pa: longitudinal, transverse, tilted (mean over the phases).
 	double slope_longitudinal;
 	double slope_transverse;
 	double slope_tilted;

@@ -13,7 +13,7 @@ static const char *const sample_keys[] = {"width", "height",   "thickness", "bar
                                           "mesh",  "elements", "seed",      NULL};
 static const char *const material_keys[] = {
     "model", "E_vv",          "E_ww",        "E_vw",           "barb_constraint",   "E_B",
-    "E_b",   "barb_fraction", "band_period", "barb_divisions", "barbule_divisions", NULL};
+    "E_b",   "barb_fraction", "band_period", "barb_divisions", "barbule_divisions", "compression_coefficient", "band_phase", NULL};
 static const char *const traction_keys[] = {
     "strain_max",          "steps",           "tolerance", "max_iterations", "max_substep_halvings",
     "require_convergence", "accept_residual", NULL};
@@ -64,8 +64,10 @@ static void read_material(plume_spec_reader *reader, const json_t *object, plume
 	plume_spec_number(reader, object, "$.material", "E_b", &material->E_b);
 	plume_spec_number(reader, object, "$.material", "barb_fraction", &material->bands.barb_fraction);
 	plume_spec_number(reader, object, "$.material", "band_period", &material->bands.period);
+	plume_spec_number(reader, object, "$.material", "band_phase", &material->bands.phase);
 	plume_spec_int(reader, object, "$.material", "barb_divisions", &material->bands.barb_divisions);
 	plume_spec_int(reader, object, "$.material", "barbule_divisions", &material->bands.barbule_divisions);
+	plume_spec_number(reader, object, "$.material", "compression_coefficient", &material->compression_coefficient);
 }
 
 static void read_traction(plume_spec_reader *reader, const json_t *object, plume_traction_def *traction)

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "core/alloc.h"
+#include "lab/quadratic.h"
 #include "plume/lab.h"
 
 plume_lab_material plume_lab_material_default(plume_lab_model model)
@@ -18,6 +19,7 @@ plume_lab_material plume_lab_material_default(plume_lab_model model)
 	    .E_B = 2.57e9,
 	    .E_b = 3.92e4,
 	    .bands = plume_band_default_def(),
+	    .compression_coefficient = plume_material_vane().compression_coefficient,
 	};
 }
 
@@ -33,40 +35,28 @@ plume_traction_def plume_traction_default_def(void)
 	};
 }
 
-plume_sim_def plume_lab_sim_def(const plume_lab_material *material, double thickness, const plume_solver_def *solver)
+// The simulator definition of the macroscale model: planar, no bending, gravity or mass
+// (the lab measures the membrane alone).
+static plume_sim_def macroscale_sim_def(const plume_lab_material *material, double thickness,
+                                        const plume_solver_def *solver)
 {
 	plume_sim_def def = plume_sim_default_def();
 	def.gravity = plume_v3(0.0, 0.0, 0.0);
 	def.bending = false;
 	def.planar = true;
-	if (solver != NULL)
-		def.solver = *solver;
-	// The lab measures the membrane alone: no bending, no Kikuuwe compression term, no mass.
-	plume_material base = plume_material_vane();
-	base.thickness = thickness;
-	base.surface_density = 0.0;
-	base.compression_coefficient = 0.0;
-	if (material->model == PLUME_LAB_MACROSCALE) {
-		plume_material vane = base;
-		vane.kind = PLUME_MATERIAL_ORTHOTROPIC;
-		vane.E_vv = material->barb_constraint ? material->E_ww : material->E_vv;
-		vane.E_ww = material->E_ww;
-		vane.E_vw = material->E_vw;
-		vane.barb_constraint = material->barb_constraint;
-		def.materials[0] = vane;
-		def.materials[1] = vane;
-	} else {
-		// Thesis 5.2: isotropic bands with zero Poisson ratio (no Poisson effect, section 3.3).
-		plume_material band = base;
-		band.kind = PLUME_MATERIAL_ISOTROPIC;
-		band.poisson_ratio = 0.0;
-		band.barb_constraint = false;
-		band.youngs_modulus = material->E_b;
-		def.materials[PLUME_BAND_BARBULE] = band;
-		band.youngs_modulus = material->E_B;
-		def.materials[PLUME_BAND_BARB] = band;
-	}
-	def.material_count = 2;
+	def.solver = *solver;
+	plume_material vane = plume_material_vane();
+	vane.thickness = thickness;
+	vane.surface_density = 0.0;
+	vane.compression_coefficient = material->compression_coefficient;
+	vane.kind = PLUME_MATERIAL_ORTHOTROPIC;
+	// With inextensible barbs E_vv does not enter: the constraint holds the barbs' length.
+	vane.E_vv = material->barb_constraint ? material->E_ww : material->E_vv;
+	vane.E_ww = material->E_ww;
+	vane.E_vw = material->E_vw;
+	vane.barb_constraint = material->barb_constraint;
+	def.materials[0] = vane;
+	def.material_count = 1;
 	return def;
 }
 
@@ -79,6 +69,8 @@ plume_status plume_lab_validate(const plume_lab_material *material, const plume_
 	if (!(condition))                                                                                                  \
 		return plume_error_set(err, PLUME_ERROR_SPEC, format, __VA_ARGS__);
 	if (material != NULL) {
+		REQUIRE(material->compression_coefficient >= 0.0 && isfinite(material->compression_coefficient),
+		        "material.compression_coefficient is %g Pa, allowed >= 0", material->compression_coefficient);
 		if (material->model == PLUME_LAB_MACROSCALE) {
 			REQUIRE(positive(material->E_ww), "material.E_ww is %g Pa, allowed > 0", material->E_ww);
 			REQUIRE(positive(material->E_vw), "material.E_vw is %g Pa, allowed > 0", material->E_vw);
@@ -169,6 +161,86 @@ static double lateral_strain(const plume_mesh *mesh, const plume_vec3 *x, double
 	return (right / right_count - left / left_count) / width - 1.0;
 }
 
+// The solver behind a traction test: the simulator (macroscale model, linear triangles,
+// barb constraint) or the quadratic band model (mesoscale, lab/quadratic.h).
+typedef struct traction_solver {
+	plume_sim *sim;
+	int bottom, top;
+	plume_quadratic *bands;
+} traction_solver;
+
+typedef struct traction_step {
+	plume_status status;
+	int solves;
+	int iterations;
+	/// Free forces over the clamp force, and the y force of the top clamp on the sample, N.
+	double residual;
+	double force;
+} traction_step;
+
+static plume_status solver_create(const plume_lab_material *material, const plume_mesh *mesh, double thickness,
+                                  const plume_solver_def *solver_def, traction_solver *solver, plume_error *err)
+{
+	memset(solver, 0, sizeof *solver);
+	if (material->model == PLUME_LAB_MESOSCALE)
+		return plume_quadratic_create(mesh, material->E_b, material->E_B, material->compression_coefficient, thickness,
+		                              solver_def, &solver->bands, err);
+	plume_sim_def sim_def = macroscale_sim_def(material, thickness, solver_def);
+	plume_status status = plume_sim_create(mesh, &sim_def, &solver->sim, err);
+	if (status != PLUME_OK)
+		return status;
+	solver->bottom = plume_sim_add_handle(solver->sim, "bottom", err);
+	solver->top = solver->bottom >= 0 ? plume_sim_add_handle(solver->sim, "top", err) : -1;
+	if (solver->top < 0) {
+		plume_sim_destroy(solver->sim);
+		solver->sim = NULL;
+		return err != NULL && err->status != PLUME_OK ? err->status : PLUME_ERROR_NUMERIC;
+	}
+	return PLUME_OK;
+}
+
+static void solver_destroy(traction_solver *solver)
+{
+	plume_sim_destroy(solver->sim);
+	plume_quadratic_destroy(solver->bands);
+}
+
+// Moves the top clamp to displacement d and solves the static problem.
+static traction_step solver_step(traction_solver *solver, double d, plume_error *err)
+{
+	traction_step step = {0};
+	if (solver->bands != NULL) {
+		plume_quadratic_report report;
+		step.status = plume_quadratic_solve(solver->bands, d, &report, err);
+		step.solves = report.substeps;
+		step.iterations = report.newton_iterations;
+		step.residual = report.relative_residual;
+		step.force = report.force;
+		return step;
+	}
+	plume_vec3 origin = plume_v3(0.0, 0.0, 0.0);
+	plume_mat3 identity = plume_m3_identity();
+	plume_sim_set_handle(solver->sim, solver->bottom, origin, identity, origin);
+	plume_sim_set_handle(solver->sim, solver->top, plume_v3(0.0, d, 0.0), identity, origin);
+	plume_solve_report report = {0};
+	step.status = plume_sim_solve_static(solver->sim, &report, err);
+	step.solves = report.substeps > 0 ? report.substeps : 1;
+	step.iterations = report.newton_iterations;
+	plume_vec3 force = {0.0, 0.0, 0.0};
+	plume_sim_group_reaction(solver->sim, "top", &force);
+	step.force = force.y;
+	step.residual = report.gradient_norm / fmax(fabs(force.y), 1e-300);
+	return step;
+}
+
+static void solver_positions(const traction_solver *solver, int vertex_count, plume_vec3 *out)
+{
+	if (solver->bands != NULL)
+		plume_quadratic_positions(solver->bands, out);
+	else
+		memcpy(out, plume_sim_positions(solver->sim), sizeof(plume_vec3) * (size_t)vertex_count);
+}
+
 plume_status plume_lab_traction(const plume_lab_material *material, const plume_sample_def *sample,
                                 const plume_traction_def *def, plume_traction_result *result, plume_error *err)
 {
@@ -180,66 +252,52 @@ plume_status plume_lab_traction(const plume_lab_material *material, const plume_
 	status = plume_sample_mesh(sample, material->model == PLUME_LAB_MESOSCALE ? &material->bands : NULL, &mesh, err);
 	if (status != PLUME_OK)
 		return status;
-	plume_sim_def sim_def = plume_lab_sim_def(material, sample->thickness, &def->solver);
-	plume_sim *sim = NULL;
-	status = plume_sim_create(mesh, &sim_def, &sim, err);
+	traction_solver solver;
+	status = solver_create(material, mesh, sample->thickness, &def->solver, &solver, err);
 	if (status != PLUME_OK) {
 		plume_mesh_destroy(mesh);
 		return status;
 	}
-	int bottom = plume_sim_add_handle(sim, "bottom", err);
-	int top = bottom >= 0 ? plume_sim_add_handle(sim, "top", err) : -1;
-	if (top < 0) {
-		plume_sim_destroy(sim);
-		plume_mesh_destroy(mesh);
-		return err != NULL && err->status != PLUME_OK ? err->status : PLUME_ERROR_NUMERIC;
-	}
 	plume_traction_result r;
 	status = allocate_result(&r, def->steps + 1, mesh->vertex_count, err);
 	double W = sample->width, H = sample->height, b = sample->thickness;
-	plume_vec3 origin = plume_v3(0.0, 0.0, 0.0);
-	plume_mat3 identity = plume_m3_identity();
 	if (status == PLUME_OK)
 		r.converged[0] = true;
 	for (int i = 1; i <= def->steps && status == PLUME_OK; ++i) {
 		// Evenly spaced measured strains (the slope's quadrature needs them evenly spaced).
 		double strain = (def->compression ? -1.0 : 1.0) * def->strain_max * i / def->steps;
 		double d = plume_lab_displacement_for_strain(H, strain);
-		plume_sim_set_handle(sim, bottom, origin, identity, origin);
-		plume_sim_set_handle(sim, top, plume_v3(0.0, d, 0.0), identity, origin);
-		plume_solve_report report = {0};
 		plume_error step_err = {0};
-		plume_status solved = plume_sim_solve_static(sim, &report, &step_err);
-		r.solve_count += report.substeps > 0 ? report.substeps : 1;
-		r.newton_iterations += report.newton_iterations;
-		r.iterations[i] = report.newton_iterations;
-		r.converged[i] = solved == PLUME_OK;
-		plume_vec3 force = {0.0, 0.0, 0.0};
-		plume_sim_group_reaction(sim, "top", &force);
-		r.residual[i] = report.gradient_norm / fmax(fabs(force.y), 1e-300);
-		bool accepted = solved == PLUME_OK || (solved == PLUME_ERROR_NUMERIC && r.residual[i] <= def->accept_residual);
-		if (!accepted && (def->require_convergence || solved != PLUME_ERROR_NUMERIC)) {
-			status = plume_error_set(err, solved, "traction step %d of %d (strain %g) failed: %s", i, def->steps,
-			                         strain, step_err.message);
+		traction_step step = solver_step(&solver, d, &step_err);
+		r.solve_count += step.solves;
+		r.newton_iterations += step.iterations;
+		r.iterations[i] = step.iterations;
+		r.converged[i] = step.status == PLUME_OK;
+		r.residual[i] = step.residual;
+		bool accepted = step.status == PLUME_OK ||
+		                (step.status == PLUME_ERROR_NUMERIC && step.residual <= def->accept_residual);
+		if (!accepted && (def->require_convergence || step.status != PLUME_ERROR_NUMERIC)) {
+			status = plume_error_set(err, step.status, "traction step %d of %d (strain %g) failed: %s", i,
+			                         def->steps, strain, step_err.message);
 			break;
 		}
 		r.strain[i] = plume_lab_measured_strain(H, d);
 		r.displacement[i] = d;
-		// f: the y force the clamp applies on the sample (the reaction the sim reports).
-		r.stress[i] = plume_lab_measured_stress(W, H, b, d, force.y);
+		// f: the y force the clamp applies on the sample.
+		r.stress[i] = plume_lab_measured_stress(W, H, b, d, step.force);
 		if (!isfinite(r.stress[i]))
 			status = plume_error_set(err, PLUME_ERROR_NUMERIC, "traction step %d of %d gave a stress of %g", i,
 			                         def->steps, r.stress[i]);
 	}
 	if (status == PLUME_OK) {
-		memcpy(r.positions, plume_sim_positions(sim), sizeof(plume_vec3) * (size_t)mesh->vertex_count);
+		solver_positions(&solver, mesh->vertex_count, r.positions);
 		r.slope = plume_lab_slope(r.strain, r.stress, r.count);
 		r.lateral_strain = lateral_strain(mesh, r.positions, W);
 		*result = r;
 	} else if (r.strain != NULL) {
 		plume_traction_result_free(&r);
 	}
-	plume_sim_destroy(sim);
+	solver_destroy(&solver);
 	plume_mesh_destroy(mesh);
 	return status;
 }

@@ -120,10 +120,10 @@ static int push_offset(line_set *set, double w)
 }
 
 // Band of an offset: 1 inside a barb band, 0 inside a barbule band. Barb bands are
-// centred in each period, counted from the lowest corner.
+// centred at (k + 1/2 + phase) T from the lowest corner.
 static int band_of(const plume_band_def *bands, double w_from_min)
 {
-	double s = fmod(w_from_min, bands->period) / bands->period;
+	double s = fmod(w_from_min - bands->phase * bands->period + bands->period, bands->period) / bands->period;
 	double half = 0.5 * bands->barb_fraction;
 	return s > 0.5 - half && s < 0.5 + half;
 }
@@ -182,7 +182,12 @@ static plume_status mesh_aligned(const plume_sample_def *sample, const plume_ban
 			status = PLUME_ERROR_MEMORY;
 	if (bands != NULL) {
 		double T = bands->period, half = 0.5 * bands->barb_fraction * T;
-		for (double centre = w_min + 0.5 * T; centre - half < w_max && status == PLUME_OK; centre += T) {
+		// The first centre at or below the lowest corner, so that a shifted pattern has
+		// no gap there.
+		for (double centre = w_min + (bands->phase - 0.5) * T; centre - half < w_max && status == PLUME_OK;
+		     centre += T) {
+			if (centre + half <= w_min)
+				continue;
 			if (push_offset(&breaks, centre - half) != 0 || push_offset(&breaks, centre + half) != 0)
 				status = PLUME_ERROR_MEMORY;
 		}
@@ -433,6 +438,8 @@ plume_status plume_sample_validate(const plume_sample_def *sample, const plume_b
 		                       bands->barb_fraction);
 	if (!(bands->period > 0.0 && isfinite(bands->period)))
 		return plume_error_set(err, PLUME_ERROR_SPEC, "material.band_period is %g m, allowed > 0", bands->period);
+	if (!(bands->phase >= 0.0 && bands->phase < 1.0))
+		return plume_error_set(err, PLUME_ERROR_SPEC, "material.band_phase is %g, allowed in [0, 1)", bands->phase);
 	if (bands->barb_divisions < 1 || bands->barb_divisions > 64)
 		return plume_error_set(err, PLUME_ERROR_SPEC, "material.barb_divisions is %d, allowed in [1, 64]",
 		                       bands->barb_divisions);

@@ -43,8 +43,7 @@ static int push_block(entry_list *list, const int *vertices, int count)
 	return 0;
 }
 
-/// Index of (row, column) in the CSC arrays; the entry must exist.
-static int find_slot(const cholmod_sparse *matrix, int row, int column)
+int plume_csc_find(const cholmod_sparse *matrix, int row, int column)
 {
 	const int *p = matrix->p, *rows = matrix->i;
 	int lo = p[column], hi = p[column + 1] - 1;
@@ -66,7 +65,7 @@ static void fill_block_slots(const cholmod_sparse *matrix, const int *vertices, 
 	for (int a = 0; a < n; ++a)
 		for (int b = 0; b < n; ++b) {
 			int i = 3 * vertices[a / 3] + a % 3, j = 3 * vertices[b / 3] + b % 3;
-			slots[a * n + b] = i <= j ? find_slot(matrix, i, j) : -1;
+			slots[a * n + b] = i <= j ? plume_csc_find(matrix, i, j) : -1;
 		}
 }
 
@@ -164,8 +163,8 @@ plume_status plume_kkt_init(plume_kkt *kkt, int vertex_count, int face_count, co
 		fill_block_slots(kkt->matrix, constraint_vertices + 2 * k, 2, kkt->pair_slots + 36 * k);
 		for (int a = 0; a < 6; ++a)
 			kkt->constraint_slots[7 * k + a] =
-			    find_slot(kkt->matrix, 3 * constraint_vertices[2 * k + a / 3] + a % 3, column);
-		kkt->constraint_slots[7 * k + 6] = find_slot(kkt->matrix, column, column);
+			    plume_csc_find(kkt->matrix, 3 * constraint_vertices[2 * k + a / 3] + a % 3, column);
+		kkt->constraint_slots[7 * k + 6] = plume_csc_find(kkt->matrix, column, column);
 	}
 
 	kkt->factor = cholmod_analyze(kkt->matrix, &kkt->common);

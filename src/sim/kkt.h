@@ -40,6 +40,10 @@ typedef struct plume_kkt {
 	double *refine;        ///< scratch for iterative refinement (2 x size)
 } plume_kkt;
 
+/// Index of (row, column) in a CSC matrix with sorted row indices, or -1 when the entry is
+/// not stored (also used by the lab's quadratic band model).
+int plume_csc_find(const cholmod_sparse *matrix, int row, int column);
+
 /// Builds the pattern from faces (3 vertices), hinges (4 vertices), per-vertex blocks and
 /// constraints (2 vertices each), and runs the symbolic analysis.
 plume_status plume_kkt_init(plume_kkt *kkt, int vertex_count, int face_count, const int *faces, int hinge_count,
