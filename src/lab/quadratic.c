@@ -9,9 +9,12 @@
 //   dW/dx_a      = F S g_a
 //   d2W/dx_a dx_b = B_a^T C B_b + (g_a . S g_b) I,
 // B_a the 3x2 derivative of (E11, E22, 2 E12) with respect to x_a, C = k diag(1, 1, 1/2).
-// Where the barbules are compressed the second term makes the Hessian indefinite;
-// Newton then takes the projected Hessian, with S replaced by its positive part
-// (positive semidefinite by construction).
+// Kikuuwe's compression term (thesis eq. 6.6) is added on J = det F (element_evaluate).
+// Where the barbules are compressed the Hessian can be indefinite; Newton then shifts
+// it by mu diag(H) (factor_newton_matrix).
+// The degree-4 rule is exact for the St-Venant-Kirchhoff part; the cubic Kikuuwe term
+// on J (degree 2 in x) is of degree six and is integrated approximately, consistently
+// in the energy and its derivatives.
 #include "lab/quadratic.h"
 
 #include <math.h>
@@ -71,6 +74,11 @@ struct plume_quadratic {
 	bool started;
 	cholmod_sparse *matrix;
 	cholmod_factor *factor;
+	/// Newton's right-hand side and CHOLMOD's solution and workspace, kept between solves.
+	cholmod_dense *rhs;
+	cholmod_dense *solution;
+	cholmod_dense *work_y;
+	cholmod_dense *work_e;
 	/// Slot of each element block entry in matrix->x (upper part over free unknowns), else -1.
 	int *slots;
 };
@@ -378,7 +386,8 @@ static plume_status build_matrix(plume_quadratic *m, plume_error *err)
 			}
 	}
 	m->factor = cholmod_analyze(m->matrix, &m->common);
-	if (m->factor == NULL)
+	m->rhs = cholmod_zeros((size_t)n, 1, CHOLMOD_REAL, &m->common);
+	if (m->factor == NULL || m->rhs == NULL)
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "CHOLMOD could not analyse the band model's matrix (status %d)",
 		                       m->common.status);
 	return PLUME_OK;
@@ -386,8 +395,6 @@ static plume_status build_matrix(plume_quadratic *m, plume_error *err)
 
 // ---------------------------------------------------------------------------
 // Newton's method
-
-enum hessian_kind { NO_HESSIAN, EXACT_HESSIAN };
 
 static double sum_energies(const plume_quadratic *m)
 {
@@ -406,29 +413,27 @@ static double energy_at(plume_quadratic *m, const double *x)
 	return sum_energies(m);
 }
 
-// Energy and the full gradient at x; with a Hessian kind, its free block into the matrix.
-static double assemble(plume_quadratic *m, const double *x, enum hessian_kind kind)
+// Energy, the full gradient and the exact Hessian's free block (into the matrix) at x.
+static double assemble(plume_quadratic *m, const double *x)
 {
 #pragma omp parallel for schedule(static) if (m->element_count >= 1024)
 	for (int e = 0; e < m->element_count; ++e)
 		m->element_energy[e] = element_evaluate(m, e, x, m->element_gradient + (size_t)DOFS * e,
-		                                        kind == NO_HESSIAN ? NULL : m->element_hessian + (size_t)BLOCK * e);
+		                                        m->element_hessian + (size_t)BLOCK * e);
 	memset(m->gradient, 0, sizeof(double) * 2 * (size_t)m->node_count);
 	for (int e = 0; e < m->element_count; ++e) {
 		const int *nodes = m->elements + NODES * e;
 		for (int r = 0; r < DOFS; ++r)
 			m->gradient[2 * nodes[r / 2] + r % 2] += m->element_gradient[(size_t)DOFS * e + r];
 	}
-	if (kind != NO_HESSIAN) {
-		double *values = m->matrix->x;
-		memset(values, 0, sizeof(double) * (size_t)((int *)m->matrix->p)[m->free_count]);
-		for (int e = 0; e < m->element_count; ++e) {
-			const int *slots = m->slots + (size_t)BLOCK * e;
-			const double *block = m->element_hessian + (size_t)BLOCK * e;
-			for (int k = 0; k < BLOCK; ++k)
-				if (slots[k] >= 0)
-					values[slots[k]] += block[k];
-		}
+	double *values = m->matrix->x;
+	memset(values, 0, sizeof(double) * (size_t)((int *)m->matrix->p)[m->free_count]);
+	for (int e = 0; e < m->element_count; ++e) {
+		const int *slots = m->slots + (size_t)BLOCK * e;
+		const double *block = m->element_hessian + (size_t)BLOCK * e;
+		for (int k = 0; k < BLOCK; ++k)
+			if (slots[k] >= 0)
+				values[slots[k]] += block[k];
 	}
 	return sum_energies(m);
 }
@@ -485,13 +490,11 @@ static void residual_of(const plume_quadratic *m, double *free_force, double *cl
 // Minimises the energy with the clamps where m->x has them. Returns convergence.
 static bool newton(plume_quadratic *m, int *iterations, double *relative_residual)
 {
-	cholmod_dense *rhs = cholmod_zeros((size_t)m->free_count, 1, CHOLMOD_REAL, &m->common);
-	cholmod_dense *solution = NULL, *work_y = NULL, *work_e = NULL;
 	bool converged = false;
 	*iterations = 0;
 	*relative_residual = INFINITY;
-	for (int it = 0; rhs != NULL; ++it) {
-		double energy = assemble(m, m->x, EXACT_HESSIAN);
+	for (int it = 0;; ++it) {
+		double energy = assemble(m, m->x);
 		double free_force, clamp_force;
 		residual_of(m, &free_force, &clamp_force);
 		double scale = clamp_force > 0.0 ? clamp_force : 1.0;
@@ -505,21 +508,21 @@ static bool newton(plume_quadratic *m, int *iterations, double *relative_residua
 		if (it == m->solver.max_iterations || !factor_newton_matrix(m))
 			break;
 		*iterations = it + 1;
-		double *b = rhs->x;
+		double *b = m->rhs->x;
 		for (int k = 0; k < 2 * m->node_count; ++k)
 			if (m->free_index[k] >= 0)
 				b[m->free_index[k]] = -m->gradient[k];
-		if (!cholmod_solve2(CHOLMOD_A, m->factor, rhs, NULL, &solution, NULL, &work_y, &work_e, &m->common))
+		if (!cholmod_solve2(CHOLMOD_A, m->factor, m->rhs, NULL, &m->solution, NULL, &m->work_y, &m->work_e,
+		                    &m->common))
 			break;
-		const double *dx = solution->x;
+		const double *dx = m->solution->x;
 		double slope = 0.0;
 		for (int i = 0; i < m->free_count; ++i)
 			slope -= b[i] * dx[i];
 		// Backtracking (Armijo) on the energy. Near the solution the energy's changes fall
 		// below its round-off: a full step that does not raise it beyond that is taken.
 		bool accepted = false;
-		double alpha = 1.0;
-		for (; alpha > 1e-10 && !accepted; alpha *= 0.5) {
+		for (double alpha = 1.0; alpha > 1e-10; alpha *= 0.5) {
 			memcpy(m->trial, m->x, sizeof(double) * 2 * (size_t)m->node_count);
 			for (int k = 0; k < 2 * m->node_count; ++k)
 				if (m->free_index[k] >= 0)
@@ -534,10 +537,6 @@ static bool newton(plume_quadratic *m, int *iterations, double *relative_residua
 			break;
 		memcpy(m->x, m->trial, sizeof(double) * 2 * (size_t)m->node_count);
 	}
-	cholmod_free_dense(&rhs, &m->common);
-	cholmod_free_dense(&solution, &m->common);
-	cholmod_free_dense(&work_y, &m->common);
-	cholmod_free_dense(&work_e, &m->common);
 	return converged;
 }
 
@@ -604,7 +603,7 @@ plume_status plume_quadratic_solve(plume_quadratic *m, double displacement, plum
 		}
 	}
 	report->converged = converged;
-	assemble(m, m->x, NO_HESSIAN);
+	// Every Newton exit follows an assembly at the current state: the gradient is current.
 	double force = 0.0;
 	for (int node = 0; node < m->node_count; ++node)
 		if (m->clamp[node] == 2)
@@ -701,6 +700,10 @@ void plume_quadratic_destroy(plume_quadratic *m)
 	if (m->started) {
 		cholmod_free_sparse(&m->matrix, &m->common);
 		cholmod_free_factor(&m->factor, &m->common);
+		cholmod_free_dense(&m->rhs, &m->common);
+		cholmod_free_dense(&m->solution, &m->common);
+		cholmod_free_dense(&m->work_y, &m->common);
+		cholmod_free_dense(&m->work_e, &m->common);
 		cholmod_finish(&m->common);
 	}
 	plume_free(m->elements);

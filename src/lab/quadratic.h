@@ -8,7 +8,7 @@
 // linearly across the band, which is pure bending, so the band model converges at a
 // few thousand elements. This solver is planar (two unknowns per node), clamps the
 // sample's "bottom" and "top" groups and minimises the St-Venant-Kirchhoff energy of
-// isotropic bands with zero Poisson ratio by Newton's method on CHOLMOD's supernodal
+// isotropic bands with zero Poisson ratio by Newton's method on CHOLMOD's simplicial
 // Cholesky factorisation.
 #ifndef PLUME_LAB_QUADRATIC_H
 #define PLUME_LAB_QUADRATIC_H
