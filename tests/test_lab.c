@@ -492,6 +492,15 @@ static void test_quadratic_derivatives(void **state)
 	plume_mesh_destroy(mesh);
 }
 
+// The calibration's tilted sample: 4 x 5.2 mm (aspect 1.3), barbs at 45 degrees, 10 barbs across.
+static plume_sample_def calibration_tilted_sample(int elements)
+{
+	plume_sample_def sample = small_sample(45.0, elements);
+	sample.width = 4e-3;
+	sample.height = 5.2e-3;
+	return sample;
+}
+
 static void test_mesoscale_tilted_converges(void **state)
 {
 	(void)state;
@@ -500,9 +509,7 @@ static void test_mesoscale_tilted_converges(void **state)
 	// the change 2.5 times, against 1.2 times on linear triangles, whose slope moved 8 % from
 	// 4000 to 8000 elements).
 	plume_lab_material material = plume_lab_material_default(PLUME_LAB_MESOSCALE);
-	plume_sample_def sample = small_sample(45.0, 500);
-	sample.width = 4e-3;
-	sample.height = 5.2e-3;
+	plume_sample_def sample = calibration_tilted_sample(500);
 	double slopes[3];
 	for (int k = 0; k < 3; ++k) {
 		sample.element_count = 500 << k;
@@ -514,6 +521,43 @@ static void test_mesoscale_tilted_converges(void **state)
 	assert_true(first > 0.0 && second > 0.0);
 	assert_true(first > 2.0 * second);
 	assert_true(second < 0.02 * slopes[2]);
+}
+
+static void test_mean_slope_over_phases(void **state)
+{
+	(void)state;
+	// The mesoscale mean is the mean of one run per phase; the phase matters at 10 barbs.
+	plume_lab_material material = plume_lab_material_default(PLUME_LAB_MESOSCALE);
+	plume_sample_def sample = calibration_tilted_sample(500);
+	plume_traction_def def = plume_traction_default_def();
+	def.steps = 10;
+	plume_error err = {0};
+	double mean = 0.0;
+	int solves = 0;
+	if (plume_lab_mean_slope(&material, &sample, &def, 2, &mean, &solves, &err) != PLUME_OK)
+		fail_msg("%s", err.message);
+	double at_zero = run_slope(&material, &sample, def.strain_max, def.steps, NULL);
+	material.bands.phase = 0.5;
+	double at_half = run_slope(&material, &sample, def.strain_max, def.steps, NULL);
+	print_message("mesoscale tilted slope at phases 0 and 0.5: %.6g %.6g E_b\n", at_zero / material.E_b,
+	              at_half / material.E_b);
+	assert_close(mean / (0.5 * (at_zero + at_half)), 1.0, 1e-12);
+	assert_true(fabs(at_half - at_zero) > 0.01 * at_zero);
+	assert_true(solves >= 2 * def.steps);
+
+	// The macroscale model has no bands: one run, whatever the phase count.
+	plume_lab_material macro = plume_lab_material_default(PLUME_LAB_MACROSCALE);
+	plume_traction_result single;
+	if (plume_lab_traction(&macro, &sample, &def, &single, &err) != PLUME_OK)
+		fail_msg("%s", err.message);
+	if (plume_lab_mean_slope(&macro, &sample, &def, 4, &mean, &solves, &err) != PLUME_OK)
+		fail_msg("%s", err.message);
+	assert_close(mean / single.slope, 1.0, 1e-14);
+	assert_int_equal(solves, single.solve_count);
+	plume_traction_result_free(&single);
+
+	assert_int_equal(plume_lab_mean_slope(&macro, &sample, &def, 0, &mean, NULL, &err), PLUME_ERROR_SPEC);
+	assert_non_null(strstr(err.message, "phase count is 0"));
 }
 
 // ---------------------------------------------------------------------------
@@ -589,7 +633,13 @@ static void test_plot_and_csv(void **state)
 	snprintf(csv, sizeof csv, "%s/a.csv", dir);
 	double x[5] = {0.0, 0.1, 0.2, 0.3, 0.4}, y[5] = {0.0, 1.0, 2.1, 3.3, 4.6};
 	plume_plot_series series[2] = {{"data", x, y, 5, true, false}, {"line", x, x, 5, false, true}};
-	plume_plot plot = {"title", "strain", "stress [Pa]", false, false, 2, series, 320, 240};
+	plume_plot plot = {.title = "title",
+	                   .x_label = "strain",
+	                   .y_label = "stress [Pa]",
+	                   .series_count = 2,
+	                   .series = series,
+	                   .width = 320,
+	                   .height = 240};
 	plume_error err = {0};
 	assert_int_equal(plume_lab_plot(&plot, png, svg, &err), PLUME_OK);
 	assert_int_equal(plume_lab_plot(&plot, png2, NULL, &err), PLUME_OK);
@@ -600,6 +650,11 @@ static void test_plot_and_csv(void **state)
 	free(bytes);
 	// Deterministic: the same plot, the same bytes.
 	assert_true(test_hash_file(png) == test_hash_file(png2));
+	// The legend moves to the corner asked for.
+	plot.legend = PLUME_LEGEND_BOTTOM_RIGHT;
+	assert_int_equal(plume_lab_plot(&plot, png2, NULL, &err), PLUME_OK);
+	assert_true(test_hash_file(png) != test_hash_file(png2));
+	plot.legend = PLUME_LEGEND_TOP_LEFT;
 	bytes = test_read_file(svg, &size);
 	assert_non_null(bytes);
 	assert_non_null(strstr((const char *)bytes, "<svg"));
@@ -723,6 +778,7 @@ int main(void)
 	    cmocka_unit_test(test_mesoscale_transverse),
 	    cmocka_unit_test(test_quadratic_derivatives),
 	    cmocka_unit_test(test_mesoscale_tilted_converges),
+	    cmocka_unit_test(test_mean_slope_over_phases),
 	    cmocka_unit_test(test_calibration_table_5_1),
 	    cmocka_unit_test(test_small_locking_study),
 	    cmocka_unit_test(test_plot_and_csv),

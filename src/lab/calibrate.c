@@ -66,9 +66,11 @@ static plume_status check(const plume_calibration_def *def, plume_error *err)
 	return plume_lab_validate(&material, s, NULL, err);
 }
 
-// Runs one traction test and returns its slope.
+// Runs one traction test (the mean over phase_count band phases for the mesoscale model)
+// and returns its slope.
 static plume_status slope_of(const plume_lab_material *material, const plume_sample_def *sample, double strain_max,
-                             int steps, plume_calibration_result *result, double *slope, plume_error *err)
+                             int steps, int phase_count, plume_calibration_result *result, double *slope,
+                             plume_error *err)
 {
 	plume_traction_def traction = plume_traction_default_def();
 	traction.strain_max = strain_max;
@@ -81,8 +83,8 @@ static plume_status slope_of(const plume_lab_material *material, const plume_sam
 	// moves that sample's stress, and the slope, by about that much at most, well inside the
 	// mesoscale mesh's own error.
 	traction.accept_residual = 1e-3;
-	plume_traction_result run;
-	plume_status status = plume_lab_traction(material, sample, &traction, &run, err);
+	int solves = 0;
+	plume_status status = plume_lab_mean_slope(material, sample, &traction, phase_count, slope, &solves, err);
 	if (status != PLUME_OK) {
 		char context[160];
 		if (material->model == PLUME_LAB_MACROSCALE)
@@ -93,10 +95,8 @@ static plume_status slope_of(const plume_lab_material *material, const plume_sam
 		plume_error_prefix(err, context);
 		return status;
 	}
-	result->traction_count += 1;
-	result->solve_count += run.solve_count;
-	*slope = run.slope;
-	plume_traction_result_free(&run);
+	result->traction_count += material->model == PLUME_LAB_MESOSCALE ? phase_count : 1;
+	result->solve_count += solves;
 	return PLUME_OK;
 }
 
@@ -125,25 +125,20 @@ plume_status plume_lab_calibrate(const plume_calibration_def *def, plume_calibra
 	straight.element_count = 200;
 	straight.barb_angle = 0.0;
 	status =
-	    slope_of(&meso, &straight, def->longitudinal_strain_max, def->steps, result, &result->slope_longitudinal, err);
+	    slope_of(&meso, &straight, def->longitudinal_strain_max, def->steps, 1, result, &result->slope_longitudinal, err);
 	if (status == PLUME_OK) {
 		straight.barb_angle = 0.5 * PI;
 		status =
-		    slope_of(&meso, &straight, def->transverse_strain_max, def->steps, result, &result->slope_transverse, err);
+		    slope_of(&meso, &straight, def->transverse_strain_max, def->steps, 1, result, &result->slope_transverse, err);
 	}
 	plume_sample_def tilted = def->sample;
 	tilted.height = height;
 	tilted.barb_angle = 0.25 * PI;
 	// The tilted slope of a sample a few barbs wide depends on where the bands meet its
-	// corners (+-6 % at 10 barbs): the target is its mean over evenly spaced band phases,
-	// the expected slope of a sample cut at a random place in the vane.
-	for (int k = 0; k < def->phase_count && status == PLUME_OK; ++k) {
-		plume_lab_material shifted = meso;
-		shifted.bands.phase = (double)k / def->phase_count;
-		double slope = 0.0;
-		status = slope_of(&shifted, &tilted, def->transverse_strain_max, def->steps, result, &slope, err);
-		result->slope_tilted += slope / def->phase_count;
-	}
+	// corners: the target is its mean over band phases.
+	if (status == PLUME_OK)
+		status = slope_of(&meso, &tilted, def->transverse_strain_max, def->steps, def->phase_count, result,
+		                  &result->slope_tilted, err);
 	if (status != PLUME_OK) {
 		plume_error_prefix(err, "calibration");
 		return status;
@@ -164,19 +159,19 @@ plume_status plume_lab_calibrate(const plume_calibration_def *def, plume_calibra
 	// bracket should not reach further than it needs.
 	double lo = log(0.25 * macro.E_ww), hi = lo, f_lo = 0.0, f_hi = 0.0, slope = 0.0;
 	macro.E_vw = exp(lo);
-	status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, result, &slope, err);
+	status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, 1, result, &slope, err);
 	f_lo = f_hi = slope - target;
 	double step = log(2.0);
 	for (int expand = 0; expand < 12 && status == PLUME_OK && (f_lo > 0.0) == (f_hi > 0.0); ++expand) {
 		double x = f_lo > 0.0 ? lo - step : hi + step;
 		macro.E_vw = exp(x);
-		status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, result, &slope, err);
+		status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, 1, result, &slope, err);
 		// Newton may fail on a very stiff trial: step out by half as far and try again.
 		for (int retry = 0; retry < 4 && status == PLUME_ERROR_NUMERIC; ++retry) {
 			step *= 0.5;
 			x = f_lo > 0.0 ? lo - step : hi + step;
 			macro.E_vw = exp(x);
-			status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, result, &slope, err);
+			status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, 1, result, &slope, err);
 		}
 		if (f_lo > 0.0) {
 			hi = lo, f_hi = f_lo;
@@ -198,7 +193,7 @@ plume_status plume_lab_calibrate(const plume_calibration_def *def, plume_calibra
 		if (!(x > lo && x < hi))
 			x = 0.5 * (lo + hi);
 		macro.E_vw = exp(x);
-		status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, result, &slope, err);
+		status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, 1, result, &slope, err);
 		double f = slope - target;
 		result->bisection_iterations += 1;
 		if (f == 0.0) {
@@ -220,7 +215,7 @@ plume_status plume_lab_calibrate(const plume_calibration_def *def, plume_calibra
 			// Slow progress: bisect once.
 			double mid = 0.5 * (lo + hi);
 			macro.E_vw = exp(mid);
-			status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, result, &slope, err);
+			status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, 1, result, &slope, err);
 			result->bisection_iterations += 1;
 			if ((slope - target > 0.0) == (f_hi > 0.0))
 				hi = mid, f_hi = slope - target;
@@ -238,7 +233,7 @@ plume_status plume_lab_calibrate(const plume_calibration_def *def, plume_calibra
 	if (!(x >= lo && x <= hi))
 		x = 0.5 * (lo + hi);
 	macro.E_vw = exp(x);
-	status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, result, &result->slope_tilted_macroscale,
+	status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, 1, result, &result->slope_tilted_macroscale,
 	                  err);
 	if (status != PLUME_OK) {
 		plume_error_prefix(err, "calibration");

@@ -130,8 +130,11 @@ static plume_status draw(const plume_plot *plot, plume_error *err)
 	plwidth(1.0);
 	if (n > 0) {
 		PLFLT legend_width, legend_height;
-		pllegend(&legend_width, &legend_height, PL_LEGEND_BOUNDING_BOX,
-		         PL_POSITION_TOP | PL_POSITION_LEFT | PL_POSITION_INSIDE, 0.02, 0.02, 0.08, 0, 1, 1, 0, 0, n, opts, 1.0,
+		bool top = plot->legend == PLUME_LEGEND_TOP_LEFT || plot->legend == PLUME_LEGEND_TOP_RIGHT;
+		bool left = plot->legend == PLUME_LEGEND_TOP_LEFT || plot->legend == PLUME_LEGEND_BOTTOM_LEFT;
+		PLINT position = (top ? PL_POSITION_TOP : PL_POSITION_BOTTOM) | (left ? PL_POSITION_LEFT : PL_POSITION_RIGHT) |
+		                 PL_POSITION_INSIDE;
+		pllegend(&legend_width, &legend_height, PL_LEGEND_BOUNDING_BOX, position, 0.02, 0.02, 0.08, 0, 1, 1, 0, 0, n, opts, 1.0,
 		         0.8, 2.0, 0.0, text_colors, texts, NULL, NULL, NULL, NULL, line_colors, line_styles, line_widths,
 		         symbol_colors, symbol_scales, symbol_numbers, symbols);
 	}

@@ -304,20 +304,16 @@ static plume_status study_conditioning(const plume_study_def *def, const char *c
 // ---------------------------------------------------------------------------
 // Barb angles
 
+// The slope of a traction test, for the mesoscale model the mean over the calibration's
+// band phases: the measure the calibration fitted E_vw to, so the models meet at 45 degrees.
 static plume_status slope_at(const plume_lab_material *material, const plume_sample_def *sample, int steps,
-                             double *slope, plume_error *err)
+                             int phase_count, double *slope, plume_error *err)
 {
 	plume_traction_def def = plume_traction_default_def();
 	def.steps = steps;
 	def.solver.tolerance = 1e-6;
 	def.accept_residual = 1e-4;
-	plume_traction_result r;
-	plume_status status = plume_lab_traction(material, sample, &def, &r, err);
-	if (status != PLUME_OK)
-		return status;
-	*slope = r.slope;
-	plume_traction_result_free(&r);
-	return PLUME_OK;
+	return plume_lab_mean_slope(material, sample, &def, phase_count, slope, NULL, err);
 }
 
 static plume_status study_angles(const plume_study_def *def, const char *csv, const char *png, const char *svg,
@@ -355,10 +351,10 @@ static plume_status study_angles(const plume_study_def *def, const char *csv, co
 			angle_deg[a] = 15.0 * a;
 			sample.barb_angle = angle_deg[a] * PI / 180.0;
 			sample.element_count = cal.sample.element_count;
-			status = slope_at(&meso_material, &sample, cal.steps, &meso[p][a], err);
+			status = slope_at(&meso_material, &sample, cal.steps, cal.phase_count, &meso[p][a], err);
 			sample.element_count = cal.macroscale_elements;
 			if (status == PLUME_OK)
-				status = slope_at(&macro_material, &sample, cal.steps, &macro[p][a], err);
+				status = slope_at(&macro_material, &sample, cal.steps, 1, &macro[p][a], err);
 			if (status == PLUME_OK) {
 				meso[p][a] /= E_b[p];
 				macro[p][a] /= E_b[p];
@@ -395,6 +391,7 @@ static plume_status study_angles(const plume_study_def *def, const char *csv, co
 		                   .x_label = "barb angle #fi#gh#fn [deg]",
 		                   .y_label = "slope / #fiE#db#u#fn",
 		                   .log_y = true,
+		                   .legend = PLUME_LEGEND_TOP_RIGHT,
 		                   .series_count = 6,
 		                   .series = series};
 		status = plume_lab_plot(&plot, png, svg, err);

@@ -2,6 +2,7 @@
 // edge moved along y, sides free, solved as a sequence of static problems at
 // evenly spaced measured strains, each warm-started from the previous one.
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "core/alloc.h"
@@ -300,4 +301,37 @@ plume_status plume_lab_traction(const plume_lab_material *material, const plume_
 	solver_destroy(&solver);
 	plume_mesh_destroy(mesh);
 	return status;
+}
+
+plume_status plume_lab_mean_slope(const plume_lab_material *material, const plume_sample_def *sample,
+                                  const plume_traction_def *def, int phase_count, double *slope, int *solve_count,
+                                  plume_error *err)
+{
+	if (phase_count < 1)
+		return plume_error_set(err, PLUME_ERROR_SPEC, "phase count is %d, allowed >= 1", phase_count);
+	int runs = material->model == PLUME_LAB_MESOSCALE ? phase_count : 1;
+	double sum = 0.0;
+	int solves = 0;
+	for (int k = 0; k < runs; ++k) {
+		plume_lab_material shifted = *material;
+		if (runs > 1)
+			shifted.bands.phase = (double)k / runs;
+		plume_traction_result r;
+		plume_status status = plume_lab_traction(&shifted, sample, def, &r, err);
+		if (status != PLUME_OK) {
+			if (runs > 1) {
+				char context[48];
+				snprintf(context, sizeof context, "band phase %g", shifted.bands.phase);
+				plume_error_prefix(err, context);
+			}
+			return status;
+		}
+		sum += r.slope;
+		solves += r.solve_count;
+		plume_traction_result_free(&r);
+	}
+	*slope = sum / runs;
+	if (solve_count != NULL)
+		*solve_count = solves;
+	return PLUME_OK;
 }
