@@ -19,6 +19,7 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
+PLUME_API_BEGIN
 
 typedef struct plume_coat plume_coat;
 
@@ -56,6 +57,7 @@ plume_status plume_coat_write_usda(const plume_coat *coat, const char *path, plu
 plume_status plume_coat_render2d(const plume_coat *coat, const plume_render2d_def *def, plume_image_format format,
                                  const char *path, plume_error *err);
 
+PLUME_API_END
 #ifdef __cplusplus
 }
 #endif

@@ -9,9 +9,21 @@
 #include <stddef.h>
 #include <stdint.h>
 
+// Exported from the shared library: the declarations between PLUME_API_BEGIN and
+// PLUME_API_END in these headers. libplume is compiled with hidden visibility
+// (CMakeLists.txt), so its internal functions stay internal.
+#if defined(__GNUC__)
+#define PLUME_API_BEGIN _Pragma("GCC visibility push(default)")
+#define PLUME_API_END _Pragma("GCC visibility pop")
+#else
+#define PLUME_API_BEGIN
+#define PLUME_API_END
+#endif
+
 #ifdef __cplusplus
 extern "C" {
 #endif
+PLUME_API_BEGIN
 
 #define PLUME_VERSION_MAJOR 0
 #define PLUME_VERSION_MINOR 1
@@ -195,6 +207,7 @@ double plume_rng_range(plume_rng *rng, double lo, double hi);
 /// An independent stream: the generator seeded from this one's next output.
 plume_rng plume_rng_split(plume_rng *rng);
 
+PLUME_API_END
 #ifdef __cplusplus
 }
 #endif

@@ -20,6 +20,7 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
+PLUME_API_BEGIN
 
 typedef struct plume_barb_embedding plume_barb_embedding;
 
@@ -44,6 +45,7 @@ double plume_embedding_max_offset(const plume_barb_embedding *embedding);
 
 void plume_embedding_destroy(plume_barb_embedding *embedding);
 
+PLUME_API_END
 #ifdef __cplusplus
 }
 #endif

@@ -16,6 +16,7 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
+PLUME_API_BEGIN
 
 typedef struct plume_feather plume_feather;
 
@@ -124,6 +125,7 @@ plume_feather *plume_feather_clone(const plume_feather *feather);
 /// DIR/summary.json and prints them.
 const char *plume_feather_summary(const plume_feather *feather);
 
+PLUME_API_END
 #ifdef __cplusplus
 }
 #endif

@@ -8,6 +8,7 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
+PLUME_API_BEGIN
 
 /// Wavefront OBJ: shaft and barbs (and barbules) as polyline elements
 /// "l v/vt ..." with texture coordinates, one object per part, so Blender and
@@ -26,6 +27,7 @@ plume_status plume_write_json(const plume_feather *feather, const char *path, pl
 /// feather that was written, bit for bit.
 plume_status plume_read_json(const char *path, plume_feather **out, plume_error *err);
 
+PLUME_API_END
 #ifdef __cplusplus
 }
 #endif

@@ -26,6 +26,7 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
+PLUME_API_BEGIN
 
 // ---------------------------------------------------------------------------
 // Analytic references (thesis 5.2 and appendix C.1). Strains are the measured
@@ -374,6 +375,7 @@ plume_status plume_lab_plot(const plume_plot *plot, const char *png_path, const 
 plume_status plume_lab_write_csv(const char *path, const char *header, const double *const *columns, int column_count,
                                  int row_count, plume_error *err);
 
+PLUME_API_END
 #ifdef __cplusplus
 }
 #endif

@@ -16,6 +16,7 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
+PLUME_API_BEGIN
 
 /// Material of a face.
 typedef enum plume_material_id {
@@ -173,6 +174,7 @@ plume_status plume_mesh_read_obj(const char *path, plume_mesh **out, plume_error
 plume_status plume_mesh_write_obj(const plume_mesh *mesh, const plume_vec3 *positions, const char *path,
                                   plume_error *err);
 
+PLUME_API_END
 #ifdef __cplusplus
 }
 #endif

@@ -10,6 +10,7 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
+PLUME_API_BEGIN
 
 // ---------------------------------------------------------------------------
 // Franco & Walter 2002, "Modeling and Rendering of Individual Feathers", section 4.
@@ -119,6 +120,7 @@ plume_status plume_spec_generate(const char *path, const plume_spec_options *opt
 /// Reads a Franco–Walter spec into def and its seed (1 when absent).
 plume_status plume_fw_def_read(const char *path, plume_fw_def *def, uint64_t *seed, plume_error *err);
 
+PLUME_API_END
 #ifdef __cplusplus
 }
 #endif

@@ -21,6 +21,7 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
+PLUME_API_BEGIN
 
 // ---------------------------------------------------------------------------
 // Camera
@@ -195,6 +196,7 @@ plume_status plume_write_rgba_png(int width, int height, const uint8_t *rgba, co
 /// A camera with "eye" or "target" is not automatic. Errors read "file: $.json.path: what is allowed".
 plume_status plume_raytrace_def_read(const char *path, plume_raytrace_def *def, plume_error *err);
 
+PLUME_API_END
 #ifdef __cplusplus
 }
 #endif

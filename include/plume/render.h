@@ -7,6 +7,7 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
+PLUME_API_BEGIN
 
 typedef enum plume_image_format {
 	PLUME_IMAGE_PNG = 0,
@@ -136,6 +137,7 @@ plume_shell_view_def plume_shell_view_default_def(void);
 plume_status plume_render_shell_png(const plume_mesh *mesh, const plume_vec3 *positions,
                                     const plume_shell_view_def *def, const char *path, plume_error *err);
 
+PLUME_API_END
 #ifdef __cplusplus
 }
 #endif

@@ -11,6 +11,7 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
+PLUME_API_BEGIN
 
 /// One key of a handle's scripted motion: at `time` the handle's vertices are at
 /// rotation(axis, angle) (rest - pivot) + pivot + translation.
@@ -111,6 +112,7 @@ typedef plume_status plume_scene_step_fn(void *user, int step, double time, cons
 plume_status plume_scene_run(const plume_scene *scene, plume_scene_step_fn *on_step, void *user,
                              plume_scene_summary *summary, plume_error *err);
 
+PLUME_API_END
 #ifdef __cplusplus
 }
 #endif

@@ -15,6 +15,7 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
+PLUME_API_BEGIN
 
 enum { PLUME_MAX_MATERIALS = 8 };
 
@@ -164,6 +165,7 @@ typedef struct plume_sim_energies {
 } plume_sim_energies;
 plume_sim_energies plume_sim_energy(plume_sim *sim);
 
+PLUME_API_END
 #ifdef __cplusplus
 }
 #endif

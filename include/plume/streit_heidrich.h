@@ -31,6 +31,7 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
+PLUME_API_BEGIN
 
 /// Most control vertices of one key barb (degree 31).
 #define PLUME_SH_MAX_CVS 32
@@ -207,6 +208,7 @@ plume_status plume_sh_scan_barb_lengths(const char *image_path, const plume_sh_s
 /// PLUME_SH_MAX_CVS points to cvs and returns their count. For tests and tools.
 int plume_sh_barb_cvs(const plume_sh_params *params, uint64_t seed, double rp, int barb_index, plume_vec3 *cvs);
 
+PLUME_API_END
 #ifdef __cplusplus
 }
 #endif

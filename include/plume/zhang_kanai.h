@@ -25,6 +25,7 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
+PLUME_API_BEGIN
 
 #define PLUME_ZK_MAX_CURVE_POINTS 16
 #define PLUME_ZK_MAX_COLLAR_POINTS 64
@@ -218,6 +219,7 @@ plume_status plume_zk_generate(const plume_zk_def *def, uint64_t seed, plume_fea
 /// Reads a zhang-kanai spec (docs/spec-zhang-kanai.md) into def and its seed (1 when absent).
 plume_status plume_zk_def_read(const char *path, plume_zk_def *def, uint64_t *seed, plume_error *err);
 
+PLUME_API_END
 #ifdef __cplusplus
 }
 #endif

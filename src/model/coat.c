@@ -689,7 +689,8 @@ plume_status coat_build(coat_def *def, plume_coat **out, plume_error *err)
 		coat->is_key[slot] = key_of[i] >= 0;
 		statuses[slot] = s;
 		if (s != PLUME_OK) {
-#pragma omp critical(plume_coat_error)
+			// Unnamed: a named section's lock is a global symbol libplume.so would export.
+#pragma omp critical
 			if (slot < failed) {
 				failed = slot;
 				*errors = local;
