@@ -103,10 +103,11 @@ static plume_status write_traction(cli_output *output, const plume_traction_resu
 	               fprintf(file,
 	                       "{\"slope_pa\": %.10g, \"strain_max\": %.10g, \"steps\": %d, "
 	                       "\"newton_iterations\": %d, \"lateral_strain\": %.6g, "
-	                       "\"model\": \"%s\", \"barb_angle_deg\": %.10g}\n",
+	                       "\"model\": \"%s\", \"barb_angle_deg\": %.10g, \"compression\": %s}\n",
 	                       r->slope, spec->traction.strain_max, spec->traction.steps, r->newton_iterations,
 	                       r->lateral_strain, spec->material.model == PLUME_LAB_MESOSCALE ? "mesoscale" : "macroscale",
-	                       spec->sample.barb_angle * 180.0 / 3.14159265358979323846) >= 0;
+	                       spec->sample.barb_angle * 180.0 / 3.14159265358979323846,
+	                       spec->traction.compression ? "true" : "false") >= 0;
 	if (file != NULL && fclose(file) != 0)
 		written = false;
 	if (!written)

@@ -16,7 +16,7 @@ static const char *const material_keys[] = {
     "E_b",   "barb_fraction", "band_period", "barb_divisions", "barbule_divisions", "compression_coefficient", "band_phase", NULL};
 static const char *const traction_keys[] = {
     "strain_max",          "steps",           "tolerance", "max_iterations", "max_substep_halvings",
-    "require_convergence", "accept_residual", NULL};
+    "require_convergence", "accept_residual", "compression", NULL};
 
 static void read_sample(plume_spec_reader *reader, const json_t *object, plume_sample_def *sample)
 {
@@ -82,6 +82,7 @@ static void read_traction(plume_spec_reader *reader, const json_t *object, plume
 	plume_spec_int(reader, object, "$.traction", "max_substep_halvings", &traction->solver.max_substep_halvings);
 	plume_spec_bool(reader, object, "$.traction", "require_convergence", &traction->require_convergence);
 	plume_spec_number(reader, object, "$.traction", "accept_residual", &traction->accept_residual);
+	plume_spec_bool(reader, object, "$.traction", "compression", &traction->compression);
 }
 
 plume_status plume_lab_spec_load(const char *path, plume_lab_spec *spec, plume_error *err)

@@ -95,6 +95,9 @@ plume_status plume_lab_validate(const plume_lab_material *material, const plume_
 	if (traction != NULL) {
 		REQUIRE(positive(traction->strain_max) && traction->strain_max <= 10.0,
 		        "traction.strain_max is %g, allowed in (0, 10]", traction->strain_max);
+		// In compression the measured strain -eps_max needs 1 - 2 eps_max > 0: at 0.5 the clamps meet.
+		REQUIRE(!traction->compression || traction->strain_max < 0.5,
+		        "traction.strain_max is %g in compression, allowed in (0, 0.5)", traction->strain_max);
 		REQUIRE(traction->steps >= 1 && traction->steps <= 100000, "traction.steps is %d, allowed in [1, 100000]",
 		        traction->steps);
 		REQUIRE(positive(traction->solver.tolerance), "traction.tolerance is %g, allowed > 0",

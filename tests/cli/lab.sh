@@ -67,11 +67,31 @@ assert r['solves'] > 0 and 'tilted_mesoscale' in r['slopes'] and r['phases'] == 
 
 # --- study ---------------------------------------------------------------------
 expect_failure "unknown study" 2 "unknown study 'bending'" "$plume" lab study bending -o "$scratch/s"
-"$plume" lab study size -o "$scratch/size" --scale 0.25 >"$scratch/out.txt" 2>"$scratch/err.txt"
-check "size study succeeds ($(cat "$scratch/err.txt"))" test $? -eq 0
-for file in size.csv size.png size.svg; do
-	check "size study: $file written" test -s "$scratch/size/$file"
+# The locking study at a twentieth of its size: the paper's point, unaligned meshes lock.
+"$plume" lab study locking -o "$scratch/locking" --scale 0.05 >"$scratch/out.txt" 2>"$scratch/err.txt"
+check "locking study succeeds ($(cat "$scratch/err.txt"))" test $? -eq 0
+for file in locking.csv locking.png locking.svg; do
+	check "locking study: $file written" test -s "$scratch/locking/$file"
 done
-check "size study: summary" grep -q '"study": "size"' "$scratch/out.txt"
+check "locking study: 35 rows and a header" test "$(wc -l <"$scratch/locking/locking.csv")" -eq 36
+check "locking study: summary" python3 -c "
+import json
+r = json.load(open('$scratch/out.txt'))
+assert r['study'] == 'locking' and r['unconverged_runs'] == 0
+ratio = r['unaligned_over_aligned_error_alpha_1e4']
+assert ratio['elements'] == 50 and ratio['ratio'] > 10
+"
+
+# --- compression (thesis A.3): the barbs buckle, the stress plateaus -------------
+"$plume" lab traction "$examples/compression-mesoscale.json" -o "$scratch/compression" >/dev/null 2>"$scratch/err.txt"
+check "compression succeeds ($(cat "$scratch/err.txt"))" test $? -eq 0
+check "compression: the JSON says so" grep -q '"compression": true' "$scratch/compression/traction.json"
+check "compression: negative strains, a plateau near Euler's 9.3e5 Pa" python3 -c "
+import csv
+rows = list(csv.DictReader(open('$scratch/compression/traction.csv')))[1:]
+assert all(float(r['strain']) < 0 for r in rows)
+stress = [-float(r['stress_pa']) for r in rows]
+assert 9.3e5 < stress[0] < 1.25 * 9.3e5 and stress[-1] < 1.3 * stress[0]
+"
 
 finish
