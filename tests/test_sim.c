@@ -315,6 +315,43 @@ static void test_steps_are_deterministic(void **state)
 	free(b);
 }
 
+static void test_kkt_factor_reports_indefinite(void **state)
+{
+	(void)state;
+	// Without constraints the Newton matrix is H alone, factored by Cholesky: an indefinite
+	// or non-finite H must not pass as a factorisation (Newton would not descend).
+	plume_kkt kkt;
+	memset(&kkt, 0, sizeof kkt);
+	plume_error err = {0};
+	assert_int_equal(plume_kkt_init(&kkt, 2, 0, NULL, 0, NULL, 0, 0, NULL, &err), PLUME_OK);
+	double *values = plume_kkt_values(&kkt);
+	double shift = -1.0, rhs[6] = {1, 2, 3, 4, 5, 6}, x[6];
+	plume_kkt_zero(&kkt);
+	for (int v = 0; v < 2; ++v)
+		for (int d = 0; d < 3; ++d)
+			values[kkt.vertex_slots[9 * v + 4 * d]] = 2.0;
+	assert_int_equal(plume_kkt_factor(&kkt, false, &shift, &err), PLUME_OK);
+	assert_true(shift == 0.0);
+	assert_int_equal(plume_kkt_solve(&kkt, rhs, x, &err), PLUME_OK);
+	for (int i = 0; i < 6; ++i)
+		assert_close(x[i], rhs[i] / 2.0, 1e-15);
+
+	values[kkt.vertex_slots[9 * 1 + 4 * 2]] = -1.0; // mean |diagonal| 11/6
+	assert_int_equal(plume_kkt_factor(&kkt, false, &shift, &err), PLUME_ERROR_NUMERIC);
+	assert_non_null(strstr(err.message, "not positive definite"));
+	assert_int_equal(plume_kkt_factor(&kkt, true, &shift, &err), PLUME_OK);
+	assert_close(shift, 11.0 / 6.0, 1e-12); // 1e-10, 1e-9 ... 1 times the mean: the first past 1
+	assert_int_equal(plume_kkt_solve(&kkt, rhs, x, &err), PLUME_OK);
+	assert_close(x[5], 6.0 / (shift - 1.0), 1e-12);
+
+	plume_kkt_zero(&kkt);
+	for (int v = 0; v < 2; ++v)
+		for (int d = 0; d < 3; ++d)
+			values[kkt.vertex_slots[9 * v + 4 * d]] = v == 1 && d == 1 ? NAN : 2.0;
+	assert_int_equal(plume_kkt_factor(&kkt, false, &shift, &err), PLUME_ERROR_NUMERIC);
+	plume_kkt_free(&kkt);
+}
+
 static void test_bad_definitions(void **state)
 {
 	(void)state;
@@ -353,6 +390,7 @@ int main(void)
 	    cmocka_unit_test(test_handle_reaches_keyframe),
 	    cmocka_unit_test(test_reaction_balances_load),
 	    cmocka_unit_test(test_steps_are_deterministic),
+	    cmocka_unit_test(test_kkt_factor_reports_indefinite),
 	    cmocka_unit_test(test_bad_definitions),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);

@@ -8,7 +8,7 @@
 // quasi-definite. A quasi-definite matrix has an LDL' factorisation for every
 // symmetric ordering (Vanderbei 1995), so CHOLMOD's simplicial LDL' factors it
 // without pivoting; its supernodal mode computes LL' only and cannot. Without
-// constraints the matrix is H alone and supernodal Cholesky is used.
+// constraints the matrix is H alone, factored by simplicial Cholesky (LL').
 // The pattern is fixed per mesh: the symbolic analysis runs once.
 #ifndef PLUME_SIM_KKT_H
 #define PLUME_SIM_KKT_H
