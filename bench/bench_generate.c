@@ -3,7 +3,6 @@
 //
 // Usage: bench_generate [SPEC.json] [OUTPUT_DIR]   (defaults: the hawk preset, /tmp)
 #define _GNU_SOURCE
-#include <malloc.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -39,12 +38,8 @@ int main(int argc, char **argv)
 	printf("generate            median %8.3f ms   (min %.3f ms, %d runs, one thread)\n", 1e3 * generate_median,
 	       1e3 * times[0], GENERATE_RUNS);
 
-	// The result is ~10 MiB in a few large blocks, which glibc maps fresh from
-	// the kernel each time: zero-filling those pages is a large share of the
-	// time above. A long-running program (an editor, a coat builder) keeps its
-	// heap; this is what generation costs then.
-	mallopt(M_MMAP_THRESHOLD, 256 << 20);
-	mallopt(M_TRIM_THRESHOLD, 512 << 20);
+	// The result is ~10 MiB: see bench_keep_heap.
+	bench_keep_heap();
 	for (int i = 0; i < GENERATE_RUNS; ++i) {
 		plume_feather_destroy(feather);
 		double start = bench_now();

@@ -2,6 +2,7 @@
 #ifndef PLUME_BENCH_SUPPORT_H
 #define PLUME_BENCH_SUPPORT_H
 
+#include <malloc.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <time.h>
@@ -35,6 +36,16 @@ static inline double bench_median(double *values, int count)
 {
 	qsort(values, (size_t)count, sizeof *values, bench_compare);
 	return count % 2 ? values[count / 2] : 0.5 * (values[count / 2 - 1] + values[count / 2]);
+}
+
+/// Keeps freed memory in the process from now on. A result of many MiB in a few large
+/// blocks is otherwise mapped fresh from the kernel each time, and zero-filling those
+/// pages is a large share of a generation; a long-running program (an editor, a coat
+/// builder) keeps its heap, and this measures what generation costs then (glibc).
+static inline void bench_keep_heap(void)
+{
+	mallopt(M_MMAP_THRESHOLD, 256 << 20);
+	mallopt(M_TRIM_THRESHOLD, 512 << 20);
 }
 
 /// Stops the benchmark with the error's message.
