@@ -21,10 +21,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include <cholmod.h>
-
 #include "core/alloc.h"
-#include "sim/kkt.h"
+#include "sim/sparse.h"
 
 enum { NODES = 6, DOFS = 12, POINTS = 6, BLOCK = DOFS * DOFS };
 
@@ -70,16 +68,9 @@ struct plume_quadratic {
 	double *element_gradient;
 	double *element_hessian;
 
-	cholmod_common common;
-	bool started;
-	cholmod_sparse *matrix;
-	cholmod_factor *factor;
-	/// Newton's right-hand side and CHOLMOD's solution and workspace, kept between solves.
-	cholmod_dense *rhs;
-	cholmod_dense *solution;
-	cholmod_dense *work_y;
-	cholmod_dense *work_e;
-	/// Slot of each element block entry in matrix->x (upper part over free unknowns), else -1.
+	/// H over the free unknowns (upper triangle) and its factorisation; Newton's right-hand side.
+	plume_sparse system;
+	/// Slot of each element block entry in system.matrix->x (upper part over free unknowns), else -1.
 	int *slots;
 };
 
@@ -183,9 +174,9 @@ static double element_evaluate(const plume_quadratic *m, int e, const double *x,
 				double twist = dpsi_c * (g[2 * a] * g[2 * b + 1] - g[2 * a + 1] * g[2 * b]);
 				for (int i = 0; i < 2; ++i)
 					for (int j = 0; j < 2; ++j) {
-						double value = k * (B[a][0][i] * B[b][0][j] + B[a][1][i] * B[b][1][j] +
-						                    0.5 * B[a][2][i] * B[b][2][j]) +
-						               d2psi_c * dJ[2 * a + i] * dJ[2 * b + j];
+						double value =
+						    k * (B[a][0][i] * B[b][0][j] + B[a][1][i] * B[b][1][j] + 0.5 * B[a][2][i] * B[b][2][j]) +
+						    d2psi_c * dJ[2 * a + i] * dJ[2 * b + j];
 						if (i == j)
 							value += geometric;
 						else
@@ -274,8 +265,8 @@ static plume_status build_nodes(plume_quadratic *m, const plume_mesh *mesh, plum
 	return PLUME_OK;
 }
 
-static plume_status build_quadrature(plume_quadratic *m, const plume_mesh *mesh, double E_b, double E_B,
-                                     double kappa, double thickness, plume_error *err)
+static plume_status build_quadrature(plume_quadratic *m, const plume_mesh *mesh, double E_b, double E_B, double kappa,
+                                     double thickness, plume_error *err)
 {
 	int count = m->element_count;
 	m->weight = plume_alloc(sizeof(double) * POINTS * (size_t)count);
@@ -308,22 +299,14 @@ static plume_status build_quadrature(plume_quadratic *m, const plume_mesh *mesh,
 	return PLUME_OK;
 }
 
-static int compare_ints2(const void *a, const void *b)
-{
-	const int *p = a, *q = b;
-	if (p[0] != q[0])
-		return p[0] < q[0] ? -1 : 1;
-	return (p[1] > q[1]) - (p[1] < q[1]);
-}
-
 // The free unknowns' upper-triangle pattern (fixed per mesh), its slots and the symbolic analysis.
 static plume_status build_matrix(plume_quadratic *m, plume_error *err)
 {
 	size_t capacity = (size_t)m->element_count * (DOFS * (DOFS + 1) / 2);
-	int *pairs = plume_alloc(sizeof(int) * 2 * (capacity > 0 ? capacity : 1));
+	plume_sparse_entry *entries = plume_alloc(sizeof *entries * (capacity > 0 ? capacity : 1));
 	m->slots = plume_alloc(sizeof(int) * BLOCK * (size_t)(m->element_count > 0 ? m->element_count : 1));
-	if (pairs == NULL || m->slots == NULL) {
-		plume_free(pairs);
+	if (entries == NULL || m->slots == NULL) {
+		plume_free(entries);
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory building the band model's matrix");
 	}
 	// At most DOFS (DOFS + 1) / 2 pairs i <= j per element: every unordered pair and the diagonal.
@@ -333,48 +316,16 @@ static plume_status build_matrix(plume_quadratic *m, plume_error *err)
 		for (int r = 0; r < DOFS; ++r)
 			for (int c = 0; c < DOFS; ++c) {
 				int i = m->free_index[2 * nodes[r / 2] + r % 2], j = m->free_index[2 * nodes[c / 2] + c % 2];
-				if (i >= 0 && j >= 0 && i <= j) {
-					pairs[2 * count] = j;
-					pairs[2 * count + 1] = i;
-					++count;
-				}
+				if (i >= 0 && j >= 0 && i <= j)
+					entries[count++] = (plume_sparse_entry){j, i};
 			}
 	}
-	qsort(pairs, count, 2 * sizeof(int), compare_ints2);
-	size_t unique = 0;
-	for (size_t e = 0; e < count; ++e)
-		if (unique == 0 || compare_ints2(pairs + 2 * (unique - 1), pairs + 2 * e) != 0) {
-			pairs[2 * unique] = pairs[2 * e];
-			pairs[2 * unique + 1] = pairs[2 * e + 1];
-			++unique;
-		}
-	cholmod_start(&m->common);
-	m->started = true;
-	m->common.print = 0; // the library never prints
-	m->common.nmethods = 1;
-	m->common.method[0].ordering = CHOLMOD_AMD;
-	// Simplicial LL': no BLAS, so no threads of its own and the same bits for every
-	// thread count; on these 2D band meshes it is faster than the supernodal method with
-	// Debian's reference BLAS (13 s against 18 s for the 8000-element tilted test).
-	m->common.supernodal = CHOLMOD_SIMPLICIAL;
-	m->common.final_ll = 1;
-	int n = m->free_count;
-	m->matrix = cholmod_allocate_sparse((size_t)n, (size_t)n, unique, 1, 1, 1, CHOLMOD_REAL, &m->common);
-	if (m->matrix == NULL) {
-		plume_free(pairs);
-		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory allocating the band model's matrix");
-	}
-	int *p = m->matrix->p, *rows = m->matrix->i;
-	size_t e = 0;
-	for (int column = 0; column < n; ++column) {
-		p[column] = (int)e;
-		while (e < unique && pairs[2 * e] == column) {
-			rows[e] = pairs[2 * e + 1];
-			++e;
-		}
-	}
-	p[n] = (int)unique;
-	plume_free(pairs);
+	// LL': H is meant to be positive definite, and where it is not Newton shifts it.
+	plume_status status =
+	    plume_sparse_init(&m->system, m->free_count, entries, count, true, "the band model's matrix", err);
+	plume_free(entries);
+	if (status != PLUME_OK)
+		return status;
 	for (int el = 0; el < m->element_count; ++el) {
 		const int *nodes = m->elements + NODES * el;
 		for (int r = 0; r < DOFS; ++r)
@@ -382,14 +333,9 @@ static plume_status build_matrix(plume_quadratic *m, plume_error *err)
 				int i = m->free_index[2 * nodes[r / 2] + r % 2], j = m->free_index[2 * nodes[c / 2] + c % 2];
 				// Each unordered pair once: (r, c) with i < j; i == j only on the diagonal r == c.
 				m->slots[(size_t)el * BLOCK + r * DOFS + c] =
-				    i >= 0 && j >= 0 && i <= j ? plume_csc_find(m->matrix, i, j) : -1;
+				    i >= 0 && j >= 0 && i <= j ? plume_csc_find(m->system.matrix, i, j) : -1;
 			}
 	}
-	m->factor = cholmod_analyze(m->matrix, &m->common);
-	m->rhs = cholmod_zeros((size_t)n, 1, CHOLMOD_REAL, &m->common);
-	if (m->factor == NULL || m->rhs == NULL)
-		return plume_error_set(err, PLUME_ERROR_MEMORY, "CHOLMOD could not analyse the band model's matrix (status %d)",
-		                       m->common.status);
 	return PLUME_OK;
 }
 
@@ -418,16 +364,16 @@ static double assemble(plume_quadratic *m, const double *x)
 {
 #pragma omp parallel for schedule(static) if (m->element_count >= 1024)
 	for (int e = 0; e < m->element_count; ++e)
-		m->element_energy[e] = element_evaluate(m, e, x, m->element_gradient + (size_t)DOFS * e,
-		                                        m->element_hessian + (size_t)BLOCK * e);
+		m->element_energy[e] =
+		    element_evaluate(m, e, x, m->element_gradient + (size_t)DOFS * e, m->element_hessian + (size_t)BLOCK * e);
 	memset(m->gradient, 0, sizeof(double) * 2 * (size_t)m->node_count);
 	for (int e = 0; e < m->element_count; ++e) {
 		const int *nodes = m->elements + NODES * e;
 		for (int r = 0; r < DOFS; ++r)
 			m->gradient[2 * nodes[r / 2] + r % 2] += m->element_gradient[(size_t)DOFS * e + r];
 	}
-	double *values = m->matrix->x;
-	memset(values, 0, sizeof(double) * (size_t)((int *)m->matrix->p)[m->free_count]);
+	double *values = m->system.matrix->x;
+	memset(values, 0, sizeof(double) * (size_t)((int *)m->system.matrix->p)[m->free_count]);
 	for (int e = 0; e < m->element_count; ++e) {
 		const int *slots = m->slots + (size_t)BLOCK * e;
 		const double *block = m->element_hessian + (size_t)BLOCK * e;
@@ -438,11 +384,6 @@ static double assemble(plume_quadratic *m, const double *x)
 	return sum_energies(m);
 }
 
-static bool factored(const plume_quadratic *m)
-{
-	return m->common.status == CHOLMOD_OK && m->factor->minor == m->factor->n;
-}
-
 // Factors the assembled exact Hessian H. Where it is not positive definite (the
 // barbules' compression softens the St-Venant-Kirchhoff energy and a shear band forms),
 // H + mu diag(H) with the smallest mu in a decade ladder that factors: unlike a
@@ -450,13 +391,12 @@ static bool factored(const plume_quadratic *m)
 // a few steps instead of crawling. m->shift remembers the last mu to start near it.
 static bool factor_newton_matrix(plume_quadratic *m)
 {
-	cholmod_factorize(m->matrix, m->factor, &m->common);
-	if (factored(m)) {
+	if (plume_sparse_factor(&m->system)) {
 		m->shift = 0.0;
 		return true;
 	}
-	double *values = m->matrix->x;
-	const int *p = m->matrix->p;
+	double *values = m->system.matrix->x;
+	const int *p = m->system.matrix->p;
 	int n = m->free_count;
 	// The diagonal is the last entry of each upper-triangle column.
 	for (int j = 0; j < n; ++j)
@@ -465,8 +405,7 @@ static bool factor_newton_matrix(plume_quadratic *m)
 	for (; mu <= 1e4; mu *= 10.0) {
 		for (int j = 0; j < n; ++j)
 			values[p[j + 1] - 1] = m->diagonal[j] + mu * fabs(m->diagonal[j]);
-		cholmod_factorize(m->matrix, m->factor, &m->common);
-		if (factored(m)) {
+		if (plume_sparse_factor(&m->system)) {
 			m->shift = mu;
 			return true;
 		}
@@ -508,14 +447,13 @@ static bool newton(plume_quadratic *m, int *iterations, double *relative_residua
 		if (it == m->solver.max_iterations || !factor_newton_matrix(m))
 			break;
 		*iterations = it + 1;
-		double *b = m->rhs->x;
+		double *b = m->system.rhs->x;
 		for (int k = 0; k < 2 * m->node_count; ++k)
 			if (m->free_index[k] >= 0)
 				b[m->free_index[k]] = -m->gradient[k];
-		if (!cholmod_solve2(CHOLMOD_A, m->factor, m->rhs, NULL, &m->solution, NULL, &m->work_y, &m->work_e,
-		                    &m->common))
+		if (!plume_sparse_solve(&m->system))
 			break;
-		const double *dx = m->solution->x;
+		const double *dx = m->system.solution->x;
 		double slope = 0.0;
 		for (int i = 0; i < m->free_count; ++i)
 			slope -= b[i] * dx[i];
@@ -666,8 +604,8 @@ plume_status plume_quadratic_create(const plume_mesh *mesh, double E_b, double E
 		m->element_energy = plume_alloc(sizeof(double) * (size_t)(m->element_count + 1));
 		m->element_gradient = plume_alloc(sizeof(double) * DOFS * (size_t)(m->element_count + 1));
 		m->element_hessian = plume_alloc(sizeof(double) * BLOCK * (size_t)(m->element_count + 1));
-		if (!m->free_index || !m->x || !m->converged || !m->converged_before || !m->trial || !m->gradient || !m->diagonal ||
-		    !m->element_energy || !m->element_gradient || !m->element_hessian)
+		if (!m->free_index || !m->x || !m->converged || !m->converged_before || !m->trial || !m->gradient ||
+		    !m->diagonal || !m->element_energy || !m->element_gradient || !m->element_hessian)
 			status = plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory creating the band model");
 	}
 	if (status == PLUME_OK) {
@@ -697,15 +635,7 @@ void plume_quadratic_destroy(plume_quadratic *m)
 {
 	if (m == NULL)
 		return;
-	if (m->started) {
-		cholmod_free_sparse(&m->matrix, &m->common);
-		cholmod_free_factor(&m->factor, &m->common);
-		cholmod_free_dense(&m->rhs, &m->common);
-		cholmod_free_dense(&m->solution, &m->common);
-		cholmod_free_dense(&m->work_y, &m->common);
-		cholmod_free_dense(&m->work_e, &m->common);
-		cholmod_finish(&m->common);
-	}
+	plume_sparse_free(&m->system);
 	plume_free(m->elements);
 	plume_free(m->slots);
 	plume_free(m->reference);

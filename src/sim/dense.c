@@ -130,9 +130,10 @@ void plume_symmetric_eigen(const double *matrix, int n, double *values, double *
 		memcpy(vectors, z, (size_t)(n * n) * sizeof(double));
 }
 
-void plume_project_psd(double *matrix, int n)
+// Replaces a symmetric matrix by its projection on the PSD cone (negative eigenvalues
+// dropped). Returns false, leaving it untouched, when it already is PSD up to rounding.
+static bool project_if_indefinite(double *matrix, int n)
 {
-	assert(n >= 1 && n <= PLUME_DENSE_MAX);
 	double values[PLUME_DENSE_MAX];
 	double vectors[PLUME_DENSE_MAX * PLUME_DENSE_MAX];
 	plume_symmetric_eigen(matrix, n, values, vectors);
@@ -144,7 +145,7 @@ void plume_project_psd(double *matrix, int n)
 	// Negative only by rounding (the zero eigenvalues of rigid motions come out as
 	// +-1e-17 relative): rebuilding would only add rounding, so keep the matrix as it is.
 	if (smallest >= -16.0 * DBL_EPSILON * largest)
-		return;
+		return false;
 	for (int i = 0; i < n; ++i) {
 		for (int j = i; j < n; ++j) {
 			double sum = 0.0;
@@ -155,6 +156,13 @@ void plume_project_psd(double *matrix, int n)
 			matrix[j * n + i] = sum;
 		}
 	}
+	return true;
+}
+
+void plume_project_psd(double *matrix, int n)
+{
+	assert(n >= 1 && n <= PLUME_DENSE_MAX);
+	project_if_indefinite(matrix, n);
 }
 
 // Orthonormal basis of the vectors of R^m whose entries sum to zero (Helmert): column k
@@ -192,26 +200,9 @@ void plume_project_psd_translation_free(double *matrix, int vertex_count)
 			reduced[i * r + j] = mean;
 			reduced[j * r + i] = mean;
 		}
-	double values[PLUME_DENSE_MAX];
-	double vectors[PLUME_DENSE_MAX * PLUME_DENSE_MAX];
-	plume_symmetric_eigen(reduced, r, values, vectors);
-	double largest = 0.0, smallest = INFINITY;
-	for (int k = 0; k < r; ++k) {
-		largest = fmax(largest, fabs(values[k]));
-		smallest = fmin(smallest, values[k]);
-	}
-	if (smallest >= -16.0 * DBL_EPSILON * largest)
+	if (!project_if_indefinite(reduced, r))
 		return;
-	// Projected reduced matrix, then back: H = (U x I3) P (U x I3)^T.
-	for (int i = 0; i < r; ++i)
-		for (int j = i; j < r; ++j) {
-			double sum = 0.0;
-			for (int k = 0; k < r; ++k)
-				if (values[k] > 0.0)
-					sum += vectors[i * r + k] * values[k] * vectors[j * r + k];
-			reduced[i * r + j] = sum;
-			reduced[j * r + i] = sum;
-		}
+	// Back from the projected reduced matrix: H = (U x I3) P (U x I3)^T.
 	for (int i = 0; i < m; ++i)
 		for (int j = i; j < m; ++j)
 			for (int p = 0; p < 3; ++p)

@@ -9,22 +9,8 @@
 #include "core/alloc.h"
 #include "sim/kkt.h"
 
-/// One stored entry (row <= column): sorted column-major.
-typedef struct entry {
-	int column;
-	int row;
-} entry;
-
-static int compare_entries(const void *a, const void *b)
-{
-	const entry *p = a, *q = b;
-	if (p->column != q->column)
-		return p->column < q->column ? -1 : 1;
-	return (p->row > q->row) - (p->row < q->row);
-}
-
 typedef struct entry_list {
-	entry *items;
+	plume_sparse_entry *items;
 	int count;
 	int capacity;
 } entry_list;
@@ -38,25 +24,9 @@ static int push_block(entry_list *list, const int *vertices, int count)
 				continue;
 			if (PLUME_GROW(list->items, list->capacity, list->count + 1) != 0)
 				return -1;
-			list->items[list->count++] = (entry){j, i};
+			list->items[list->count++] = (plume_sparse_entry){j, i};
 		}
 	return 0;
-}
-
-int plume_csc_find(const cholmod_sparse *matrix, int row, int column)
-{
-	const int *p = matrix->p, *rows = matrix->i;
-	int lo = p[column], hi = p[column + 1] - 1;
-	while (lo <= hi) {
-		int mid = (lo + hi) / 2;
-		if (rows[mid] == row)
-			return mid;
-		if (rows[mid] < row)
-			lo = mid + 1;
-		else
-			hi = mid - 1;
-	}
-	return -1;
 }
 
 static void fill_block_slots(const cholmod_sparse *matrix, const int *vertices, int count, int *slots)
@@ -96,51 +66,23 @@ plume_status plume_kkt_init(plume_kkt *kkt, int vertex_count, int face_count, co
 		}
 		for (int e = 0; e < 2; ++e)
 			for (int d = 0; d < 3; ++d)
-				list.items[list.count++] = (entry){column, 3 * constraint_vertices[2 * k + e] + d};
-		list.items[list.count++] = (entry){column, column};
+				list.items[list.count++] = (plume_sparse_entry){column, 3 * constraint_vertices[2 * k + e] + d};
+		list.items[list.count++] = (plume_sparse_entry){column, column};
 	}
 	if (failed) {
 		plume_free(list.items);
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory building the solver's sparse pattern");
 	}
-	qsort(list.items, (size_t)list.count, sizeof *list.items, compare_entries);
-	int unique = 0;
-	for (int e = 0; e < list.count; ++e)
-		if (unique == 0 || compare_entries(list.items + unique - 1, list.items + e) != 0)
-			list.items[unique++] = list.items[e];
-
-	cholmod_start(&kkt->common);
-	kkt->started = true;
-	// The library never prints: failures come back through the status (DESIGN.md).
-	kkt->common.print = 0;
-	// Deterministic and fast enough at feather sizes; METIS is not needed.
-	kkt->common.nmethods = 1;
-	kkt->common.method[0].ordering = CHOLMOD_AMD;
-	kkt->common.postorder = 1;
-	// Simplicial, with or without constraints: with Debian's reference BLAS the supernodal
-	// method was 5 times slower on Figure 1's isotropic vane (3.7 s against 0.73 s of
-	// factorisation), and without BLAS the bits do not depend on the thread count.
-	// LL' without constraints, so that an indefinite H reports itself (factor_ok).
-	kkt->common.supernodal = CHOLMOD_SIMPLICIAL;
-	kkt->common.final_ll = constraint_count == 0;
-	kkt->matrix =
-	    cholmod_allocate_sparse((size_t)size, (size_t)size, (size_t)unique, 1, 1, 1, CHOLMOD_REAL, &kkt->common);
-	if (kkt->matrix == NULL) {
-		plume_free(list.items);
-		plume_kkt_free(kkt);
-		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory allocating the solver's matrix");
-	}
-	int *p = kkt->matrix->p, *rows = kkt->matrix->i;
-	int e = 0;
-	for (int column = 0; column < size; ++column) {
-		p[column] = e;
-		while (e < unique && list.items[e].column == column) {
-			rows[e] = list.items[e].row;
-			++e;
-		}
-	}
-	p[size] = unique;
+	// LL' without constraints, so that an indefinite H reports itself; the KKT matrix is
+	// quasi-definite, never positive definite: LDL'.
+	plume_status status = plume_sparse_init(&kkt->system, size, list.items, (size_t)list.count, constraint_count == 0,
+	                                        "the solver's matrix", err);
 	plume_free(list.items);
+	if (status != PLUME_OK) {
+		plume_kkt_free(kkt);
+		return status;
+	}
+	const cholmod_sparse *matrix = kkt->system.matrix;
 
 	kkt->vertex_slots = plume_alloc(sizeof(int) * 9 * (size_t)(vertex_count > 0 ? vertex_count : 1));
 	kkt->face_slots = plume_alloc(sizeof(int) * 81 * (size_t)(face_count > 0 ? face_count : 1));
@@ -152,42 +94,27 @@ plume_status plume_kkt_init(plume_kkt *kkt, int vertex_count, int face_count, co
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory allocating the solver's slot maps");
 	}
 	for (int v = 0; v < vertex_count; ++v)
-		fill_block_slots(kkt->matrix, &v, 1, kkt->vertex_slots + 9 * v);
+		fill_block_slots(matrix, &v, 1, kkt->vertex_slots + 9 * v);
 	for (int f = 0; f < face_count; ++f)
-		fill_block_slots(kkt->matrix, faces + 3 * f, 3, kkt->face_slots + 81 * f);
+		fill_block_slots(matrix, faces + 3 * f, 3, kkt->face_slots + 81 * f);
 	for (int h = 0; h < hinge_count; ++h)
-		fill_block_slots(kkt->matrix, (const int *)((const char *)hinge_vertices + (size_t)h * hinge_stride), 4,
+		fill_block_slots(matrix, (const int *)((const char *)hinge_vertices + (size_t)h * hinge_stride), 4,
 		                 kkt->hinge_slots + 144 * h);
 	for (int k = 0; k < constraint_count; ++k) {
 		int column = kkt->dof_count + k;
-		fill_block_slots(kkt->matrix, constraint_vertices + 2 * k, 2, kkt->pair_slots + 36 * k);
+		fill_block_slots(matrix, constraint_vertices + 2 * k, 2, kkt->pair_slots + 36 * k);
 		for (int a = 0; a < 6; ++a)
 			kkt->constraint_slots[7 * k + a] =
-			    plume_csc_find(kkt->matrix, 3 * constraint_vertices[2 * k + a / 3] + a % 3, column);
-		kkt->constraint_slots[7 * k + 6] = plume_csc_find(kkt->matrix, column, column);
+			    plume_csc_find(matrix, 3 * constraint_vertices[2 * k + a / 3] + a % 3, column);
+		kkt->constraint_slots[7 * k + 6] = plume_csc_find(matrix, column, column);
 	}
 
-	kkt->factor = cholmod_analyze(kkt->matrix, &kkt->common);
-	kkt->rhs = cholmod_zeros((size_t)size, 1, CHOLMOD_REAL, &kkt->common);
-	if (kkt->factor == NULL || kkt->rhs == NULL) {
-		plume_kkt_free(kkt);
-		return plume_error_set(err, PLUME_ERROR_MEMORY, "CHOLMOD could not analyse the solver's matrix (status %d)",
-		                       kkt->common.status);
-	}
 	return PLUME_OK;
 }
 
 void plume_kkt_free(plume_kkt *kkt)
 {
-	if (kkt->started) {
-		cholmod_free_sparse(&kkt->matrix, &kkt->common);
-		cholmod_free_factor(&kkt->factor, &kkt->common);
-		cholmod_free_dense(&kkt->rhs, &kkt->common);
-		cholmod_free_dense(&kkt->solution, &kkt->common);
-		cholmod_free_dense(&kkt->work_y, &kkt->common);
-		cholmod_free_dense(&kkt->work_e, &kkt->common);
-		cholmod_finish(&kkt->common);
-	}
+	plume_sparse_free(&kkt->system);
 	plume_free(kkt->vertex_slots);
 	plume_free(kkt->face_slots);
 	plume_free(kkt->hinge_slots);
@@ -197,17 +124,17 @@ void plume_kkt_free(plume_kkt *kkt)
 	memset(kkt, 0, sizeof *kkt);
 }
 
-double *plume_kkt_values(plume_kkt *kkt) { return kkt->matrix->x; }
+double *plume_kkt_values(plume_kkt *kkt) { return kkt->system.matrix->x; }
 
 void plume_kkt_zero(plume_kkt *kkt)
 {
-	const int *p = kkt->matrix->p;
-	memset(kkt->matrix->x, 0, sizeof(double) * (size_t)p[kkt->matrix->ncol]);
+	const int *p = kkt->system.matrix->p;
+	memset(kkt->system.matrix->x, 0, sizeof(double) * (size_t)p[kkt->system.matrix->ncol]);
 }
 
 static double mean_position_diagonal(const plume_kkt *kkt)
 {
-	const double *values = kkt->matrix->x;
+	const double *values = kkt->system.matrix->x;
 	double sum = 0;
 	int vertex_count = kkt->dof_count / 3;
 	for (int v = 0; v < vertex_count; ++v)
@@ -218,36 +145,17 @@ static double mean_position_diagonal(const plume_kkt *kkt)
 
 static void shift_positions(plume_kkt *kkt, double amount)
 {
-	double *values = kkt->matrix->x;
+	double *values = kkt->system.matrix->x;
 	int vertex_count = kkt->dof_count / 3;
 	for (int v = 0; v < vertex_count; ++v)
 		for (int d = 0; d < 3; ++d)
 			values[kkt->vertex_slots[9 * v + 4 * d]] += amount;
 }
 
-static bool factor_ok(const plume_kkt *kkt)
-{
-	if (kkt->common.status != CHOLMOD_OK)
-		return false;
-	// The simplicial LDL' does not pivot: a zero or non-finite pivot shows up in D (a NaN
-	// in H passes LL''s positivity test too, and shows up in its diagonal).
-	if (!kkt->factor->is_super) {
-		const int *p = kkt->factor->p;
-		const double *x = kkt->factor->x;
-		for (size_t j = 0; j < kkt->factor->n; ++j) {
-			double d = x[p[j]];
-			if (!isfinite(d) || d == 0)
-				return false;
-		}
-	}
-	return true;
-}
-
 plume_status plume_kkt_factor(plume_kkt *kkt, bool allow_shift, double *shift, plume_error *err)
 {
 	*shift = 0;
-	cholmod_factorize(kkt->matrix, kkt->factor, &kkt->common);
-	if (factor_ok(kkt))
+	if (plume_sparse_factor(&kkt->system))
 		return PLUME_OK;
 	if (!allow_shift)
 		return plume_error_set(err, PLUME_ERROR_NUMERIC, "the Newton matrix is not positive definite");
@@ -261,24 +169,23 @@ plume_status plume_kkt_factor(plume_kkt *kkt, bool allow_shift, double *shift, p
 		double wanted = factor * base;
 		shift_positions(kkt, wanted - applied);
 		applied = wanted;
-		cholmod_factorize(kkt->matrix, kkt->factor, &kkt->common);
-		if (factor_ok(kkt)) {
+		if (plume_sparse_factor(&kkt->system)) {
 			*shift = applied;
 			return PLUME_OK;
 		}
 	}
 	return plume_error_set(err, PLUME_ERROR_NUMERIC,
 	                       "the Newton system could not be factored (CHOLMOD status %d) even after regularisation",
-	                       kkt->common.status);
+	                       kkt->system.common.status);
 }
 
 static plume_status solve_once(plume_kkt *kkt, const double *rhs, double *solution, plume_error *err)
 {
-	memcpy(kkt->rhs->x, rhs, sizeof(double) * kkt->rhs->nrow);
-	if (!cholmod_solve2(CHOLMOD_A, kkt->factor, kkt->rhs, NULL, &kkt->solution, NULL, &kkt->work_y, &kkt->work_e,
-	                    &kkt->common))
-		return plume_error_set(err, PLUME_ERROR_NUMERIC, "CHOLMOD solve failed (status %d)", kkt->common.status);
-	memcpy(solution, kkt->solution->x, sizeof(double) * kkt->rhs->nrow);
+	plume_sparse *system = &kkt->system;
+	memcpy(system->rhs->x, rhs, sizeof(double) * system->rhs->nrow);
+	if (!plume_sparse_solve(system))
+		return plume_error_set(err, PLUME_ERROR_NUMERIC, "CHOLMOD solve failed (status %d)", system->common.status);
+	memcpy(solution, system->solution->x, sizeof(double) * system->rhs->nrow);
 	return PLUME_OK;
 }
 
@@ -289,11 +196,11 @@ plume_status plume_kkt_solve(plume_kkt *kkt, const double *rhs, double *solution
 	plume_status status = solve_once(kkt, rhs, solution, err);
 	if (status != PLUME_OK || kkt->constraint_count == 0)
 		return status;
-	size_t size = kkt->rhs->nrow;
+	size_t size = kkt->system.rhs->nrow;
 	if (kkt->refine == NULL && (kkt->refine = plume_alloc(2 * sizeof(double) * size)) == NULL)
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory refining the Newton step");
 	double *residual = kkt->refine, *correction = kkt->refine + size;
-	const double *values = kkt->matrix->x;
+	const double *values = kkt->system.matrix->x;
 	for (int step = 0; step < REFINEMENT_STEPS; ++step) {
 		// residual = rhs - K0 x, K0 the matrix without the -d diagonal of the constraint rows.
 		for (size_t i = 0; i < size; ++i)
@@ -315,9 +222,9 @@ plume_status plume_kkt_solve(plume_kkt *kkt, const double *rhs, double *solution
 
 void plume_kkt_multiply_add(const plume_kkt *kkt, const double *x, double *y)
 {
-	const int *p = kkt->matrix->p, *rows = kkt->matrix->i;
-	const double *values = kkt->matrix->x;
-	for (size_t j = 0; j < kkt->matrix->ncol; ++j)
+	const int *p = kkt->system.matrix->p, *rows = kkt->system.matrix->i;
+	const double *values = kkt->system.matrix->x;
+	for (size_t j = 0; j < kkt->system.matrix->ncol; ++j)
 		for (int e = p[j]; e < p[j + 1]; ++e) {
 			size_t i = (size_t)rows[e];
 			y[i] += values[e] * x[j];

@@ -8,27 +8,19 @@
 // quasi-definite. A quasi-definite matrix has an LDL' factorisation for every
 // symmetric ordering (Vanderbei 1995), so CHOLMOD's simplicial LDL' factors it
 // without pivoting; its supernodal mode computes LL' only and cannot. Without
-// constraints the matrix is H alone, factored by simplicial Cholesky (LL').
+// constraints the matrix is H alone, factored by Cholesky (LL', sim/sparse.h).
 // The pattern is fixed per mesh: the symbolic analysis runs once.
 #ifndef PLUME_SIM_KKT_H
 #define PLUME_SIM_KKT_H
 
 #include <stdbool.h>
 
-#include <cholmod.h>
-
 #include "plume/core.h"
+#include "sim/sparse.h"
 
 typedef struct plume_kkt {
-	cholmod_common common;
-	bool started;
-	/// Upper triangle (stype 1), CSC; values rewritten every iteration.
-	cholmod_sparse *matrix;
-	cholmod_factor *factor;
-	cholmod_dense *solution;
-	cholmod_dense *rhs;
-	cholmod_dense *work_y;
-	cholmod_dense *work_e;
+	/// The matrix (upper triangle, values rewritten every iteration) and its factorisation.
+	plume_sparse system;
 	int dof_count;
 	int constraint_count;
 	/// Slot of the entry for each element block pair (upper part), -1 for the lower part.
@@ -39,10 +31,6 @@ typedef struct plume_kkt {
 	int *pair_slots;       ///< 36 per constraint: the 6x6 position block of its two vertices
 	double *refine;        ///< scratch for iterative refinement (2 x size)
 } plume_kkt;
-
-/// Index of (row, column) in a CSC matrix with sorted row indices, or -1 when the entry is
-/// not stored (also used by the lab's quadratic band model).
-int plume_csc_find(const cholmod_sparse *matrix, int row, int column);
 
 /// Builds the pattern from faces (3 vertices), hinges (4 vertices), per-vertex blocks and
 /// constraints (2 vertices each), and runs the symbolic analysis.

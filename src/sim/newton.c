@@ -79,7 +79,7 @@ static double max_constraint_strain(const plume_sim *sim, const plume_vec3 *x)
 
 static double mean_diagonal(const plume_sim *sim)
 {
-	const double *values = sim->kkt.matrix->x;
+	const double *values = sim->kkt.system.matrix->x;
 	double sum = 0;
 	int count = 0;
 	for (int i = 0; i < 3 * sim->vertex_count; ++i)
