@@ -195,6 +195,33 @@ static void test_every_preset_generates(void **state)
 	}
 }
 
+static void test_text_spec_is_the_file_spec(void **state)
+{
+	(void)state;
+	static const char text[] = "{\"model\": \"franco-walter\", \"seed\": 7}";
+	const char *path = spec_file("text.json", text);
+	plume_feather *from_file = NULL, *from_text = NULL;
+	assert_int_equal(plume_spec_generate(path, NULL, &from_file, NULL), PLUME_OK);
+	assert_int_equal(plume_spec_parse(text, "<text>", NULL, &from_text, NULL), PLUME_OK);
+	assert_true(plume_feather_equal(from_file, from_text));
+	plume_feather_destroy(from_file);
+	plume_feather_destroy(from_text);
+
+	int64_t before = plume_bytes_in_use();
+	plume_feather *feather = NULL;
+	plume_error err = {0};
+	assert_int_equal(plume_spec_parse("{\"model\": \"franco-walter\",\n \"seed\": }", "<text>", NULL, &feather, &err),
+	                 PLUME_ERROR_SYNTAX);
+	assert_null(feather);
+	assert_true(strncmp(err.message, "<text>:2:", 9) == 0);
+	assert_int_equal(
+	    plume_spec_parse("{\"model\": \"franco-walter\", \"calamus_fraction\": 2}", "<text>", NULL, &feather, &err),
+	    PLUME_ERROR_SPEC);
+	if (strstr(err.message, "<text>: $.calamus_fraction") == NULL)
+		fail_msg("message '%s' lacks the name and the path", err.message);
+	assert_int_equal(plume_bytes_in_use(), before);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -207,6 +234,7 @@ int main(void)
 	    cmocka_unit_test(test_wrong_types_name_path),
 	    cmocka_unit_test(test_missing_file_is_an_io_error),
 	    cmocka_unit_test(test_every_preset_generates),
+	    cmocka_unit_test(test_text_spec_is_the_file_spec),
 	};
 	return cmocka_run_group_tests_name("spec", tests, setup, teardown);
 }

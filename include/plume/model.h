@@ -117,6 +117,11 @@ typedef struct plume_spec_options {
 plume_status plume_spec_generate(const char *path, const plume_spec_options *options, plume_feather **out,
                                  plume_error *err);
 
+/// The same from JSON text (a feather spec in memory, e.g. from a binding); name stands for
+/// the file in messages ("name:line:column: ..." and "name: $.key.path: ...").
+plume_status plume_spec_parse(const char *text, const char *name, const plume_spec_options *options,
+                              plume_feather **out, plume_error *err);
+
 /// Reads a Franco–Walter spec into def and its seed (1 when absent).
 plume_status plume_fw_def_read(const char *path, plume_fw_def *def, uint64_t *seed, plume_error *err);
 

@@ -83,3 +83,16 @@ plume_status plume_spec_generate(const char *path, const plume_spec_options *opt
 	json_decref(root);
 	return status;
 }
+
+plume_status plume_spec_parse(const char *text, const char *name, const plume_spec_options *options,
+                              plume_feather **out, plume_error *err)
+{
+	*out = NULL;
+	json_error_t error;
+	json_t *root = json_loads(text, JSON_REJECT_DUPLICATES, &error);
+	if (root == NULL)
+		return plume_error_set(err, PLUME_ERROR_SYNTAX, "%s:%d:%d: %s", name, error.line, error.column, error.text);
+	plume_status status = plume_spec_generate_json(name, root, options, out, err);
+	json_decref(root);
+	return status;
+}
