@@ -5,6 +5,8 @@ set -euo pipefail
 
 packages=(build-essential cmake pkg-config libcairo2-dev libjansson-dev libstb-dev libcmocka-dev
 	libsuitesparse-dev libembree-dev libqhull-dev libplplot-dev)
+# The Python binding (python/) and its tests.
+packages+=(python3-cffi python3-numpy python3-pytest)
 
 missing=()
 for package in "${packages[@]}"; do

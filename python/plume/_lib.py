@@ -1,0 +1,148 @@
+"""Loading libplume through cffi (ABI mode) and turning its errors into plume.Error."""
+
+from __future__ import annotations
+
+import ctypes.util
+import os
+import pathlib
+import re
+import shutil
+import subprocess
+from typing import Any, Optional
+
+import cffi
+import numpy as np
+
+from . import _headers
+
+_PACKAGE = pathlib.Path(__file__).resolve().parent
+
+
+def _pkg_config(variable: str) -> Optional[str]:
+    if shutil.which("pkg-config") is None:
+        return None
+    try:
+        out = subprocess.run(
+            ["pkg-config", f"--variable={variable}", "plume"], capture_output=True, text=True, check=True
+        ).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return None
+    return out or None
+
+
+def _cdef_text() -> str:
+    """The declarations: bundled at install time (setup.py), else the source tree's headers."""
+    include = os.environ.get("PLUME_INCLUDE_DIR")
+    if include:
+        return _headers.cdef(include)[0]
+    bundled = _PACKAGE / "_cdef.h"
+    if bundled.exists():
+        return bundled.read_text()
+    source_include = _PACKAGE.parent.parent / "include"
+    if (source_include / "plume" / "core.h").exists():
+        return _headers.cdef(source_include)[0]
+    include = _pkg_config("includedir")
+    if include and (pathlib.Path(include) / "plume" / "core.h").exists():
+        return _headers.cdef(include)[0]
+    raise ImportError("plume: cannot find libplume's headers (set PLUME_INCLUDE_DIR to the folder holding plume/core.h)")
+
+
+def _library_path() -> str:
+    """libplume.so: $PLUME_LIBRARY, $PLUME_BUILD_DIR/libplume.so, the path recorded at install, pkg-config, the loader."""
+    explicit = os.environ.get("PLUME_LIBRARY")
+    if explicit:
+        return explicit
+    build = os.environ.get("PLUME_BUILD_DIR")
+    if build:
+        return str(pathlib.Path(build) / "libplume.so")
+    recorded = _PACKAGE / "_libpath.txt"
+    if recorded.exists():
+        path = recorded.read_text().strip()
+        if os.path.exists(path):
+            return path
+    libdir = _pkg_config("libdir")
+    if libdir and os.path.exists(os.path.join(libdir, "libplume.so")):
+        return os.path.join(libdir, "libplume.so")
+    found = ctypes.util.find_library("plume")
+    if found:
+        return found
+    raise ImportError(
+        "plume: cannot find libplume.so; `make install` it (pkg-config plume), or set PLUME_BUILD_DIR to a build folder"
+    )
+
+
+ffi = cffi.FFI()
+ffi.cdef(_cdef_text())
+library_path = _library_path()
+# Never unloaded: Embree's worker threads (TBB) outlive the interpreter's teardown, and
+# unmapping their code under them crashes the process at exit.
+lib: Any = ffi.dlopen(library_path, ffi.RTLD_NOW | getattr(ffi, "RTLD_NODELETE", 0))
+
+
+class Error(Exception):
+    """A failed libplume call.
+
+    Attributes:
+        message: the library's whole message (it names the file and the JSON path).
+        path: the JSON path the message names ("$.segments[1].barb_count"), or None.
+        file: the file (or "<dict>") the message names, or None.
+        code: the status's stable name: "io", "syntax", "spec", "memory", "numeric", "unsupported".
+        status: the numeric plume_status.
+    """
+
+    def __init__(self, message: str, path: Optional[str] = None, code: str = "spec", status: int = 3,
+                 file: Optional[str] = None):
+        super().__init__(message)
+        self.message = message
+        self.path = path
+        self.code = code
+        self.status = status
+        self.file = file
+
+    @classmethod
+    def from_c(cls, err: Any, rename: Optional[dict[str, str]] = None) -> "Error":
+        message = ffi.string(err.message).decode("utf-8", "replace")
+        for old, new in (rename or {}).items():
+            message = message.replace(old, new)
+        status = int(err.status)
+        code = ffi.string(lib.plume_status_name(status)).decode()
+        match = re.search(r"(\$[\w.\[\]\"-]*)", message)
+        path = match.group(1).rstrip(":.") if match else None
+        file_match = re.match(r"([^:\s]+?)(?::\d+:\d+)?: ", message)
+        file = file_match.group(1) if file_match else None
+        return cls(message, path, code, status, file)
+
+
+def new_error() -> Any:
+    return ffi.new("plume_error *")
+
+
+def check(status: int, err: Any, rename: Optional[dict[str, str]] = None) -> None:
+    """Raises plume.Error when status is not PLUME_OK."""
+    if status != lib.PLUME_OK:
+        raise Error.from_c(err, rename)
+
+
+def view(owner: Any, pointer: Any, count: int, dtype: Any, shape: tuple[int, ...]) -> np.ndarray:
+    """A NumPy array over count C items at pointer, without copying, that keeps owner alive.
+
+    The buffer keeps a cdata alive whose (never called before collection) destructor closes
+    over owner, so the memory cannot be freed while any view of it exists.
+    """
+    dtype = np.dtype(dtype)
+    if count == 0 or pointer == ffi.NULL:
+        return np.zeros(shape, dtype)
+    keeper = ffi.gc(ffi.cast("char *", pointer), lambda _p, _owner=owner: None)
+    size = int(np.prod(shape)) * dtype.itemsize
+    array = np.frombuffer(ffi.buffer(keeper, size), dtype=dtype).reshape(shape)
+    array.flags.writeable = False
+    return array
+
+
+def text(s: Any) -> str:
+    return ffi.string(s).decode("utf-8", "replace")
+
+
+def bytes_in_use() -> int:
+    """Bytes libplume has allocated and not freed (its allocator's counter, all threads)."""
+    return int(lib.plume_bytes_in_use())

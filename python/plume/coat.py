@@ -1,0 +1,117 @@
+"""Coats of feathers on a surface (Streit & Heidrich 4.4; docs/coats.md)."""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from typing import Any, Iterable, Optional, Union
+
+import numpy as np
+
+from ._lib import check, ffi, lib, new_error
+from .feather import Feather, _options
+from .mesh import Mesh
+
+
+class Coat:
+    """A groomed coat: ``feathers`` (placed, world coordinates, drawing order bottom to top),
+    ``follicles`` and ``follicle_normals`` (K x 3), ``is_key`` (K,), the ``surface`` mesh."""
+
+    def __init__(self, pointer: Any):
+        self._ptr = ffi.gc(pointer, lib.plume_coat_destroy)
+        self._keep = self._ptr
+
+    def __enter__(self) -> "Coat":
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.close()
+
+    def close(self) -> None:
+        self._ptr = None
+        self._keep = None
+
+    @property
+    def pointer(self) -> Any:
+        if self._ptr is None:
+            raise ValueError("the coat was closed")
+        return self._ptr
+
+    def __len__(self) -> int:
+        return int(lib.plume_coat_feather_count(self.pointer))
+
+    def feather(self, index: int) -> Feather:
+        if not 0 <= index < len(self):
+            raise IndexError(f"feather {index} of {len(self)}")
+        p = lib.plume_coat_feather(self.pointer, index)
+        return Feather(ffi.cast("plume_feather *", p), owner=self, destroy=False)
+
+    @property
+    def feathers(self) -> list[Feather]:
+        return [self.feather(i) for i in range(len(self))]
+
+    def _follicles(self) -> tuple[np.ndarray, np.ndarray]:
+        n = len(self)
+        pos, nor = np.zeros((n, 3)), np.zeros((n, 3))
+        p, q = ffi.new("plume_vec3 *"), ffi.new("plume_vec3 *")
+        for i in range(n):
+            lib.plume_coat_follicle(self.pointer, i, p, q)
+            pos[i] = (p.x, p.y, p.z)
+            nor[i] = (q.x, q.y, q.z)
+        return pos, nor
+
+    @property
+    def follicles(self) -> np.ndarray:
+        return self._follicles()[0]
+
+    @property
+    def follicle_normals(self) -> np.ndarray:
+        return self._follicles()[1]
+
+    @property
+    def is_key(self) -> np.ndarray:
+        return np.array([bool(lib.plume_coat_is_key(self.pointer, i)) for i in range(len(self))])
+
+    @property
+    def surface(self) -> Mesh:
+        p = lib.plume_coat_surface(self.pointer)
+        return Mesh(ffi.cast("plume_mesh *", p), owner=self, destroy=False)
+
+    def write(self, path: Union[str, "os.PathLike[str]"], formats: Optional[Iterable[str]] = None) -> list[str]:
+        """OBJ (one object per feather) and/or USD text, by formats or path's suffix."""
+        path = os.fspath(path)
+        root, suffix = os.path.splitext(path)
+        formats = [suffix.lstrip(".").lower()] if formats is None else list(formats)
+        writers = {"obj": lib.plume_coat_write_obj, "usda": lib.plume_coat_write_usda}
+        written = []
+        for f in formats:
+            if f not in writers:
+                raise ValueError(f"format {f!r}; allowed: obj, usda")
+            target = path if len(formats) == 1 and suffix == "." + f else f"{root}.{f}"
+            err = new_error()
+            check(writers[f](self.pointer, target.encode(), err), err)
+            written.append(target)
+        return written
+
+    def __repr__(self) -> str:
+        return f"<plume.Coat {len(self)} feathers>"
+
+
+def coat(spec: Union[dict, str, "os.PathLike[str]"], *, seed: Optional[int] = None,
+         stage: Optional[float] = None) -> Coat:
+    """Grooms a coat from a coat spec ("model": "coat"): a dict or a path. A dict's file
+    references (key feathers, surface OBJ) must be absolute paths; messages name it "<dict>"."""
+    options = _options(seed, stage, "growth")
+    out = ffi.new("plume_coat **")
+    err = new_error()
+    if isinstance(spec, dict):
+        with tempfile.TemporaryDirectory(prefix="plume-coat-") as folder:
+            path = os.path.join(folder, "coat.json")
+            with open(path, "w") as f:
+                json.dump(spec, f)
+            status = lib.plume_coat_spec_generate(path.encode(), options, out, err)
+            check(status, err, rename={path: "<dict>"})
+    else:
+        check(lib.plume_coat_spec_generate(os.fspath(spec).encode(), options, out, err), err)
+    return Coat(out[0])

@@ -1,0 +1,119 @@
+"""The virtual lab (Jouve thesis chapters 3-5): traction tests, calibration, studies."""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from typing import Any, Optional, Union
+
+import numpy as np
+
+from ._lib import check, ffi, lib, new_error
+
+
+def _load_spec(spec: Union[dict, str, "os.PathLike[str]"]) -> Any:
+    s = ffi.new("plume_lab_spec *")
+    err = new_error()
+    if isinstance(spec, dict):
+        with tempfile.TemporaryDirectory(prefix="plume-lab-") as folder:
+            path = os.path.join(folder, "lab.json")
+            with open(path, "w") as f:
+                json.dump(spec, f)
+            check(lib.plume_lab_spec_load(path.encode(), s, err), err, rename={path: "<dict>"})
+    else:
+        check(lib.plume_lab_spec_load(os.fspath(spec).encode(), s, err), err)
+    return s
+
+
+def traction(spec: Union[dict, str, "os.PathLike[str]"]) -> dict:
+    """Runs the traction test of a lab file or dict (docs/lab.md: sample, material, traction).
+
+    Returns strain, stress (Pa), displacement (m), iterations, converged, residual (arrays over
+    the steps + 1 samples), slope (Pa), solve_count, newton_iterations, positions (N x 3, final)
+    and lateral_strain."""
+    s = _load_spec(spec)
+    result = ffi.new("plume_traction_result *")
+    err = new_error()
+    check(lib.plume_lab_traction(ffi.addressof(s.material), ffi.addressof(s.sample), ffi.addressof(s.traction),
+                                 result, err), err)
+    try:
+        n, nv = result.count, result.vertex_count
+
+        def copy(p: Any, ctype: str, count: int, dtype: Any) -> np.ndarray:
+            return np.frombuffer(ffi.buffer(p, count * ffi.sizeof(ctype)), dtype=dtype).copy()
+
+        return {
+            "strain": copy(result.strain, "double", n, np.float64),
+            "stress": copy(result.stress, "double", n, np.float64),
+            "displacement": copy(result.displacement, "double", n, np.float64),
+            "iterations": copy(result.iterations, "int", n, np.intc),
+            "converged": copy(result.converged, "bool", n, np.bool_),
+            "residual": copy(result.residual, "double", n, np.float64),
+            "slope": result.slope,
+            "solve_count": result.solve_count,
+            "newton_iterations": result.newton_iterations,
+            "positions": copy(result.positions, "double", 3 * nv, np.float64).reshape(nv, 3),
+            "lateral_strain": result.lateral_strain,
+        }
+    finally:
+        lib.plume_traction_result_free(result)
+
+
+def calibrate(*, barb_fraction: Optional[float] = None, E_B: Optional[float] = None, E_b: Optional[float] = None,
+              period: Optional[float] = None, width: Optional[float] = None, thickness: Optional[float] = None,
+              aspect_ratio: Optional[float] = None, steps: Optional[int] = None,
+              barb_constraint: Optional[bool] = None, tolerance: Optional[float] = None,
+              macroscale_elements: Optional[int] = None, phase_count: Optional[int] = None,
+              element_count: Optional[int] = None) -> dict:
+    """Calibrates the macroscale moduli E_vv, E_ww, E_vw (Pa) from the mesoscale model (thesis 5.2-5.3).
+
+    Keywords override plume_calibration_default_def(): barb_fraction is Phi_B, E_B and E_b the
+    barb and barbule moduli (Pa), period the band period T (m), width/thickness the tilted sample's
+    (m), element_count the mesoscale sample's target triangles. Returns the result's fields."""
+    d = ffi.new("plume_calibration_def *", lib.plume_calibration_default_def())
+    if barb_fraction is not None:
+        d.mesoscale.bands.barb_fraction = barb_fraction
+    if E_B is not None:
+        d.mesoscale.E_B = E_B
+    if E_b is not None:
+        d.mesoscale.E_b = E_b
+    if period is not None:
+        d.mesoscale.bands.period = period
+    if width is not None:
+        d.sample.width = width
+    if thickness is not None:
+        d.sample.thickness = thickness
+    if element_count is not None:
+        d.sample.element_count = element_count
+    for name, value in (("aspect_ratio", aspect_ratio), ("steps", steps), ("barb_constraint", barb_constraint),
+                        ("tolerance", tolerance), ("macroscale_elements", macroscale_elements),
+                        ("phase_count", phase_count)):
+        if value is not None:
+            setattr(d, name, value)
+    r = ffi.new("plume_calibration_result *")
+    err = new_error()
+    check(lib.plume_lab_calibrate(d, r, err), err)
+    return {name: getattr(r, name) for name in (
+        "E_vv", "E_ww", "E_vw", "slope_longitudinal", "slope_transverse", "slope_tilted",
+        "slope_tilted_macroscale", "traction_count", "solve_count", "bisection_iterations")}
+
+
+def study(kind: str, *, scale: float = 1.0, csv: Optional[str] = None, png: Optional[str] = None,
+          svg: Optional[str] = None) -> dict:
+    """Runs a study ("locking", "conditioning", "angles", "size"; docs/lab.md), writing its table and
+    plot where asked, and returns its JSON digest. scale multiplies every element count."""
+    k = ffi.new("plume_study_kind *")
+    if not lib.plume_study_kind_from_name(kind.encode(), k):
+        raise ValueError(f"study {kind!r}; allowed: locking, conditioning, angles, size")
+    d = ffi.new("plume_study_def *", lib.plume_study_default_def(k[0]))
+    d.scale = scale
+    summary = ffi.new("char[]", 4096)
+    err = new_error()
+
+    def c(p: Optional[str]) -> Any:
+        return ffi.NULL if p is None else os.fspath(p).encode()
+
+    check(lib.plume_lab_study(d, c(csv), c(png), c(svg), summary, 4096, err), err)
+    text = ffi.string(summary).decode()
+    return json.loads(text) if text else {}
