@@ -5,7 +5,7 @@ BUILD ?= build
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 CMAKE_FLAGS ?= -DCMAKE_BUILD_TYPE=Release
 
-.PHONY: all deps configure build demo test bench install clean format
+.PHONY: all deps configure build demo test bench install clean format blender-addon
 
 all: build
 
@@ -29,6 +29,10 @@ bench: build
 
 install: build
 	cmake --install $(BUILD)
+
+# The Blender add-on (blender/), with the Python package and the presets inside.
+blender-addon:
+	/usr/bin/python3 blender/make_zip.py . $(BUILD)/plume_feathers.zip
 
 format:
 	clang-format -i include/plume/*.h src/*/*.c src/*/*.h cli/*.c cli/*.h tests/*.c tests/*.h bench/*.c

@@ -34,7 +34,7 @@ def locate():
         return include, str(pathlib.Path(build).resolve() / "libplume.so")
     include, libdir = pkg_config("includedir"), pkg_config("libdir")
     if include and libdir:
-        return include, os.path.join(libdir, "libplume.so")
+        return include, os.path.normpath(os.path.join(libdir, "libplume.so"))
     sys.exit("plume: libplume not found: run `make install` (pkg-config plume) or set PLUME_BUILD_DIR")
 
 
