@@ -54,6 +54,20 @@ def _curves_of(feather: plume.Feather):
         yield from _curves_of(after)
 
 
+def feather_material() -> bpy.types.Material:
+    """One shared material, plume's ray tracer's hawk brown (plume_raytrace_default_def's barb colour)."""
+    material = bpy.data.materials.get("plume feather")
+    if material is None:
+        material = bpy.data.materials.new("plume feather")
+        material.diffuse_color = (0.45, 0.33, 0.22, 1.0)
+        material.use_nodes = True
+        bsdf = material.node_tree.nodes.get("Principled BSDF")
+        if bsdf is not None:
+            bsdf.inputs["Base Color"].default_value = (0.45, 0.33, 0.22, 1.0)
+            bsdf.inputs["Roughness"].default_value = 0.6
+    return material
+
+
 def feather_curve(feather: plume.Feather, name: str) -> bpy.types.Curve:
     """A curve data-block: one poly spline per shaft, barb and barbule, point radius = half the width
     (bevel depth 1, so the tubes are as thick as the feather's curves), metres."""
@@ -62,6 +76,7 @@ def feather_curve(feather: plume.Feather, name: str) -> bpy.types.Curve:
     curve.bevel_depth = 1.0
     curve.bevel_resolution = 0
     curve.use_fill_caps = False
+    curve.materials.append(feather_material())
     for points, widths in _curves_of(feather):
         n = len(points)
         if n < 2:
@@ -96,15 +111,24 @@ def _write_world_obj(obj: bpy.types.Object, path: str, depsgraph) -> None:
     """The evaluated mesh, triangulated, in world coordinates, as Wavefront OBJ."""
     evaluated = obj.evaluated_get(depsgraph)
     mesh = evaluated.to_mesh()
-    mesh.calc_loop_triangles()
     matrix = obj.matrix_world
     with open(path, "w") as f:
         for v in mesh.vertices:
             p = matrix @ v.co
             f.write(f"v {p.x:.9g} {p.y:.9g} {p.z:.9g}\n")
-        for tri in mesh.loop_triangles:
-            a, b, c = tri.vertices
-            f.write(f"f {a + 1} {b + 1} {c + 1}\n")
+        # The same mesh must give the same coat, and plume's Poisson layout walks the faces in
+        # order; but Blender's polygon order and each polygon's first corner vary from run to run
+        # (and loop_triangles come from several threads). So: each polygon rotated to start at
+        # its smallest vertex index (winding kept), polygons sorted, a fan per polygon (Blender's
+        # faces are convex in practice).
+        polygons = []
+        for polygon in mesh.polygons:
+            v = list(polygon.vertices)
+            first = v.index(min(v))
+            polygons.append(tuple(v[first:] + v[:first]))
+        for v in sorted(polygons):
+            for k in range(1, len(v) - 1):
+                f.write(f"f {v[0] + 1} {v[k] + 1} {v[k + 1] + 1}\n")
     evaluated.to_mesh_clear()
 
 

@@ -74,7 +74,9 @@ def main():
     check(len(instances) == expected and expected > 20, f"coat: {len(instances)} instances, package {expected}")
     check(len({o.data.name for o in instances}) == 2, "coat: instances share the two key feathers' curves")
     radii = [o.matrix_world.translation.length for o in instances]
-    check(max(radii) < 0.06, f"coat: feathers rooted near the sphere (largest root distance {max(radii):.4f} m)")
+    # Roots on the UV sphere's faces: within its radius, and no deeper than its flattest face's centre.
+    check(0.036 < min(radii) and max(radii) < 0.0401,
+          f"coat: feathers rooted on the sphere (root distances {min(radii):.4f} to {max(radii):.4f} m)")
 
     if len(args) > 1:
         scene = bpy.context.scene
@@ -92,7 +94,11 @@ def main():
         scene.render.filepath = args[1]
         world = bpy.data.worlds.new("plume") if scene.world is None else scene.world
         scene.world = world
-        world.color = (0.8, 0.8, 0.8)
+        world.use_nodes = True
+        world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.75, 0.78, 0.82, 1.0)
+        skin = bpy.data.materials.new("skin")
+        skin.diffuse_color = (0.55, 0.45, 0.40, 1.0)
+        sphere.data.materials.append(skin)
         bpy.ops.render.render(write_still=True)
         print("rendered", args[1])
 

@@ -117,3 +117,24 @@ def study(kind: str, *, scale: float = 1.0, csv: Optional[str] = None, png: Opti
     check(lib.plume_lab_study(d, c(csv), c(png), c(svg), summary, 4096, err), err)
     text = ffi.string(summary).decode()
     return json.loads(text) if text else {}
+
+
+def mesoscale_moduli(barb_fraction: float, slope_longitudinal: float, slope_transverse: float,
+                     transverse_strain_max: float = 0.4) -> tuple[float, float]:
+    """(E_B, E_b), Pa: the mesoscale moduli that give the measured longitudinal and transverse slopes
+    at barb fraction Phi_B (inverting thesis eqs. 5.3 and 5.5)."""
+    E_B, E_b = ffi.new("double *"), ffi.new("double *")
+    err = new_error()
+    check(lib.plume_lab_mesoscale_moduli(barb_fraction, slope_longitudinal, slope_transverse, transverse_strain_max,
+                                         E_B, E_b, err), err)
+    return E_B[0], E_b[0]
+
+
+def longitudinal_modulus(barb_fraction: float, E_B: float, E_b: float) -> float:
+    """Phi_B E_B + (1 - Phi_B) E_b, Pa (thesis eq. 5.2)."""
+    return float(lib.plume_lab_longitudinal_modulus(barb_fraction, E_B, E_b))
+
+
+def transverse_slope_rigid(barb_fraction: float, E_b: float, strain_max: float = 0.4) -> float:
+    """Slope of the transverse test with rigid barbs over [0, strain_max], Pa (thesis eq. 5.5)."""
+    return float(lib.plume_lab_transverse_slope_rigid(barb_fraction, E_b, strain_max))

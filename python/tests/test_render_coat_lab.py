@@ -80,3 +80,14 @@ def test_calibrate_is_the_cli_calibration(cli):
     assert result["solve_count"] == expected["solves"]
     with pytest.raises(plume.Error):
         plume.calibrate(barb_fraction=1.5)
+
+
+def test_mesoscale_moduli_invert_the_closed_forms():
+    slope_long = plume.longitudinal_modulus(0.14, 2.57e9, 3.92e4)
+    slope_trans = plume.transverse_slope_rigid(0.14, 3.92e4, 0.4)
+    assert slope_long == pytest.approx(0.14 * 2.57e9 + 0.86 * 3.92e4, rel=1e-15)
+    E_B, E_b = plume.mesoscale_moduli(0.14, slope_long, slope_trans, 0.4)
+    assert E_B == pytest.approx(2.57e9, rel=1e-12) and E_b == pytest.approx(3.92e4, rel=1e-12)
+    with pytest.raises(plume.Error) as e:
+        plume.mesoscale_moduli(1.5, slope_long, slope_trans)
+    assert e.value.code == "spec"
