@@ -4,7 +4,9 @@ The build finds libplume through pkg-config (after `make install`), or a build f
 PLUME_BUILD_DIR (with the source tree's headers beside this folder). It writes two files into the
 package: _cdef.h, the cffi declarations made from the headers it found (plume/_headers.py), and
 _libpath.txt, the libplume.so it will load. Nothing is compiled (cffi ABI mode), so nothing is
-downloaded either: pip's --no-build-isolation uses Debian's setuptools.
+downloaded either. There is deliberately no pyproject.toml: without one, pip runs this file with
+the setuptools already installed (Debian's) instead of downloading one into an isolated build
+environment, so `pip install ./python` works offline.
 """
 
 import os

@@ -199,23 +199,57 @@ def groom(context, surface: bpy.types.Object, spacing: float, key_names: list[st
 
 # --- simulation --------------------------------------------------------------------------
 
+def handle_keyframes(context, obj: bpy.types.Object, frames: int, dt: float, substeps: int = 1) -> list[dict]:
+    """The object's animation as a scene handle's keyframes, in its own frame at the first frame:
+    at frame start + f the calamus goes where the animated object takes it (x -> L x, L the motion
+    from the first frame's transform to frame f's). Empty when the object is not animated."""
+    if obj.animation_data is None or obj.animation_data.action is None:
+        return []
+    scene = context.scene
+    start, current = scene.frame_start, scene.frame_current
+    scene.frame_set(start)
+    first = np.array(obj.matrix_world, dtype=np.float64)
+    keys = []
+    for f in range(frames + 1):
+        scene.frame_set(start + f)
+        motion = np.linalg.solve(first, np.array(obj.matrix_world, dtype=np.float64))
+        rotation = motion[:3, :3]
+        angle = float(np.arccos(np.clip((np.trace(rotation) - 1) / 2, -1.0, 1.0)))
+        axis = np.array([rotation[2, 1] - rotation[1, 2], rotation[0, 2] - rotation[2, 0],
+                         rotation[1, 0] - rotation[0, 1]])
+        if np.linalg.norm(axis) < 1e-12:
+            axis, angle = np.array([0.0, 0.0, 1.0]), 0.0
+        # The time of the step that ends frame f, computed as plume computes it (n dt), so the
+        # pose at each step is a key exactly.
+        keys.append({"time": (f * substeps) * dt, "translation": motion[:3, 3].tolist(),
+                     "rotation_axis": (axis / np.linalg.norm(axis)).tolist(), "rotation_deg": np.degrees(angle)})
+    scene.frame_set(current)
+    return keys
+
+
 def simulate(context, feather_obj: bpy.types.Object, frames: int, edge_length: float,
              substeps: int = 1) -> tuple[bpy.types.Object, plume.Simulation]:
     """Simulates the feather held at its calamus (group rachis_clamp) under gravity (world -Z seen in
     the feather's frame) for `frames` frames at the scene's frame rate, and bakes every frame to a
-    shape key of a new mesh object (keyframed so frame f shows shape key f). Shape keys are float32;
-    the final positions in double precision are kept in the object's "plume_final_positions"."""
+    shape key of a new mesh object (keyframed so frame f shows shape key f). When the feather object
+    is animated, its motion moves the calamus (a keyframed handle; handle_keyframes) and the baked
+    object stays where the feather was at the first frame. Shape keys are float32; the final
+    positions in double precision are kept in the object's "plume_final_positions"."""
     spec = json.loads(feather_obj["plume_spec"])
     seed = int(feather_obj.get("plume_seed", -1))
     fps = context.scene.render.fps / context.scene.render.fps_base
     dt = 1.0 / fps / substeps
+    current = context.scene.frame_current
+    keyframes = handle_keyframes(context, feather_obj, frames, dt, substeps)
+    if keyframes:
+        context.scene.frame_set(context.scene.frame_start)
     # In double precision (mathutils is float32): world -Z seen in the feather's own frame.
     rotation = np.array(feather_obj.matrix_world.to_3x3().normalized(), dtype=np.float64)
     gravity = np.linalg.solve(rotation, np.array([0.0, 0.0, -9.81]))
     scene = {
         "feather": spec,
         "mesh": {"edge_length": edge_length},
-        "handles": [{"group": "rachis_clamp"}],
+        "handles": [{"group": "rachis_clamp", "keyframes": keyframes} if keyframes else {"group": "rachis_clamp"}],
         "gravity": gravity.tolist(),
         "time_step": dt,
         "duration": frames * substeps * dt,
@@ -243,5 +277,8 @@ def simulate(context, feather_obj: bpy.types.Object, frames: int, edge_length: f
             key.value = value
             key.keyframe_insert("value", frame=f)
     obj["plume_final_positions"] = sim.positions.ravel().tolist()
+    obj["plume_scene"] = json.dumps(scene)
+    if keyframes:
+        context.scene.frame_set(current)
     obj["plume_frames"] = frames
     return obj, sim

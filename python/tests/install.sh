@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # `pip install ./python` the way a user does, offline: libplume installed with `make install` into a
-# prefix, found through pkg-config; Debian's pip, a virtual environment with the system's cffi and
-# NumPy, no build isolation (it would download setuptools) and no index. Then a feather from it.
+# prefix, found through pkg-config; Debian's pip in a virtual environment with the system's cffi
+# and NumPy, and no package index. Then a feather from it.
 # Usage: python/tests/install.sh BUILD_DIR   (run by .ci/run)
 set -euo pipefail
 build=$(cd "$1" && pwd)
@@ -13,7 +13,7 @@ cmake --install "$build" --prefix "$scratch/prefix" >/dev/null
 pc=$(dirname "$(find "$scratch/prefix" -name plume.pc | head -1)")
 /usr/bin/python3 -m venv --system-site-packages "$scratch/venv"
 cp -r "$source_dir/python" "$scratch/src"  # pip builds in place: keep the source tree clean
-PKG_CONFIG_PATH=$pc "$scratch/venv/bin/pip" install -q --no-build-isolation --no-index "$scratch/src"
+PKG_CONFIG_PATH=$pc "$scratch/venv/bin/pip" install -q --no-index "$scratch/src"
 cd "$scratch"
 "$scratch/venv/bin/python" - "$source_dir" "$scratch/prefix" <<'PY'
 import sys
