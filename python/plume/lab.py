@@ -101,8 +101,9 @@ def calibrate(*, barb_fraction: Optional[float] = None, E_B: Optional[float] = N
 
 def study(kind: str, *, scale: float = 1.0, csv: Optional[str] = None, png: Optional[str] = None,
           svg: Optional[str] = None) -> dict:
-    """Runs a study ("locking", "conditioning", "angles", "size"; docs/lab.md), writing its table and
-    plot where asked, and returns its JSON digest. scale multiplies every element count."""
+    """Runs a study ("locking", "conditioning", "angles", "size"; docs/lab.md), writing its table (CSV)
+    and plot (PNG, SVG) where asked, and returns its JSON digest with the table's columns added
+    under "table" (name -> array). scale multiplies every element count."""
     k = ffi.new("plume_study_kind *")
     if not lib.plume_study_kind_from_name(kind.encode(), k):
         raise ValueError(f"study {kind!r}; allowed: locking, conditioning, angles, size")
@@ -110,13 +111,23 @@ def study(kind: str, *, scale: float = 1.0, csv: Optional[str] = None, png: Opti
     d.scale = scale
     summary = ffi.new("char[]", 4096)
     err = new_error()
-
-    def c(p: Optional[str]) -> Any:
-        return ffi.NULL if p is None else os.fspath(p).encode()
-
-    check(lib.plume_lab_study(d, c(csv), c(png), c(svg), summary, 4096, err), err)
+    # The C study writes all three files; those not asked for go to a scratch folder.
+    with tempfile.TemporaryDirectory(prefix="plume-study-") as folder:
+        paths = [os.fspath(p) if p is not None else os.path.join(folder, f"{kind}.{ext}")
+                 for p, ext in ((csv, "csv"), (png, "png"), (svg, "svg"))]
+        check(lib.plume_lab_study(d, *(p.encode() for p in paths), summary, 4096, err), err)
+        table = _read_csv(paths[0])
     text = ffi.string(summary).decode()
-    return json.loads(text) if text else {}
+    result = json.loads(text) if text else {}
+    result["table"] = table
+    return result
+
+
+def _read_csv(path: str) -> dict[str, np.ndarray]:
+    with open(path) as f:
+        header = f.readline().strip().split(",")
+    data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    return {name: data[:, i] for i, name in enumerate(header)}
 
 
 def mesoscale_moduli(barb_fraction: float, slope_longitudinal: float, slope_transverse: float,

@@ -91,3 +91,17 @@ def test_mesoscale_moduli_invert_the_closed_forms():
     with pytest.raises(plume.Error) as e:
         plume.mesoscale_moduli(1.5, slope_long, slope_trans)
     assert e.value.code == "spec"
+
+
+def test_study_is_the_cli_study(cli, tmp_path):
+    cli("lab", "study", "conditioning", "--scale", 0.05, "-o", tmp_path)
+    result = plume.study("conditioning", scale=0.05, png=str(tmp_path / "binding.png"))
+    assert result["study"] == "conditioning"
+    table = np.loadtxt(tmp_path / "conditioning.csv", delimiter=",", skiprows=1)
+    header = (tmp_path / "conditioning.csv").read_text().splitlines()[0].split(",")
+    assert list(result["table"]) == header
+    for i, name in enumerate(header):
+        assert np.array_equal(result["table"][name], table[:, i]), name
+    assert (tmp_path / "binding.png").read_bytes()[:4] == b"\x89PNG"
+    with pytest.raises(ValueError, match="allowed"):
+        plume.study("lockin")
