@@ -90,12 +90,49 @@ def feather_curve(feather: plume.Feather, name: str) -> bpy.types.Curve:
     return curve
 
 
+def ribbon_material() -> bpy.types.Material:
+    """Base colour from the ribbon mesh's "Col" attribute (plume's banded texture), two-sided."""
+    material = bpy.data.materials.get("plume ribbon")
+    if material is None:
+        material = bpy.data.materials.new("plume ribbon")
+        material.use_nodes = True
+        nodes = material.node_tree.nodes
+        bsdf = nodes.get("Principled BSDF")
+        attribute = nodes.new("ShaderNodeAttribute")
+        attribute.attribute_name = "Col"
+        if bsdf is not None:
+            material.node_tree.links.new(attribute.outputs["Color"], bsdf.inputs["Base Color"])
+        material.use_backface_culling = False
+    return material
+
+
+def feather_ribbons(feather: plume.Feather, name: str) -> bpy.types.Mesh:
+    """A mesh data-block: barbs and shaft as flat ribbons (plume.ribbons) with the feather's UVs and
+    a per-vertex colour "Col" from plume's banded texture (the shaft in plume's horn colour)."""
+    r = plume.ribbons(feather)
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata(r["vertices"].tolist(), [], r["quads"].tolist())
+    loops = np.zeros(len(mesh.loops), dtype=np.int64)
+    mesh.loops.foreach_get("vertex_index", loops)
+    mesh.uv_layers.new(name="UVMap").data.foreach_set("uv", r["uv"][loops].astype(np.float32).ravel())
+    colors = np.empty((len(r["vertices"]), 4))
+    barb_vertices = r["side"] < 2
+    colors[barb_vertices] = np.repeat(plume.banded_colors(feather), 2, axis=0)
+    colors[~barb_vertices] = (0.78, 0.72, 0.62, 1.0)  # plume_raytrace_default_def's shaft colour
+    attribute = mesh.color_attributes.new("Col", "FLOAT_COLOR", "POINT")
+    attribute.data.foreach_set("color", colors.astype(np.float32).ravel())
+    mesh.materials.append(ribbon_material())
+    return mesh
+
+
 def add_feather(context, spec, name: str, seed: int | None = None, stage: float | None = None,
-                stage_kind: str = "growth") -> bpy.types.Object:
+                stage_kind: str = "growth", ribbons: bool = False) -> bpy.types.Object:
     """Generates the spec (a dict, or a file path: specs may name other files relative to
-    themselves) and links it to the scene as a curve object that remembers its spec."""
+    themselves) and links it to the scene as a curve object (or a ribbon mesh) that remembers
+    its spec."""
     feather = plume.generate(spec, seed=seed, stage=stage, stage_kind=stage_kind)
-    obj = bpy.data.objects.new(name, feather_curve(feather, name))
+    data = feather_ribbons(feather, name) if ribbons else feather_curve(feather, name)
+    obj = bpy.data.objects.new(name, data)
     # A path is kept as a JSON string, a dict as its JSON object text.
     obj["plume_spec"] = json.dumps(spec if isinstance(spec, dict) else os.path.abspath(spec))
     obj["plume_seed"] = -1 if seed is None else seed

@@ -42,6 +42,7 @@ class PlumeSettings(bpy.types.PropertyGroup):
     zk_stage: FloatProperty(name="Unfurl", description="Unfurling weight w (1: unfurled)", default=1.0, min=0.0,
                             max=1.0)
     seed: IntProperty(name="Seed", description="Random seed (-1: the spec's)", default=-1, min=-1)
+    geometry: EnumProperty(name="Geometry", items=[("CURVES", "Curves", ""), ("RIBBONS", "Ribbon mesh", "")])
     spacing: FloatProperty(name="Follicle spacing", default=0.01, min=1e-4, unit="LENGTH")
     key_feathers: StringProperty(name="Key feathers", default="contour,semiplume",
                                  description="Comma-separated streit-heidrich presets")
@@ -63,6 +64,9 @@ class PLUME_OT_add_feather(bpy.types.Operator):
     stage: FloatProperty(name="Stage", default=1.0, min=0.0, max=1.0)
     barbs_lower: IntProperty(name="Barbs below I_s", default=0, min=0, max=5000)
     barbs_upper: IntProperty(name="Barbs above I_s", default=0, min=0, max=5000)
+    geometry: EnumProperty(name="Geometry", items=[
+        ("CURVES", "Curves", "One poly spline per barb, radius half the width"),
+        ("RIBBONS", "Ribbon mesh", "Flat ribbons with UVs and plume's banded colours (barbs and shaft; no barbules)")])
 
     def execute(self, context):
         try:
@@ -88,7 +92,8 @@ class PLUME_OT_add_feather(bpy.types.Operator):
             if not source and not (self.barbs_lower or self.barbs_upper):
                 source = build.preset_path(self.model, name)
             # Files keep their relative references; edited specs go as dicts.
-            build.add_feather(context, source or spec, name, None if self.seed < 0 else self.seed, stage, kind)
+            build.add_feather(context, source or spec, name, None if self.seed < 0 else self.seed, stage, kind,
+                              ribbons=self.geometry == "RIBBONS")
         except Exception as e:  # plume.Error names the key; show it to the artist
             self.report({"ERROR"}, str(e))
             return {"CANCELLED"}

@@ -19,8 +19,9 @@ class PLUME_PT_franco_walter(_Panel, bpy.types.Panel):
         col.prop(s, "fw_barbs_lower")
         col.prop(s, "fw_barbs_upper")
         col.prop(s, "seed")
+        col.prop(s, "geometry")
         op = col.operator("plume.add_feather", text="Add feather")
-        op.model, op.preset, op.seed = "franco-walter", s.fw_preset, s.seed
+        op.model, op.preset, op.seed, op.geometry = "franco-walter", s.fw_preset, s.seed, s.geometry
         op.barbs_lower, op.barbs_upper = s.fw_barbs_lower, s.fw_barbs_upper
 
 
@@ -33,8 +34,10 @@ class PLUME_PT_streit_heidrich(_Panel, bpy.types.Panel):
         col.prop(s, "sh_preset")
         col.prop(s, "sh_stage")
         col.prop(s, "seed")
+        col.prop(s, "geometry")
         op = col.operator("plume.add_feather", text="Add feather")
         op.model, op.preset, op.seed, op.stage = "streit-heidrich", s.sh_preset, s.seed, s.sh_stage
+        op.geometry = s.geometry
 
 
 class PLUME_PT_zhang_kanai(_Panel, bpy.types.Panel):
@@ -46,8 +49,10 @@ class PLUME_PT_zhang_kanai(_Panel, bpy.types.Panel):
         col.prop(s, "zk_preset")
         col.prop(s, "zk_stage")
         col.prop(s, "seed")
+        col.prop(s, "geometry")
         op = col.operator("plume.add_feather", text="Add feather")
         op.model, op.preset, op.seed, op.stage = "zhang-kanai", s.zk_preset, s.seed, s.zk_stage
+        op.geometry = s.geometry
 
 
 class PLUME_PT_coat(_Panel, bpy.types.Panel):

@@ -59,6 +59,28 @@ def main():
             count += 1
     check(count >= 20, f"{count} presets added")
 
+    # Ribbon meshes: two vertices per barb and shaft point, a quad per segment, the feather's UVs.
+    for model, preset in (("franco-walter", "figure6a"), ("zhang-kanai", "figure11-expansion")):
+        before = set(bpy.data.objects)
+        check(bpy.ops.plume.add_feather(model=model, preset=preset, geometry="RIBBONS") == {"FINISHED"},
+              f"ribbons {preset}: added")
+        obj = (set(bpy.data.objects) - before).pop()
+        feather = plume.generate(build.preset_path(model, preset))
+        points = int(feather.barb_counts.sum()) + feather.info["shaft_sample_count"]
+        quads = points - feather.barb_count - 1
+        mesh = obj.data
+        check(len(mesh.vertices) == 2 * points and len(mesh.polygons) == quads,
+              f"ribbons {preset}: {len(mesh.vertices)} vertices, {len(mesh.polygons)} quads (expected {2 * points}, "
+              f"{quads})")
+        uv = np.zeros(2 * len(mesh.loops), dtype=np.float32)
+        mesh.uv_layers[0].data.foreach_get("uv", uv)
+        loops = np.zeros(len(mesh.loops), dtype=np.int64)
+        mesh.loops.foreach_get("vertex_index", loops)
+        expected_uv = plume.ribbons(feather)["uv"][loops].astype(np.float32)
+        check(np.array_equal(uv.reshape(-1, 2), expected_uv), f"ribbons {preset}: UVs are the feather's")
+        check("Col" in mesh.color_attributes, f"ribbons {preset}: colour attribute")
+        bpy.data.objects.remove(obj)
+
     # A coat on a sphere.
     bpy.ops.mesh.primitive_uv_sphere_add(radius=0.04, segments=24, ring_count=12, location=(0, 0, 0))
     sphere = bpy.context.active_object

@@ -11,7 +11,7 @@ The binding is cffi in ABI mode over the installed libplume.so (docs/python.md).
 
 from ._lib import Error, bytes_in_use, library_path
 from .coat import Coat, coat
-from .feather import Feather, generate
+from .feather import Feather, banded_colors, generate, ribbons
 from .lab import calibrate, longitudinal_modulus, mesoscale_moduli, study, traction, transverse_slope_rigid
 from .mesh import Mesh, mesh
 from .render import render, render2d, write_png
@@ -20,7 +20,8 @@ from .sim import Simulation
 __version__ = "0.1.0"
 
 __all__ = [
-    "Error", "Feather", "Mesh", "Coat", "Simulation", "generate", "mesh", "coat", "render", "render2d",
+    "Error", "Feather", "Mesh", "Coat", "Simulation", "generate", "ribbons", "banded_colors", "mesh", "coat",
+    "render", "render2d",
     "write_png", "traction", "calibrate", "study", "mesoscale_moduli", "longitudinal_modulus",
     "transverse_slope_rigid", "bytes_in_use", "library_path",
 ]

@@ -350,3 +350,82 @@ def generate(spec: Spec, *, seed: Optional[int] = None, stage: Optional[float] =
         status = lib.plume_spec_generate(os.fspath(spec).encode(), options, out, err)
     check(status, err)
     return Feather(out[0])
+
+
+def _tangents(points: np.ndarray, offsets: np.ndarray) -> np.ndarray:
+    """Unit tangents of curves stored back to back (curve i: rows offsets[i]:offsets[i + 1]):
+    central differences inside, one-sided at the ends."""
+    n = len(points)
+    t = np.zeros_like(points)
+    if n < 2:
+        return t
+    starts, ends = offsets[:-1], offsets[1:] - 1
+    t[1:-1] = points[2:] - points[:-2]
+    t[starts] = points[np.minimum(starts + 1, n - 1)] - points[starts]
+    t[ends] = points[ends] - points[np.maximum(ends - 1, 0)]
+    length = np.linalg.norm(t, axis=1, keepdims=True)
+    return np.divide(t, length, out=np.zeros_like(t), where=length > 0)
+
+
+def ribbons(feather: Feather, *, shaft: bool = True) -> dict[str, np.ndarray]:
+    """The feather's barbs (and shaft) as flat ribbons: each curve point becomes two vertices half a
+    width either side of it, across the curve in the plane its normal faces (barbs are flat ribbons
+    facing their normals, as plume's USD export and ray tracer treat them), and each curve segment
+    a quad. Returns vertices (V, 3), quads (Q, 4) counter-clockwise seen from the normal, uv (V, 2)
+    (the barb's (s, t); the shaft's (0, t)), side (V,) (0 left vane, 1 right, 2 shaft), and
+    point (V,), the pool row (or -1 - shaft sample) each vertex came from."""
+    curves_points = [feather.barb_points]
+    curves_normals = [feather.barb_normals]
+    curves_widths = [feather.barb_widths]
+    curves_uv = [feather.barb_uv]
+    offsets = [feather.barb_offsets]
+    counts = feather.barb_counts
+    sides = [np.repeat(feather.barb_sides.astype(np.int8), counts)]
+    rows = [np.concatenate([np.arange(s, s + c) for s, c in zip(feather.barb_starts, counts)])
+            if len(counts) else np.zeros(0, dtype=np.int64)]
+    if shaft:
+        sh = feather.shaft
+        curves_points.append(sh["position"])
+        curves_normals.append(sh["normal"])
+        curves_widths.append(sh["width"])
+        curves_uv.append(np.stack([np.zeros(len(sh)), sh["t"]], axis=1))
+        offsets.append(np.array([0, len(sh)]) + offsets[0][-1])
+        sides.append(np.full(len(sh), 2, dtype=np.int8))
+        rows.append(-1 - np.arange(len(sh)))
+    points = np.concatenate(curves_points)
+    normals = np.concatenate(curves_normals)
+    widths = np.concatenate(curves_widths)
+    all_offsets = np.concatenate([offsets[0]] + [o[1:] for o in offsets[1:]])
+    tangent = _tangents(points, all_offsets)
+    across = np.cross(normals, tangent)
+    length = np.linalg.norm(across, axis=1, keepdims=True)
+    across = np.divide(across, length, out=np.zeros_like(across), where=length > 0)
+    half = 0.5 * widths[:, None] * across
+    vertices = np.empty((2 * len(points), 3))
+    vertices[0::2] = points - half
+    vertices[1::2] = points + half
+    # Quads between consecutive points of one curve.
+    first = np.arange(len(points) - 1)
+    keep = np.ones(len(first), dtype=bool)
+    keep[all_offsets[1:-1] - 1] = False  # no quad across two curves
+    first = first[keep]
+    quads = np.stack([2 * first, 2 * first + 2, 2 * first + 3, 2 * first + 1], axis=1)
+    uv = np.repeat(np.concatenate(curves_uv), 2, axis=0)
+    return {"vertices": vertices, "quads": quads, "uv": uv, "side": np.repeat(np.concatenate(sides), 2),
+            "point": np.repeat(np.concatenate(rows), 2)}
+
+
+def banded_colors(feather: Feather, width: int = 256, height: int = 256) -> np.ndarray:
+    """(B points, 4) sRGBA colours of the barb points (barb_points' rows) from plume's own banded
+    hawk texture (plume_texture_create_banded), by each point's (s, t) as Franco & Walter 4.4 map
+    a texture onto the vanes."""
+    texture = ffi.gc(lib.plume_texture_create_banded(width, height), lib.plume_texture_destroy)
+    if texture == ffi.NULL:
+        raise MemoryError("plume_texture_create_banded")
+    uv, sides = feather.barb_uv, np.repeat(feather.barb_sides, feather.barb_counts)
+    out = np.empty((len(uv), 4))
+    sample = lib.plume_texture_sample_vane
+    for i, ((s, t), side) in enumerate(zip(uv.tolist(), sides.tolist())):
+        c = sample(texture, side, s, t)
+        out[i] = (c.r, c.g, c.b, c.a)
+    return out

@@ -150,3 +150,25 @@ def test_no_leak_over_a_thousand_feathers():
             plume.generate({"model": "franco-walter", "calamus_fraction": 2})
     gc.collect()
     assert plume.bytes_in_use() == start
+
+
+def test_ribbons_and_colours(source):
+    feather = plume.generate(source / "examples" / "zhang-kanai" / "figure11-expansion.json")  # barbules in between
+    r = plume.ribbons(feather)
+    points = len(feather.barb_points) + len(feather.shaft)
+    assert r["vertices"].shape == (2 * points, 3)
+    assert len(r["quads"]) == points - feather.barb_count - 1  # one per segment, none across curves
+    widths = np.linalg.norm(r["vertices"][1::2] - r["vertices"][0::2], axis=1)
+    assert np.allclose(widths, np.concatenate([feather.barb_widths, feather.shaft_widths]), rtol=1e-12, atol=1e-15)
+    centres = 0.5 * (r["vertices"][1::2] + r["vertices"][0::2])
+    assert np.allclose(centres, np.concatenate([feather.barb_points, feather.shaft_points]), rtol=0, atol=1e-15)
+    # Quads face their curve's normal (counter-clockwise seen from it).
+    q = r["vertices"][r["quads"]]
+    face_normal = np.cross(q[:, 1] - q[:, 0], q[:, 3] - q[:, 0])
+    curve_normal = np.concatenate([feather.barb_normals, feather.shaft["normal"]])[r["quads"][:, 0] // 2]
+    facing = np.einsum("ij,ij->i", face_normal, curve_normal)
+    assert (facing[np.linalg.norm(face_normal, axis=1) > 0] > 0).mean() > 0.99
+    assert np.array_equal(r["uv"][0::2][: len(feather.barb_uv)], feather.barb_uv)
+    colours = plume.banded_colors(feather, 64, 64)
+    assert colours.shape == (len(feather.barb_points), 4)
+    assert ((colours >= 0) & (colours <= 1)).all() and len(np.unique(colours[:, 0])) > 3
