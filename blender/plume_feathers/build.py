@@ -201,11 +201,12 @@ def coat_spec(context, surface: bpy.types.Object, spacing: float, key_names: lis
 
 
 def groom(context, surface: bpy.types.Object, spacing: float, key_names: list[str], seed: int = 1,
-          lift_deg: float = 15.0) -> tuple[bpy.types.Collection, plume.Coat]:
+          lift_deg: float = 15.0, instances: bool = True) -> tuple[bpy.types.Collection, plume.Coat]:
     """Grooms a coat on surface. Every coat feather becomes an instance (an object sharing its key
     feather's curve data) placed by the coat feather's base frame and scaled by its shaft length, the
     key feather nearest its follicle giving the shape (plume interpolates shapes; instances keep the
-    scene light). Returns the collection of instances and the coat."""
+    scene light). With instances False, every coat feather is its own curve object with plume's
+    interpolated shape, in world coordinates. Returns the collection and the coat."""
     if not key_names:
         raise ValueError("no key feathers")
     with tempfile.TemporaryDirectory(prefix="plume-groom-") as folder:
@@ -214,6 +215,10 @@ def groom(context, surface: bpy.types.Object, spacing: float, key_names: list[st
     coat_keys = spec["key_feathers"]
     collection = bpy.data.collections.new(f"{surface.name} coat")
     context.scene.collection.children.link(collection)
+    if not instances:
+        for i, placed in enumerate(coat.feathers):
+            collection.objects.link(bpy.data.objects.new(f"feather {i:05d}", feather_curve(placed, f"feather {i:05d}")))
+        return collection, coat
     local = {}
     for name in dict.fromkeys(key_names[:16]):
         feather = plume.generate(preset_path("streit-heidrich", name))

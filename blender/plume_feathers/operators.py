@@ -111,6 +111,9 @@ class PLUME_OT_groom_coat(bpy.types.Operator):
     key_feathers: StringProperty(name="Key feathers", default="contour,semiplume")
     seed: IntProperty(name="Seed", default=1, min=0)
     lift: FloatProperty(name="Lift (degrees)", default=15.0, min=0.1, max=90.0)
+    instances: EnumProperty(name="Feathers", items=[
+        ("INSTANCES", "Instances", "Objects sharing the key feathers' curves, placed and scaled (light)"),
+        ("CURVES", "Interpolated curves", "Every feather its own curve with plume's interpolated shape (heavy)")])
 
     @classmethod
     def poll(cls, context):
@@ -119,7 +122,8 @@ class PLUME_OT_groom_coat(bpy.types.Operator):
     def execute(self, context):
         names = [n.strip() for n in self.key_feathers.split(",") if n.strip()]
         try:
-            collection, coat = build.groom(context, context.active_object, self.spacing, names, self.seed, self.lift)
+            collection, coat = build.groom(context, context.active_object, self.spacing, names, self.seed, self.lift,
+                                           instances=self.instances == "INSTANCES")
         except Exception as e:
             self.report({"ERROR"}, str(e))
             return {"CANCELLED"}

@@ -100,6 +100,20 @@ def main():
     check(0.036 < min(radii) and max(radii) < 0.0401,
           f"coat: feathers rooted on the sphere (root distances {min(radii):.4f} to {max(radii):.4f} m)")
 
+    # The same coat, sparser, as interpolated curves: every feather its own shape.
+    result = bpy.ops.plume.groom_coat(spacing=0.024, key_feathers="contour,semiplume", seed=3, instances="CURVES")
+    check(result == {"FINISHED"}, "groom_coat (curves) finished")
+    with tempfile.TemporaryDirectory() as folder:
+        coat = plume.coat(build.coat_spec(bpy.context, sphere, 0.024, ["contour", "semiplume"], 3, 15.0, folder))
+    curves = sorted(bpy.data.collections[f"{sphere.name} coat.001"].objects, key=lambda o: o.name)
+    check(len(curves) == len(coat) and len({o.data.name for o in curves}) == len(coat),
+          f"coat curves: {len(curves)} objects with their own curves, package {len(coat)}")
+    check(all(len(o.data.splines) == 1 + f.barb_count + f.barbule_count + (
+        0 if f.afterfeather is None else 1 + f.afterfeather.barb_count) for o, f in zip(curves, coat.feathers)),
+          "coat curves: each object has its feather's shaft and barbs")
+    for obj in curves:
+        bpy.data.objects.remove(obj)
+
     if len(args) > 1:
         scene = bpy.context.scene
         bpy.ops.object.camera_add(location=(0.0, -0.32, 0.1))
