@@ -63,6 +63,19 @@ def _strip_inline_functions(text: str) -> str:
         i = j + 1
 
 
+def _integer_expression(value: str) -> "int | None":
+    """The value of an integer constant expression such as 64, 0x706c756du or (4ull << 30), else None."""
+    text = re.sub(r"\b(0[xX][0-9a-fA-F]+|\d+)[uUlL]*\b", r"\1", value.strip())
+    if not text or not re.fullmatch(r"[0-9a-fA-FxX()<>+\-*/%|&~^ ]+", text) or re.search(r"[a-wyzA-WYZ]", re.sub(
+            r"0[xX][0-9a-fA-F]+", "", text)):
+        return None
+    try:
+        result = eval(text.replace("/", "//"), {"__builtins__": {}}, {})  # digits and operators only
+    except (SyntaxError, TypeError, NameError, ZeroDivisionError):
+        return None
+    return result if isinstance(result, int) else None
+
+
 def header_text(path: pathlib.Path, constants: dict[str, str]) -> str:
     """One header, preprocessed for cffi. Fills constants with its #defines."""
     lines = []
@@ -88,12 +101,13 @@ def header_text(path: pathlib.Path, constants: dict[str, str]) -> str:
                 value = parts[2] if len(parts) > 2 else ""
                 if re.fullmatch(r"PLUME_\w+_H|PLUME_H", name) and value == "":
                     continue
-                if re.fullmatch(r"-?\d+", value):
-                    constants[name] = value
+                number = _integer_expression(value)
+                if number is not None:
+                    constants[name] = str(number)  # cffi wants plain decimal
                 elif re.fullmatch(r'"[^"]*"', value):
                     constants[name] = value
-                else:
-                    raise ValueError(f"{path}: unsupported #define {name} {value}")
+                # Anything else (a function-like macro ...) is left out: a declaration that used it
+                # would fail in cffi's parser with the macro's name, not bind wrongly.
             else:
                 raise ValueError(f"{path}: unsupported directive #{directive}")
             continue
@@ -112,10 +126,10 @@ def header_text(path: pathlib.Path, constants: dict[str, str]) -> str:
 def cdef(include_dir: str | pathlib.Path) -> tuple[str, dict[str, str]]:
     """The cdef text of every public header in include_dir/plume, and the #define constants."""
     folder = pathlib.Path(include_dir) / "plume"
-    known = {p.name for p in folder.glob("*.h")} - {"plume.h"}
-    unknown = known - set(HEADERS)
-    if unknown:
-        raise ValueError(f"{folder}: headers the binding does not know: {sorted(unknown)}")
+    present = {p.name for p in folder.glob("*.h")} - {"plume.h"}
+    # Headers added after this list was written come last, in name order: they build on the
+    # others (a new module's header includes the ones below it).
+    order = [name for name in HEADERS if name in present] + sorted(present - set(HEADERS))
     constants: dict[str, str] = {}
-    parts = [header_text(folder / name, constants) for name in HEADERS]
+    parts = [header_text(folder / name, constants) for name in order]
     return "\n".join(parts), constants

@@ -37,3 +37,22 @@ def test_every_struct_matches_the_compiler(source, tmp_path):
     wrong = [(what, want, int(got)) for (what, want), got in zip(expected, out) if want != int(got)]
     assert not wrong, f"cffi and the compiler disagree on: {wrong[:10]}"
     assert len(expected) > 300  # every public struct was seen
+
+
+def test_header_preprocessor(tmp_path):
+    from plume import _headers
+
+    assert _headers._integer_expression("64") == 64
+    assert _headers._integer_expression("0x706c756du") == 0x706C756D
+    assert _headers._integer_expression("(4ull << 30)") == 4 << 30
+    assert _headers._integer_expression("plume_v3(0, 0, 0)") is None
+    header = tmp_path / "x.h"
+    header.write_text('#define PLUME_N 0x10u\n#define PLUME_F(x) ((x) + 1)\ntypedef struct t { int a[PLUME_N]; } t;\n'
+                      "static inline int f(int x) { if (x) { return 1; } return 0; }\nint g(void);\n")
+    constants = {}
+    text = _headers.header_text(header, constants)
+    assert constants == {"PLUME_N": "16"}
+    assert "int a[16]" in text and "inline" not in text and "int g(void);" in text
+    header.write_text("#pragma once\n")
+    with pytest.raises(ValueError, match="unsupported directive"):
+        _headers.header_text(header, {})
