@@ -59,6 +59,27 @@ def main():
             count += 1
     check(count >= 20, f"{count} presets added")
 
+    # A spec file, and a bad one: the operator reports plume's message (file and JSON path).
+    import tempfile as _tempfile
+
+    with _tempfile.TemporaryDirectory() as folder:
+        good, bad = f"{folder}/mine.json", f"{folder}/bad.json"
+        with open(good, "w") as f:
+            json.dump({"model": "franco-walter", "segments": [{"barb_count": 5}, {"barb_count": 7}]}, f)
+        with open(bad, "w") as f:
+            json.dump({"model": "franco-walter", "segments": [{"barb_count": 6000}, {}]}, f)
+        check(bpy.ops.plume.add_feather(filepath=good) == {"FINISHED"}, "spec file: added")
+        obj = bpy.data.objects["mine"]
+        check(len(obj.data.splines) == 1 + 24, f"spec file: {len(obj.data.splines)} splines (shaft + 2 x 12 barbs)")
+        bpy.data.objects.remove(obj)
+        try:
+            bpy.ops.plume.add_feather(filepath=bad)
+            message = ""
+        except RuntimeError as e:
+            message = str(e)
+        check("$.segments[0].barb_count is 6000" in message and "bad.json" in message,
+              f"bad spec file: the error names the file and the key ({message.strip()})")
+
     # Ribbon meshes: two vertices per barb and shaft point, a quad per segment, the feather's UVs.
     for model, preset in (("franco-walter", "figure6a"), ("zhang-kanai", "figure11-expansion")):
         before = set(bpy.data.objects)
