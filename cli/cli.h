@@ -23,7 +23,8 @@ enum {
 	CLI_FORMAT_OBJ = 1u << 3,
 	CLI_FORMAT_USDA = 1u << 4,
 	CLI_FORMAT_JSON = 1u << 5,
-	CLI_FORMAT_ALL = (1u << 6) - 1,
+	CLI_FORMAT_ALL = (1u << 6) - 1, ///< generate's default set (glb is asked for by name)
+	CLI_FORMAT_GLB = 1u << 6,       ///< glTF 2.0 binary (plume/gltf.h)
 };
 
 /// Prints "plume: message" on stderr and returns the exit code for the status.
@@ -97,6 +98,23 @@ plume_status cli_barb_renderer_begin(cli_barb_renderer *renderer, const plume_fe
 plume_status cli_barb_renderer_frame(const cli_barb_renderer *renderer, const plume_vec3 *positions, const char *path,
                                      plume_error *err);
 void cli_barb_renderer_end(cli_barb_renderer *renderer);
+
+/// A progress line with a time estimate on stderr, when it is a terminal (cli/progress.c).
+typedef struct cli_progress {
+	const char *what;
+	int total;
+	double start;
+	bool shown;
+} cli_progress;
+void cli_progress_begin(cli_progress *progress, const char *what, int total);
+/// done items of total finished; prints a newline when done reaches total.
+void cli_progress_update(cli_progress *progress, int done);
+
+/// simulate --fields (cli/fields.c): DIR/fields/NNNN.vtu for the simulator's current state.
+plume_status cli_fields_write_frame(cli_output *output, const plume_scene *scene, const plume_sim *sim, int frame,
+                                    plume_error *err);
+/// DIR/fields.pvd listing fields/0000.vtu ... with their times.
+plume_status cli_fields_write_pvd(cli_output *output, const double *times, int frames, plume_error *err);
 
 int cli_generate(int argc, char **argv);
 int cli_grow(int argc, char **argv);

@@ -14,7 +14,7 @@ void cli_help_demo(void)
 	     "Walter's model with the paper's hawk parameters) and writes it to DIR\n"
 	     "(default: plume-demo) as images in the line style (PNG, SVG, PDF), a\n"
 	     "texture-mapped PNG coloured by plume's own banded texture, and geometry\n"
-	     "(OBJ curves, USD curves, JSON). Then it meshes the feather into a\n"
+	     "(OBJ curves, USD curves, JSON, glTF ribbons). Then it meshes the feather into a\n"
 	     "barb-aligned shell, simulates the paper's Figure 1 scenario for half a second\n"
 	     "(rachis base held, vane tip pulled down in the vane's plane, inextensible\n"
 	     "barbs) and ray-traces three frames at barb level: figure1-NNNN.png.\n"
@@ -105,7 +105,7 @@ int cli_demo(int argc, char **argv)
 	plume_status status = texture == NULL ? plume_error_set(&err, PLUME_ERROR_MEMORY, "out of memory")
 	                                      : plume_fw_generate(&def, 1, &feather, &err);
 	if (status == PLUME_OK && (status = cli_output_begin(&output, output_dir, &err)) == PLUME_OK) {
-		status = cli_write_feather(&output, feather, "feather", CLI_FORMAT_ALL, &lines, &err);
+		status = cli_write_feather(&output, feather, "feather", CLI_FORMAT_ALL | CLI_FORMAT_GLB, &lines, &err);
 		if (status == PLUME_OK)
 			status = cli_write_feather(&output, feather, "feather-textured", CLI_FORMAT_PNG, &textured, &err);
 		if (status == PLUME_OK)

@@ -98,6 +98,7 @@ check "demo succeeds" test $? -eq 0
 for file in feather.png feather.svg feather.pdf feather.obj feather.usda feather.json feather-textured.png figure1-0000.png figure1-0050.png; do
 	check "demo writes $file" test -s "$scratch/plume-demo/$file"
 done
+check "demo writes feather.glb" test -s "$scratch/plume-demo/feather.glb"
 "$plume" demo -o "$scratch/demo2" >/dev/null
 check "demo is deterministic" cmp -s "$scratch/plume-demo/feather.json" "$scratch/demo2/feather.json"
 
