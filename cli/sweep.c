@@ -181,6 +181,7 @@ typedef struct sweep_param {
 	double a, b;   ///< uniform: [a, b]; normal: mean, std; log-normal: mean and std of ln x
 	double lo, hi; ///< truncation (or -inf, inf)
 	bool integer;  ///< random values rounded to integers
+	int zip_lead;  ///< columns of one CSV go together: the first such parameter; -1 for others
 } sweep_param;
 
 typedef struct sweep {
@@ -249,8 +250,11 @@ static size_t edit_distance(const char *a, const char *b)
 // JSON paths: "$" followed by ".key" and "[index]" parts.
 
 /// The value at path in root and its parent (for replacement); NULL when absent.
-static json_t *path_lookup(json_t *root, const char *path, json_t **parent, char *key, size_t key_size, size_t *index)
+/// *settable: the path names a key the parent object lacks (a key left to its default).
+static json_t *path_lookup(json_t *root, const char *path, json_t **parent, char *key, size_t key_size, size_t *index,
+                           bool *settable)
 {
+	*settable = false;
 	if (path[0] != '$')
 		return NULL;
 	json_t *node = root;
@@ -266,6 +270,7 @@ static json_t *path_lookup(json_t *root, const char *path, json_t **parent, char
 			key[length] = '\0';
 			node = json_object_get(node, key);
 			p += length;
+			*settable = node == NULL && *p == '\0';
 		} else if (*p == '[') {
 			char *end = NULL;
 			long i = strtol(p + 1, &end, 10);
@@ -288,7 +293,8 @@ static bool path_set(json_t *root, const char *path, json_t *value)
 	json_t *parent = NULL;
 	char key[256];
 	size_t index = 0;
-	if (path_lookup(root, path, &parent, key, sizeof key, &index) == NULL || parent == NULL) {
+	bool settable;
+	if ((path_lookup(root, path, &parent, key, sizeof key, &index, &settable) == NULL && !settable) || parent == NULL) {
 		json_decref(value);
 		return false;
 	}
@@ -354,6 +360,85 @@ static void absolutize_paths(json_t *node, const char *dir)
 	}
 }
 
+/// Field k of a CSV line into out (quotes removed); false when the line is shorter.
+static bool csv_field(const char *line, int k, char *out, size_t size)
+{
+	int field = 0;
+	bool quoted = false;
+	size_t n = 0;
+	for (const char *c = line;; ++c) {
+		if (*c == '"') {
+			if (quoted && c[1] == '"' && field == k && n + 1 < size)
+				out[n++] = *++c;
+			else
+				quoted = !quoted;
+		} else if ((*c == ',' && !quoted) || *c == '\n' || *c == '\r' || *c == '\0') {
+			if (field == k) {
+				out[n] = '\0';
+				return true;
+			}
+			++field;
+			if (*c != ',')
+				return false;
+		} else if (field == k && n + 1 < size)
+			out[n++] = *c;
+	}
+}
+
+/// A column of another sweep's results.csv (its rows with status ok) as the values of p.
+static bool read_column(const sweep *s, sweep_param *p, const json_t *item, const char *where, json_t *target)
+{
+	const char *file = json_string_value(json_object_get(item, "from_csv"));
+	const char *column = json_string_value(json_object_get(item, "column"));
+	if (file == NULL || column == NULL)
+		return sweep_error(s, "%s: \"from_csv\" (a file name) and \"column\" (a header name) go together", where);
+	char path[PATH_MAX * 2];
+	if (file[0] == '/')
+		snprintf(path, sizeof path, "%s", file);
+	else
+		snprintf(path, sizeof path, "%s/%s", s->base_dir, file);
+	FILE *stream = fopen(path, "r");
+	if (stream == NULL)
+		return sweep_error(s, "%s.from_csv: %s: %s", where, path, strerror(errno));
+	char *line = NULL;
+	size_t capacity = 0;
+	int value_column = -1, status_column = -1;
+	char field[256];
+	bool ok = getline(&line, &capacity, stream) > 0;
+	for (int k = 0; ok && csv_field(line, k, field, sizeof field); ++k) {
+		if (strcmp(field, column) == 0)
+			value_column = k;
+		if (strcmp(field, "status") == 0)
+			status_column = k;
+	}
+	if (value_column < 0) {
+		free(line);
+		fclose(stream);
+		return sweep_error(s, "%s.column: %s has no column \"%s\"", where, path, column);
+	}
+	p->values = json_array();
+	int row = 1;
+	while (getline(&line, &capacity, stream) > 0) {
+		++row;
+		if (status_column >= 0 && (!csv_field(line, status_column, field, sizeof field) || strcmp(field, "ok") != 0))
+			continue;
+		char *end = NULL;
+		double x = csv_field(line, value_column, field, sizeof field) ? strtod(field, &end) : NAN;
+		if (end == field || end == NULL || *end != '\0' || !isfinite(x)) {
+			free(line);
+			fclose(stream);
+			return sweep_error(s, "%s: %s line %d: column %s is '%s', not a number", where, path, row, column, field);
+		}
+		bool whole = p->integer || (json_is_integer(target) && x == floor(x));
+		json_array_append_new(p->values, whole ? json_integer((json_int_t)llround(x)) : json_real(x));
+	}
+	free(line);
+	fclose(stream);
+	if (json_array_size(p->values) == 0)
+		return sweep_error(s, "%s: %s has no rows with status ok", where, path);
+	return true;
+}
+
 static bool read_number(const sweep *s, const json_t *object, const char *where, const char *key, double *out,
                         bool required)
 {
@@ -395,8 +480,8 @@ static bool check_keys(const sweep *s, const json_t *object, const char *where, 
 
 static bool parse_param(sweep *s, const json_t *item, int index)
 {
-	static const char *const keys[] = {"path", "values", "grid",     "distribution", "min",     "max",
-	                                   "mean", "std",    "log_mean", "log_std",      "integer", NULL};
+	static const char *const keys[] = {"path", "values",   "grid",    "distribution", "min",      "max",    "mean",
+	                                   "std",  "log_mean", "log_std", "integer",      "from_csv", "column", NULL};
 	char where[64];
 	snprintf(where, sizeof where, "$.parameters[%d]", index);
 	if (!json_is_object(item))
@@ -407,6 +492,7 @@ static bool parse_param(sweep *s, const json_t *item, int index)
 	memset(p, 0, sizeof *p);
 	p->lo = -INFINITY;
 	p->hi = INFINITY;
+	p->zip_lead = -1;
 	const char *path = json_string_value(json_object_get(item, "path"));
 	if (path == NULL || path[0] != '$' || strlen(path) >= sizeof p->path)
 		return sweep_error(s, "%s.path must be a JSON path such as \"$.material.barb_fraction\"", where);
@@ -418,14 +504,17 @@ static bool parse_param(sweep *s, const json_t *item, int index)
 	json_t *parent = NULL;
 	char key[256];
 	size_t array_index;
-	json_t *target = path_lookup(s->spec, path, &parent, key, sizeof key, &array_index);
-	if (target == NULL || parent == NULL) {
+	bool settable = false;
+	json_t *target = path_lookup(s->spec, path, &parent, key, sizeof key, &array_index, &settable);
+	// A key the base spec leaves to its default may be swept; the spec's own reader
+	// (sweep_check) then says whether the key exists.
+	if ((target == NULL && !settable) || parent == NULL) {
 		char best[512] = "$";
 		size_t distance = SIZE_MAX;
 		nearest_path(s->spec, "$", path, best, &distance);
 		return sweep_error(s, "%s.path: %s is not in the base spec; the nearest path there is %s", where, path, best);
 	}
-	if (json_is_object(target) || json_is_array(target))
+	if (target != NULL && (json_is_object(target) || json_is_array(target)))
 		return sweep_error(s, "%s.path: %s is an %s; sweep a number, a string or a boolean in it", where, path,
 		                   json_is_object(target) ? "object" : "array");
 	json_t *integer = json_object_get(item, "integer");
@@ -435,9 +524,25 @@ static bool parse_param(sweep *s, const json_t *item, int index)
 	json_t *values = json_object_get(item, "values");
 	json_t *grid = json_object_get(item, "grid");
 	json_t *dist = json_object_get(item, "distribution");
-	if ((values != NULL) + (grid != NULL) + (dist != NULL) != 1)
-		return sweep_error(s, "%s needs exactly one of \"values\", \"grid\" and \"distribution\"", where);
-	if (values != NULL) {
+	json_t *from_csv = json_object_get(item, "from_csv");
+	if ((values != NULL) + (grid != NULL) + (dist != NULL) + (from_csv != NULL) != 1)
+		return sweep_error(s, "%s needs exactly one of \"values\", \"grid\", \"distribution\" and \"from_csv\"", where);
+	if (from_csv != NULL) {
+		if (!read_column(s, p, item, where, target))
+			return false;
+		// Columns of one file are read row by row together, not crossed.
+		json_t *all = json_object_get(s->root, "parameters");
+		for (int q = 0; q < index && p->zip_lead < 0; ++q)
+			if (s->params[q].zip_lead >= 0 &&
+			    json_equal(json_object_get(json_array_get(all, (size_t)q), "from_csv"), from_csv)) {
+				p->zip_lead = s->params[q].zip_lead;
+				if (json_array_size(s->params[q].values) != json_array_size(p->values))
+					return sweep_error(s, "%s: its column has %zu rows, $.parameters[%d]'s %zu", where,
+					                   json_array_size(p->values), q, json_array_size(s->params[q].values));
+			}
+		if (p->zip_lead < 0)
+			p->zip_lead = index;
+	} else if (values != NULL) {
 		if (!json_is_array(values) || json_array_size(values) == 0)
 			return sweep_error(s, "%s.values must be a non-empty array", where);
 		size_t i;
@@ -473,7 +578,7 @@ static bool parse_param(sweep *s, const json_t *item, int index)
 		const char *name = json_string_value(dist);
 		if (name == NULL)
 			return sweep_error(s, "%s.distribution must be \"uniform\", \"normal\" or \"lognormal\"", where);
-		if (!json_is_number(target))
+		if (target != NULL && !json_is_number(target))
 			return sweep_error(s, "%s: %s is not a number in the base spec; only numbers take a distribution", where,
 			                   path);
 		if (!read_number(s, item, where, "min", &p->lo, false) || !read_number(s, item, where, "max", &p->hi, false))
@@ -517,6 +622,12 @@ static bool parse_param(sweep *s, const json_t *item, int index)
 		s->random_count++;
 	}
 	return true;
+}
+
+/// Whether parameter i is a dimension of the grid (zipped columns share their first's).
+static bool owns_dimension(const sweep_param *p, int i)
+{
+	return p->values != NULL && (p->zip_lead < 0 || p->zip_lead == i);
 }
 
 static bool output_known(const sweep_command *command, const char *key)
@@ -634,7 +745,7 @@ static bool sweep_load(sweep *s, const char *file)
 	s->seed = (uint64_t)seed;
 	double runs = samples;
 	for (int i = 0; i < s->param_count; ++i)
-		if (s->params[i].values != NULL)
+		if (owns_dimension(s->params + i, i))
 			runs *= (double)json_array_size(s->params[i].values);
 	if (runs > 1000000)
 		return sweep_error(s, "the sweep has %.0f runs; at most 1000000", runs);
@@ -741,9 +852,10 @@ static json_t *run_value(const sweep *s, int param, int index)
 		return p->integer ? json_integer((json_int_t)x) : json_real(x);
 	}
 	// The first grid/list parameter varies slowest.
+	int lead = p->zip_lead >= 0 ? p->zip_lead : param;
 	int stride = 1;
-	for (int q = s->param_count - 1; q > param; --q)
-		if (s->params[q].values != NULL)
+	for (int q = s->param_count - 1; q > lead; --q)
+		if (owns_dimension(s->params + q, q))
 			stride *= (int)json_array_size(s->params[q].values);
 	size_t k = (size_t)(grid / stride) % json_array_size(p->values);
 	return json_deep_copy(json_array_get(p->values, k));
@@ -805,6 +917,23 @@ static bool probe_spec(const sweep *s, json_t *spec, char *message, size_t size)
 	plume_error err = {0};
 	plume_status status = PLUME_OK;
 	if (s->command->probe == PROBE_CALIBRATION) {
+		const char *name;
+		json_t *value;
+		json_object_foreach (spec, name, value) {
+			size_t best = strcmp(name, "unconstrained") == 0 || strcmp(name, "description") == 0 ? 0 : SIZE_MAX;
+			const char *nearest = "phi";
+			for (int i = 0; i < CALIBRATION_KEY_COUNT && best != 0; ++i) {
+				size_t d = edit_distance(calibration_keys[i].key, name);
+				if (d < best) {
+					best = d;
+					nearest = calibration_keys[i].key;
+				}
+			}
+			if (best != 0) {
+				snprintf(message, size, "$.%s: not a calibration option; did you mean \"%s\"?", name, nearest);
+				return false;
+			}
+		}
 		for (int i = 0; i < CALIBRATION_KEY_COUNT; ++i) {
 			const calibration_key *k = calibration_keys + i;
 			json_t *v = json_object_get(spec, k->key);
