@@ -51,7 +51,8 @@ void cli_help_sweep(void)
 	     "       mpirun -n N plume sweep SWEEP.json -o DIR\n"
 	     "\n"
 	     "Runs one plume command (generate, mesh, coat, simulate, lab traction, lab\n"
-	     "calibrate) many times over parameters of its spec named by JSON path: a grid,\n"
+	     "calibrate, render frames) many times over parameters of its spec named by JSON\n"
+	     "path: a grid,\n"
 	     "a list, or seeded random samples (uniform, normal, log-normal, truncated).\n"
 	     "Each run is a separate plume process: a failing run is recorded with its\n"
 	     "message and the sweep goes on. docs/sweeps.md describes the sweep file.\n"
@@ -82,7 +83,15 @@ void cli_help_sweep(void)
 // ---------------------------------------------------------------------------
 // Commands a sweep can run
 
-typedef enum probe_kind { PROBE_FEATHER, PROBE_MESH, PROBE_COAT, PROBE_SCENE, PROBE_LAB, PROBE_CALIBRATION } probe_kind;
+typedef enum probe_kind {
+	PROBE_FEATHER,
+	PROBE_MESH,
+	PROBE_COAT,
+	PROBE_SCENE,
+	PROBE_LAB,
+	PROBE_CALIBRATION,
+	PROBE_RENDER
+} probe_kind;
 
 typedef struct sweep_command {
 	const char *name;
@@ -143,7 +152,13 @@ static const sweep_command sweep_commands[] = {
     {"simulate", {"simulate", NULL}, PROBE_SCENE, "summary.json", simulate_outputs},
     {"lab traction", {"lab", "traction"}, PROBE_LAB, "traction.json", traction_outputs},
     {"lab calibrate", {"lab", "calibrate"}, PROBE_CALIBRATION, "stdout", calibrate_outputs},
+    {"render frames", {"render", NULL}, PROBE_RENDER, NULL, no_outputs},
 };
+
+// Rendering a simulation's frames in ranges: the spec names the simulation folder, the
+// one output folder every range writes into, and the range of each run.
+static const char *const render_keys[] = {"description", "simulation", "output", "first",  "count",
+                                          "step",        "spp",        "size",   "format", NULL};
 enum { SWEEP_COMMAND_COUNT = sizeof sweep_commands / sizeof sweep_commands[0] };
 
 // The calibration has no spec file: its spec is an object of the command's options.
@@ -659,6 +674,10 @@ static bool sweep_load(sweep *s, const char *file)
 	char *slash = strrchr(copy, '/');
 	snprintf(s->base_dir, sizeof s->base_dir, "%s",
 	         slash == NULL ? "." : (slash == copy ? "/" : (*slash = '\0', copy)));
+	// Absolute: runs start in their own folders.
+	char absolute[PATH_MAX];
+	if (realpath(s->base_dir, absolute) != NULL)
+		snprintf(s->base_dir, sizeof s->base_dir, "%s", absolute);
 
 	const char *name = json_string_value(json_object_get(s->root, "command"));
 	for (int i = 0; name != NULL && i < SWEEP_COMMAND_COUNT; ++i)
@@ -697,6 +716,20 @@ static bool sweep_load(sweep *s, const char *file)
 	if (!json_is_object(s->spec))
 		return sweep_error(s, "$.spec: the base spec's top level must be an object");
 	absolutize_paths(s->spec, spec_dir);
+	if (s->command->probe == PROBE_RENDER) {
+		// Folders, relative to the spec's folder (the sweep file's for an inline spec).
+		static const char *const folders[] = {"simulation", "output"};
+		for (int i = 0; i < 2; ++i) {
+			const char *text = json_string_value(json_object_get(s->spec, folders[i]));
+			if (text == NULL)
+				return sweep_error(s, "$.spec.%s: a folder name is needed", folders[i]);
+			if (text[0] != '/') {
+				char joined[PATH_MAX * 2];
+				snprintf(joined, sizeof joined, "%s/%s", spec_dir, text);
+				json_object_set_new(s->spec, folders[i], json_string(joined));
+			}
+		}
+	}
 	if (s->command->probe == PROBE_CALIBRATION) {
 		const char *key;
 		json_t *value;
@@ -960,6 +993,37 @@ static bool probe_spec(const sweep *s, json_t *spec, char *message, size_t size)
 			}
 		return true;
 	}
+	if (s->command->probe == PROBE_RENDER) {
+		const char *name;
+		json_t *value;
+		json_object_foreach (spec, name, value) {
+			bool known = false;
+			for (int i = 0; render_keys[i] != NULL; ++i)
+				known = known || strcmp(render_keys[i], name) == 0;
+			if (!known) {
+				snprintf(message, size,
+				         "$.%s: not a render frames key (simulation, output, first, count, step, spp, size, format)",
+				         name);
+				return false;
+			}
+		}
+		static const char *const counts[] = {"first", "count", "step", "spp"};
+		for (int i = 0; i < 4; ++i) {
+			json_t *v = json_object_get(spec, counts[i]);
+			double lo = i == 0 ? 0 : 1;
+			if ((v != NULL || i < 2) && !(json_is_integer(v) && json_integer_value(v) >= lo)) {
+				snprintf(message, size, "$.%s must be a whole number >= %g", counts[i], lo);
+				return false;
+			}
+		}
+		struct stat info;
+		const char *sim = json_string_value(json_object_get(spec, "simulation"));
+		if (sim == NULL || stat(sim, &info) != 0 || !S_ISDIR(info.st_mode)) {
+			snprintf(message, size, "$.simulation: %s is not a simulation folder", sim ? sim : "(none)");
+			return false;
+		}
+		return true;
+	}
 	char path[] = "/tmp/plume-sweep-probe-XXXXXX.json";
 	int fd = mkstemps(path, 5);
 	if (fd < 0) {
@@ -1145,6 +1209,39 @@ static pid_t run_start(const sweep *s, const char *dir, int index, char *failure
 		}
 		if (json_is_true(json_object_get(run, "unconstrained")))
 			args[n++] = "--unconstrained";
+		json_decref(run);
+	} else if (s->command->probe == PROBE_RENDER) {
+		json_t *run = run_spec(s, index);
+		static char render_args[5][PATH_MAX + 64];
+		long long first = json_integer_value(json_object_get(run, "first"));
+		long long count = json_integer_value(json_object_get(run, "count"));
+		json_t *step_value = json_object_get(run, "step");
+		long long step = step_value != NULL ? json_integer_value(step_value) : 1;
+		snprintf(render_args[0], sizeof render_args[0], "%s", json_string_value(json_object_get(run, "simulation")));
+		snprintf(render_args[1], sizeof render_args[1], "%s", json_string_value(json_object_get(run, "output")));
+		snprintf(render_args[2], sizeof render_args[2], "%lld:%lld:%lld", first, first + (count - 1) * step, step);
+		args[n++] = render_args[0];
+		args[n++] = "-o";
+		args[n++] = render_args[1];
+		args[n++] = "--frames";
+		args[n++] = render_args[2];
+		if (json_object_get(run, "spp") != NULL) {
+			snprintf(render_args[3], sizeof render_args[3], "%lld",
+			         (long long)json_integer_value(json_object_get(run, "spp")));
+			args[n++] = "--spp";
+			args[n++] = render_args[3];
+		}
+		if (json_is_string(json_object_get(run, "size"))) {
+			snprintf(render_args[4], sizeof render_args[4], "%s", json_string_value(json_object_get(run, "size")));
+			args[n++] = "--size";
+			args[n++] = render_args[4];
+		}
+		if (json_is_string(json_object_get(run, "format"))) {
+			static char format[64];
+			snprintf(format, sizeof format, "%s", json_string_value(json_object_get(run, "format")));
+			args[n++] = "-f";
+			args[n++] = format;
+		}
 		json_decref(run);
 	} else {
 		args[n++] = "spec.json";
@@ -1901,7 +1998,7 @@ int cli_sweep(int argc, char **argv)
 	if (rank == 0 && code == CLI_EXIT_OK && !s.keep_runs) {
 		char runs[PATH_MAX + 16];
 		snprintf(runs, sizeof runs, "%s/runs", output_dir);
-		rmdir(runs);
+		remove_tree(runs); // and what killed attempts left of runs since done
 	}
 	state_end(&state);
 	sweep_free(&s);
