@@ -1097,8 +1097,19 @@ static bool sweep_check(const sweep *s)
 	for (int p = 0; p < s->param_count; ++p) {
 		const sweep_param *param = s->params + p;
 		json_t *probes = json_array();
-		if (param->values != NULL) {
-			for (size_t k = 0; k < json_array_size(param->values); ++k)
+		const json_t *item = json_array_get(json_object_get(s->root, "parameters"), (size_t)p);
+		size_t count = param->values != NULL ? json_array_size(param->values) : 0;
+		if (json_object_get(item, "grid") != NULL) {
+			// A grid is an interval: its ends, and one inside value (which may be a
+			// fraction where the ends are whole), stand for all; a scene's reader
+			// generates and meshes the feather, so each check costs.
+			json_array_append(probes, json_array_get(param->values, 0));
+			if (count > 2)
+				json_array_append(probes, json_array_get(param->values, 1));
+			if (count > 1)
+				json_array_append(probes, json_array_get(param->values, count - 1));
+		} else if (param->values != NULL) {
+			for (size_t k = 0; k < count; ++k)
 				json_array_append(probes, json_array_get(param->values, k));
 		} else {
 			// The ends of the range the samples can reach; an unbounded side of a
@@ -1652,6 +1663,10 @@ static bool write_summary(const sweep_state *state)
 	json_object_set_new(stats, "failed", json_integer(failed_runs));
 	json_t *outputs = json_object();
 	json_object_set_new(stats, "outputs", outputs);
+	// Samples, drawn here or read from another sweep's rows, get histograms.
+	bool zipped = false;
+	for (int p = 0; p < s->param_count; ++p)
+		zipped = zipped || s->params[p].zip_lead >= 0;
 	for (int o = 0; ok && o < s->output_count; ++o) {
 		int column = 1 + s->param_count + o;
 		int n = 0;
@@ -1682,7 +1697,7 @@ static bool write_summary(const sweep_state *state)
 		char output_name[128];
 		sanitize(s->outputs[o], output_name, sizeof output_name);
 		// Histogram of a random sweep: a step outline over 12 bins (or fewer for few runs).
-		if (s->random_count > 0 && n >= 2 && y[n - 1] > y[0]) {
+		if ((s->random_count > 0 || zipped) && n >= 2 && y[n - 1] > y[0]) {
 			int bins = n < 24 ? (n + 1) / 2 : 12;
 			double hx[2 * 64 + 2], hy[2 * 64 + 2];
 			double width = (y[n - 1] - y[0]) / bins;
