@@ -26,6 +26,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/file.h>
 #include <sys/prctl.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -47,13 +48,13 @@
 
 void cli_help_sweep(void)
 {
-	puts("Usage: plume sweep SWEEP.json -o DIR [-j N]\n"
+	puts("Usage: plume sweep SWEEP.json -o DIR [-j N] [--dry-run]\n"
 	     "       mpirun -n N plume sweep SWEEP.json -o DIR\n"
 	     "\n"
 	     "Runs one plume command (generate, mesh, coat, simulate, lab traction, lab\n"
-	     "calibrate, render frames) many times over parameters of its spec named by JSON\n"
-	     "path: a grid,\n"
-	     "a list, or seeded random samples (uniform, normal, log-normal, truncated).\n"
+	     "calibrate, render frames) many times over values of its spec named by JSON\n"
+	     "path: grids, lists, seeded random samples (uniform, normal, log-normal,\n"
+	     "truncated) or the rows of another sweep's results.csv.\n"
 	     "Each run is a separate plume process: a failing run is recorded with its\n"
 	     "message and the sweep goes on. docs/sweeps.md describes the sweep file.\n"
 	     "\n"
@@ -1520,6 +1521,17 @@ static bool state_begin(int *code, sweep_state *state, const sweep *s, const cha
 	if (mkdir(dir, 0777) != 0 && errno != EEXIST) {
 		fprintf(stderr, "plume: %s: cannot create: %s\n", dir, strerror(errno));
 		free(document);
+		return false;
+	}
+	// One sweep at a time in DIR: the lock goes with the process, however it ends.
+	snprintf(path, sizeof path, "%s/.sweep.lock", dir);
+	int lock = open(path, O_WRONLY | O_CREAT | O_CLOEXEC, 0666);
+	if (lock < 0 || flock(lock, LOCK_EX | LOCK_NB) != 0) {
+		fprintf(stderr, "plume: %s: another plume sweep is running in this folder\n", dir);
+		if (lock >= 0)
+			close(lock);
+		free(document);
+		*code = CLI_EXIT_IO;
 		return false;
 	}
 	snprintf(path, sizeof path, "%s/sweep.json", dir);

@@ -119,6 +119,8 @@ check "killed run: resumed to the uninterrupted bytes" cmp -s "$scratch/whole/re
 "$plume" sweep "$scratch/slow.json" -o "$scratch/job" -j 2 >/dev/null 2>&1 &
 job=$!
 wait_rows "$scratch/job" 3
+expect_failure "a second sweep in a busy DIR" 4 "another plume sweep is running in this folder" \
+	"$plume" sweep "$scratch/slow.json" -o "$scratch/job"
 kill -KILL $job
 wait $job 2>/dev/null
 done_before=$(rows "$scratch/job")
