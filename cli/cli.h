@@ -124,6 +124,7 @@ int cli_simulate(int argc, char **argv);
 int cli_render(int argc, char **argv);
 int cli_lab(int argc, char **argv);
 int cli_demo(int argc, char **argv);
+int cli_sweep(int argc, char **argv);
 
 void cli_help_generate(void);
 void cli_help_grow(void);
@@ -133,5 +134,6 @@ void cli_help_simulate(void);
 void cli_help_render(void);
 void cli_help_lab(void);
 void cli_help_demo(void);
+void cli_help_sweep(void);
 
 #endif

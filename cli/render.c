@@ -50,6 +50,10 @@ void cli_help_render(void)
 	     "      --strip N          simulation folders: also DIR/strip.png, N frames evenly spaced\n"
 	     "                         from the first to the last, side by side\n"
 	     "  -f, --format LIST      simulation folders: png,obj,usda (default: all three)\n"
+	     "      --frames A:B[:S]   simulation folders: only frames A, A+S, ... up to B (frame\n"
+	     "                         numbers NNNN); the camera still frames the whole sequence,\n"
+	     "                         so ranges rendered apart (plume sweep) match, and the\n"
+	     "                         frames join DIR/frames/ when it exists\n"
 	     "  -h, --help             this help");
 }
 
@@ -59,6 +63,8 @@ typedef struct render_options {
 	bool seed_given, shell;
 	uint64_t seed;
 	unsigned formats;
+	bool frames_given; ///< --frames: render frame numbers first, first + step, ... <= last
+	int frame_first, frame_last, frame_step;
 } render_options;
 
 static bool parse_count(const char *text, int lo, int hi, int *out)
@@ -86,6 +92,7 @@ static int parse_options(int argc, char **argv, render_options *o)
 	    {"strip", required_argument, NULL, 'P'},
 	    {"shell", no_argument, NULL, 'm'},
 	    {"format", required_argument, NULL, 'f'},
+	    {"frames", required_argument, NULL, 'F'},
 	    {"help", no_argument, NULL, 'h'},
 	    {NULL, 0, NULL, 0},
 	};
@@ -139,6 +146,25 @@ static int parse_options(int argc, char **argv, render_options *o)
 			}
 			if (o->formats == 0)
 				return cli_usage_error("render", "--format needs at least one of png, obj, usda");
+			break;
+		}
+		case 'F': {
+			char text[64], *second = NULL, *third = NULL;
+			snprintf(text, sizeof text, "%s", optarg);
+			second = strchr(text, ':');
+			if (second != NULL) {
+				*second++ = '\0';
+				third = strchr(second, ':');
+				if (third != NULL)
+					*third++ = '\0';
+			}
+			o->frame_step = 1;
+			if (second == NULL || !parse_count(text, 0, 99999999, &o->frame_first) ||
+			    !parse_count(second, 0, 99999999, &o->frame_last) ||
+			    (third != NULL && !parse_count(third, 1, 99999999, &o->frame_step)) || o->frame_last < o->frame_first)
+				return cli_usage_error("render", "--frames '%s': expected A:B or A:B:S with 0 <= A <= B and S >= 1",
+				                       optarg);
+			o->frames_given = true;
 			break;
 		}
 		case 'h': cli_help_render(); return -1;
@@ -391,6 +417,44 @@ static int strip_slot(int slots, int count, int i)
 	return -1;
 }
 
+/// Whether --frames selects the frame file name ("0042.obj").
+static bool frame_selected(const render_options *o, const char *name)
+{
+	if (!o->frames_given)
+		return true;
+	long number = strtol(name, NULL, 10);
+	return number >= o->frame_first && number <= o->frame_last && (number - o->frame_first) % o->frame_step == 0;
+}
+
+/// --frames into a DIR/frames that exists (another range's): the staged frames join it
+/// file by file (each rename atomic), and the staged folder goes.
+static plume_status merge_frames(cli_output *output, const char *staged, plume_error *err)
+{
+	char final[4352];
+	snprintf(final, sizeof final, "%s/frames", output->dir);
+	struct stat info;
+	if (stat(final, &info) != 0 || !S_ISDIR(info.st_mode))
+		return PLUME_OK; // the commit moves the whole folder in
+	DIR *folder = opendir(staged);
+	if (folder == NULL)
+		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot read: %s", staged, strerror(errno));
+	struct dirent *entry;
+	plume_status status = PLUME_OK;
+	while (status == PLUME_OK && (entry = readdir(folder)) != NULL) {
+		if (entry->d_name[0] == '.')
+			continue;
+		char from[4608], to[4608];
+		snprintf(from, sizeof from, "%s/%s", staged, entry->d_name);
+		snprintf(to, sizeof to, "%s/%s", final, entry->d_name);
+		if (rename(from, to) != 0)
+			status = plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write: %s", to, strerror(errno));
+	}
+	closedir(folder);
+	if (status == PLUME_OK && rmdir(staged) != 0)
+		status = plume_error_set(err, PLUME_ERROR_IO, "%s: cannot remove: %s", staged, strerror(errno));
+	return status;
+}
+
 static plume_status render_sim(const render_options *o, const plume_raytrace_def *def, cli_output *output,
                                plume_error *err)
 {
@@ -416,7 +480,19 @@ static plume_status render_sim(const render_options *o, const plume_raytrace_def
 	if (status == PLUME_OK)
 		frame_def.camera = plume_camera_frame_bounds(&def->camera, lo, hi);
 	char folder[4352];
-	if (status == PLUME_OK)
+	int selected = 0;
+	for (int i = 0; i < in.frame_count; ++i)
+		selected += frame_selected(o, in.frame_names[i]);
+	if (status == PLUME_OK && selected == 0)
+		status = plume_error_set(
+		    err, PLUME_ERROR_SPEC, "%s: no frame in --frames %d:%d:%d (the frames are %.*s to %.*s)", o->input,
+		    o->frame_first, o->frame_last, o->frame_step, (int)strlen(in.frame_names[0]) - 4, in.frame_names[0],
+		    (int)strlen(in.frame_names[in.frame_count - 1]) - 4, in.frame_names[in.frame_count - 1]);
+	if (status == PLUME_OK && o->frames_given) {
+		cli_output_path(output, "frames", folder, sizeof folder);
+		if (mkdir(folder, 0777) != 0)
+			status = plume_error_set(err, PLUME_ERROR_IO, "%s: cannot create: %s", folder, strerror(errno));
+	} else if (status == PLUME_OK)
 		status = stage_folder(output, "frames", folder, sizeof folder, err);
 	const int w = frame_def.camera.width, h = frame_def.camera.height;
 	uint8_t *image = malloc(4 * (size_t)w * (size_t)h);
@@ -428,6 +504,8 @@ static plume_status render_sim(const render_options *o, const plume_raytrace_def
 	cli_progress progress;
 	cli_progress_begin(&progress, "render frames", in.frame_count);
 	for (int i = 0; i < in.frame_count && status == PLUME_OK; ++i) {
+		if (!frame_selected(o, in.frame_names[i]))
+			continue;
 		plume_feather *moved = NULL;
 		if ((status = plume_embedding_apply(embedding, in.positions[i], &moved, err)) != PLUME_OK)
 			break;
@@ -466,6 +544,8 @@ static plume_status render_sim(const render_options *o, const plume_raytrace_def
 		cli_output_path(output, "strip.png", path, sizeof path);
 		status = plume_write_rgba_png(w * slots, h, strip, path, err);
 	}
+	if (status == PLUME_OK && o->frames_given)
+		status = merge_frames(output, folder, err);
 	free(image);
 	free(strip);
 	plume_embedding_destroy(embedding);
@@ -492,6 +572,19 @@ int cli_render(int argc, char **argv)
 		return cli_usage_error("render", "--turntable needs a feather spec as INPUT");
 	if (o.strip > 0 && (!sim || !(o.formats & CLI_FORMAT_PNG)))
 		return cli_usage_error("render", "--strip needs a simulation folder as INPUT and png among the formats");
+	if (o.frames_given && (!sim || o.strip > 0))
+		return cli_usage_error("render", "--frames needs a simulation folder as INPUT, and no --strip");
+	// Ranges rendered at once by several processes share DIR: create it first, so that
+	// each stages inside it and none finds it appearing under its feet.
+	if (o.frames_given) {
+		char frames[4352];
+		snprintf(frames, sizeof frames, "%s/frames", o.output_dir);
+		if ((mkdir(o.output_dir, 0777) != 0 && errno != EEXIST) || (mkdir(frames, 0777) != 0 && errno != EEXIST)) {
+			plume_error err;
+			plume_error_set(&err, PLUME_ERROR_IO, "%s: cannot create: %s", frames, strerror(errno));
+			return cli_fail(&err);
+		}
+	}
 
 	plume_error err = {0};
 	plume_texture *texture = NULL;

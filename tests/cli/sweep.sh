@@ -1,0 +1,259 @@
+#!/usr/bin/env bash
+# Scenario tests of `plume sweep`: a grid x random sweep of lab traction tests gives
+# the closed form of thesis eq. 5.2 in every row and the same results.csv bytes with
+# -j 1, -j 2 and under mpirun -n 2 and -n 3; failing runs are recorded; a sweep whose
+# run or whole job is SIGKILLed resumes to the uninterrupted bytes; random samples are
+# reproducible and follow their distributions; bad sweeps write nothing; every output
+# key the sweep accepts is one a real run writes.
+# Usage: sweep.sh PLUME_BINARY SOURCE_DIR
+source "$(dirname "$0")/../cli_support.sh" "$@"
+py=/usr/bin/python3
+
+# --- a small sweep: 2 grid values x 3 log-normal samples of E_B --------------
+cat >"$scratch/grid.json" <<'EOF'
+{
+  "command": "lab traction",
+  "spec": {"sample": {"width": 0.004, "height": 0.0052, "barb_angle_deg": 0, "elements": 200},
+           "material": {"model": "mesoscale", "E_B": 2.57e9, "E_b": 3.92e4, "barb_fraction": 0.14, "band_period": 4e-4},
+           "traction": {"strain_max": 0.01, "steps": 4}},
+  "parameters": [
+    {"path": "$.material.barb_fraction", "values": [0.1, 0.2]},
+    {"path": "$.material.E_B", "distribution": "lognormal", "mean": 2.57e9, "std": 0.3e9}
+  ],
+  "samples": 3, "seed": 5,
+  "outputs": ["slope_pa", "steps"]
+}
+EOF
+"$plume" sweep "$scratch/grid.json" -o "$scratch/j1" -j 1 >"$scratch/out.txt" 2>"$scratch/err.txt"
+check "sweep -j 1 succeeds ($(cat "$scratch/err.txt"))" test $? -eq 0
+check "sweep: summary line" grep -q '^sweep: 6 runs, 6 ok, 0 failed' "$scratch/out.txt"
+for file in results.csv sweep.json stats.json timings.csv plots/slope_pa-vs-material_barb_fraction.png \
+	plots/slope_pa-histogram.png; do
+	check "sweep: $file written" test -s "$scratch/j1/$file"
+done
+check "sweep: no run folders kept" test ! -e "$scratch/j1/runs"
+check "sweep: header" test "$(head -1 "$scratch/j1/results.csv")" = "index,material.barb_fraction,material.E_B,slope_pa,steps,status,message"
+check "sweep: 6 rows" test "$(wc -l <"$scratch/j1/results.csv")" -eq 7
+check "sweep: 6 timings" test "$(wc -l <"$scratch/j1/timings.csv")" -eq 6
+# Thesis eq. 5.2: the longitudinal slope is Phi_B E_B + (1 - Phi_B) E_b, to 1e-3.
+check "sweep: every row follows eq. 5.2" awk -F, 'NR > 1 { e = $2 * $3 + (1 - $2) * 39200; r = $4 / e; if (!(r > 0.999 && r < 1.001) || $6 != "ok") bad = 1 } END { exit bad }' "$scratch/j1/results.csv"
+check "sweep: grid value slowest, samples shared across it" \
+	test "$(awk -F, 'NR > 1 { print $2 }' "$scratch/j1/results.csv" | tr '\n' ' ')" = "0.1 0.1 0.1 0.2 0.2 0.2 "
+check "sweep: the same E_B samples at each grid value" \
+	test "$(awk -F, 'NR >= 2 && NR <= 4 { print $3 }' "$scratch/j1/results.csv")" = "$(awk -F, 'NR >= 5 { print $3 }' "$scratch/j1/results.csv")"
+check "sweep.json: version and seed" grep -q '"plume_version"' "$scratch/j1/sweep.json"
+
+"$plume" sweep "$scratch/grid.json" -o "$scratch/j2" -j 2 >/dev/null 2>&1
+check "sweep -j 2: same results.csv bytes" cmp -s "$scratch/j1/results.csv" "$scratch/j2/results.csv"
+check "sweep -j 2: same stats.json" cmp -s "$scratch/j1/stats.json" "$scratch/j2/stats.json"
+
+# --- MPI ----------------------------------------------------------------------
+if "$plume" help sweep | grep -q 'This plume was built with MPI' && command -v mpirun >/dev/null; then
+	# Root needs both the flag and these; Open MPI's own allocations at exit are not
+	# plume's leaks (the sanitizer build would count them).
+	export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
+	export ASAN_OPTIONS=${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0
+	for n in 2 3; do
+		mpirun --allow-run-as-root --oversubscribe -n $n "$plume" sweep "$scratch/grid.json" -o "$scratch/mpi$n" \
+			>"$scratch/out.txt" 2>"$scratch/err.txt"
+		check "mpirun -n $n succeeds ($(tail -3 "$scratch/err.txt"))" test $? -eq 0
+		check "mpirun -n $n: same results.csv bytes" cmp -s "$scratch/j1/results.csv" "$scratch/mpi$n/results.csv"
+		check "mpirun -n $n: one summary line" test "$(grep -c '^sweep: 6 runs' "$scratch/out.txt")" -eq 1
+	done
+else
+	echo "SKIP: MPI part: this plume was built without MPI (libopenmpi-dev not found at configure time)"
+fi
+
+# --- a failing run is recorded and the sweep goes on --------------------------
+cat >"$scratch/fail.json" <<'EOF'
+{"command": "lab traction",
+ "spec": {"sample": {"width": 0.004, "height": 0.0052, "barb_angle_deg": 45, "elements": 300},
+          "material": {"model": "mesoscale"},
+          "traction": {"strain_max": 0.3, "steps": 3, "max_iterations": 50, "max_substep_halvings": 0}},
+ "parameters": [{"path": "$.traction.max_iterations", "values": [1, 50]}],
+ "outputs": ["slope_pa"]}
+EOF
+"$plume" sweep "$scratch/fail.json" -o "$scratch/fail" >"$scratch/out.txt" 2>&1
+check "failing run: the sweep completes" test $? -eq 0
+check "failing run: recorded with its message" grep -q '^0,1,,failed,exit 1: spec.json: traction step 1 of 3 .*Newton did not converge' "$scratch/fail/results.csv"
+check "failing run: the next run is ok" grep -q '^1,50,[0-9.e+]*,ok,$' "$scratch/fail/results.csv"
+
+# --- kill and resume ----------------------------------------------------------
+cat >"$scratch/slow.json" <<'EOF'
+{"command": "lab traction",
+ "spec": {"sample": {"width": 0.004, "height": 0.0052, "barb_angle_deg": 45, "elements": 450},
+          "material": {"model": "mesoscale", "E_b": 3.92e4, "band_phase": 0}, "traction": {"strain_max": 0.2, "steps": 6}},
+ "parameters": [{"path": "$.material.band_phase", "grid": {"from": 0, "to": 0.75, "count": 4}},
+                {"path": "$.material.E_b", "values": [3.5e4, 4.5e4]}],
+ "outputs": ["slope_pa", "newton_iterations"]}
+EOF
+"$plume" sweep "$scratch/slow.json" -o "$scratch/whole" -j 2 >/dev/null 2>&1
+check "slow sweep: 8 ok rows" test "$(grep -c ',ok,$' "$scratch/whole/results.csv")" -eq 8
+
+rows() { test -f "$1/results.csv" && echo $(($(wc -l <"$1/results.csv") - 1)) || echo 0; }
+wait_rows() { # wait_rows DIR N: until DIR/results.csv has N rows (at most 60 s, while $job lives)
+	for _ in $(seq 600); do
+		test "$(rows "$1")" -ge "$2" && return 0
+		kill -0 "$job" 2>/dev/null || return 1
+		sleep 0.1
+	done
+	return 1
+}
+# SIGKILL to one run: recorded as killed by a signal, then run again on resume.
+"$plume" sweep "$scratch/slow.json" -o "$scratch/worker" -j 1 >/dev/null 2>&1 &
+job=$!
+wait_rows "$scratch/worker" 2
+# Kill the current run until one kill lands on a live run (not one just exiting).
+while kill -0 $job 2>/dev/null && ! grep -q ',signal,' "$scratch/worker/results.csv"; do
+	child=$(pgrep -P $job | head -1)
+	test -n "$child" && kill -KILL "$child" 2>/dev/null
+	sleep 0.2
+done
+wait $job
+check "killed run: recorded as a signal" grep -q ',signal,killed by signal 9' "$scratch/worker/results.csv"
+check "killed run: the sweep went on to the end" test "$(rows "$scratch/worker")" -eq 8
+"$plume" sweep "$scratch/slow.json" -o "$scratch/worker" -j 2 >/dev/null 2>&1
+check "killed run: resumed to the uninterrupted bytes" cmp -s "$scratch/whole/results.csv" "$scratch/worker/results.csv"
+
+# SIGKILL to the whole sweep: its runs die with it; resume runs only what is missing.
+"$plume" sweep "$scratch/slow.json" -o "$scratch/job" -j 2 >/dev/null 2>&1 &
+job=$!
+wait_rows "$scratch/job" 3
+expect_failure "a second sweep in a busy DIR" 4 "another plume sweep is running in this folder" \
+	"$plume" sweep "$scratch/slow.json" -o "$scratch/job"
+kill -KILL $job
+wait $job 2>/dev/null
+done_before=$(rows "$scratch/job")
+check "killed sweep: part done ($done_before rows)" test "$done_before" -lt 8
+check "killed sweep: results.csv whole (every row ends in a status)" \
+	awk -F, 'NR > 1 && $(NF - 1) != "ok" { bad = 1 } END { exit bad }' "$scratch/job/results.csv"
+sleep 0.3
+check "killed sweep: no run outlives it" test -z "$(pgrep -P $job)"
+"$plume" sweep "$scratch/slow.json" -o "$scratch/job" -j 1 >/dev/null 2>&1
+check "killed sweep: resumed to the uninterrupted bytes" cmp -s "$scratch/whole/results.csv" "$scratch/job/results.csv"
+check "killed sweep: only the missing runs ran again" \
+	test "$(wc -l <"$scratch/job/timings.csv")" -le $((8 + 2))
+expect_failure "resume with another sweep" 3 "holds another sweep" "$plume" sweep "$scratch/grid.json" -o "$scratch/job"
+
+# --- random samples: reproducible, distributed as asked -----------------------
+cat >"$scratch/random.json" <<'EOF'
+{"command": "lab traction",
+ "spec": {"material": {"model": "mesoscale", "E_B": 2.57e9, "E_b": 3.92e4, "barb_fraction": 0.14}},
+ "parameters": [
+   {"path": "$.material.barb_fraction", "distribution": "normal", "mean": 0.14, "std": 0.02, "min": 0.1, "max": 0.2},
+   {"path": "$.material.E_b", "distribution": "lognormal", "mean": 3.92e4, "std": 0.98e4},
+   {"path": "$.material.E_B", "distribution": "uniform", "min": 2e9, "max": 3e9}
+ ],
+ "samples": 4000, "seed": 11}
+EOF
+"$plume" sweep --dry-run "$scratch/random.json" -o "$scratch/none" >"$scratch/plan1.csv" 2>"$scratch/err.txt"
+check "dry run succeeds ($(cat "$scratch/err.txt"))" test $? -eq 0
+check "dry run: nothing written" test ! -e "$scratch/none"
+"$plume" sweep --dry-run "$scratch/random.json" -o "$scratch/none" >"$scratch/plan2.csv" 2>/dev/null
+check "same seed, same samples" cmp -s "$scratch/plan1.csv" "$scratch/plan2.csv"
+sed 's/"seed": 11/"seed": 12/' "$scratch/random.json" >"$scratch/random12.json"
+"$plume" sweep --dry-run "$scratch/random12.json" -o "$scratch/none" >"$scratch/plan3.csv" 2>/dev/null
+check "another seed, other samples" test "$(sed -n 2p "$scratch/plan1.csv")" != "$(sed -n 2p "$scratch/plan3.csv")"
+# Moments against closed forms: the truncated normal on [0.1, 0.2] (mean 0.14, std 0.02,
+# i.e. [-2, 3] std) has mean 0.14 + 0.02 (phi(-2) - phi(3)) / (Phi(3) - Phi(-2)) = 0.14101;
+# the log-normal's mean and std are the given ones; the uniform's mean 2.5e9, std 2.89e8.
+check "samples follow their distributions" "$py" - "$scratch/plan1.csv" <<'EOF'
+import csv, math, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+assert len(rows) == 4000
+phi = [float(r["material.barb_fraction"]) for r in rows]
+eb = [float(r["material.E_b"]) for r in rows]
+EB = [float(r["material.E_B"]) for r in rows]
+def mean(x): return sum(x) / len(x)
+def std(x):
+    m = mean(x); return math.sqrt(sum((v - m) ** 2 for v in x) / (len(x) - 1))
+pdf = lambda z: math.exp(-z * z / 2) / math.sqrt(2 * math.pi)
+cdf = lambda z: 0.5 * math.erfc(-z / math.sqrt(2))
+expected = 0.14 + 0.02 * (pdf(-2) - pdf(3)) / (cdf(3) - cdf(-2))
+assert min(phi) >= 0.1 and max(phi) <= 0.2, (min(phi), max(phi))
+assert abs(mean(phi) - expected) < 4 * 0.02 / math.sqrt(4000), (mean(phi), expected)
+assert abs(mean(eb) / 3.92e4 - 1) < 0.01, mean(eb)
+assert abs(std(eb) / 0.98e4 - 1) < 0.06, std(eb)
+assert min(eb) > 0
+assert abs(mean(EB) / 2.5e9 - 1) < 0.005 and abs(std(EB) / (1e9 / math.sqrt(12)) - 1) < 0.03
+EOF
+
+# --- bad sweeps: a clear message before any run, nothing written --------------
+base='"command": "lab traction", "spec": {"material": {"model": "mesoscale", "barb_fraction": 0.14}}'
+echo "{$base, \"parameters\": [{\"path\": \"\$.material.barb_fractoin\", \"values\": [0.1]}]}" >"$scratch/bad-path.json"
+expect_no_output "bad key" 3 'bad-path.json: the first run'"'"'s spec is refused: $.material.barb_fractoin: unknown key; did you mean "barb_fraction"?' \
+	"$scratch/bad" "$plume" sweep "$scratch/bad-path.json" -o "$scratch/bad"
+echo "{$base, \"parameters\": [{\"path\": \"\$.materal.barb_fraction\", \"values\": [0.1]}]}" >"$scratch/bad-path2.json"
+expect_no_output "bad path" 3 'bad-path2.json: $.parameters[0].path: $.materal.barb_fraction is not in the base spec; the nearest path there is $.material.barb_fraction' \
+	"$scratch/bad" "$plume" sweep "$scratch/bad-path2.json" -o "$scratch/bad"
+echo '{"command": "lab calibrate", "spec": {"phi": 0.14, "Eb": 3.92e4, "EB": 2.57e9}, "parameters": [{"path": "$.phase", "values": [1]}]}' >"$scratch/bad-cal.json"
+expect_no_output "bad calibration key" 3 '$.phase: not a calibration option; did you mean "phases"?' \
+	"$scratch/bad" "$plume" sweep "$scratch/bad-cal.json" -o "$scratch/bad"
+echo "{$base, \"parameters\": [{\"path\": \"\$.material.barb_fraction\", \"distribution\": \"normal\", \"mean\": 0.14, \"std\": 0.02}], \"samples\": 3}" >"$scratch/bad-range.json"
+expect_no_output "distribution outside the range" 3 '$.material.barb_fraction is -0.06, allowed in (0, 1); bound it with "min"/"max"' \
+	"$scratch/bad" "$plume" sweep "$scratch/bad-range.json" -o "$scratch/bad"
+echo "{$base, \"parameters\": [{\"path\": \"\$.material.barb_fraction\", \"values\": [0.1, 1.5]}]}" >"$scratch/bad-value.json"
+expect_no_output "grid value outside the range" 3 'the value 1.5 is refused: $.material.barb_fraction is 1.5, allowed in (0, 1)' \
+	"$scratch/bad" "$plume" sweep "$scratch/bad-value.json" -o "$scratch/bad"
+echo "{$base, \"parameters\": [{\"path\": \"\$.material.barb_fraction\", \"values\": [0.1]}], \"outputs\": [\"slope\"]}" >"$scratch/bad-output.json"
+expect_no_output "unknown output" 3 '$.outputs[0]: no lab traction run produces "slope"; lab traction writes: slope_pa,' \
+	"$scratch/bad" "$plume" sweep "$scratch/bad-output.json" -o "$scratch/bad"
+echo "{$base, \"parameters\": [{\"path\": \"\$.material.barb_fraction\", \"values\": [0.1]}], \"sample\": 3}" >"$scratch/bad-key.json"
+expect_no_output "unknown sweep key" 3 '$.sample is not a sweep key; did you mean "samples"?' \
+	"$scratch/bad" "$plume" sweep "$scratch/bad-key.json" -o "$scratch/bad"
+expect_no_output "bad -j" 2 "-j expects a whole number" "$scratch/bad" "$plume" sweep "$scratch/grid.json" -o "$scratch/bad" -j 0
+
+# --- frames: ranges rendered apart (render --frames, a sweep) equal one render -----
+sed 's/"duration": 1.1/"duration": 0.033/' "$source_dir/examples/scenes/figure1-anisotropic.json" |
+	sed "s|\"../franco-walter/hawk.json\"|\"$source_dir/examples/franco-walter/hawk.json\"|" >"$scratch/short.json"
+"$plume" simulate "$scratch/short.json" -o "$scratch/sim" >/dev/null 2>&1
+check "frames: a 4-frame simulation" test -f "$scratch/sim/frames/0003.obj"
+"$plume" render "$scratch/sim" -o "$scratch/render-all" --spp 1 --size 40x40 -f png >/dev/null 2>&1
+"$plume" render "$scratch/sim" -o "$scratch/render-parts" --spp 1 --size 40x40 -f png --frames 0:3:2 >/dev/null 2>&1
+check "render --frames 0:3:2: frames 0 and 2 only" test "$(ls "$scratch/render-parts/frames" | tr '\n' ' ')" = "0000.png 0002.png "
+"$plume" render "$scratch/sim" -o "$scratch/render-parts" --spp 1 --size 40x40 -f png --frames 1:3:2 >/dev/null 2>&1
+check "render --frames: a second range joins the folder" test "$(ls -A "$scratch/render-parts/frames" | wc -l)" -eq 4
+check "render --frames: nothing else left in DIR" test "$(ls -A "$scratch/render-parts" | tr '\n' ' ')" = "frames "
+for f in 0000 0001 0002 0003; do
+	check "render --frames: frame $f equals the whole render's" cmp -s "$scratch/render-all/frames/$f.png" "$scratch/render-parts/frames/$f.png"
+done
+expect_failure "render --frames: bad range" 2 "--frames '5:1': expected A:B or A:B:S" \
+	"$plume" render "$scratch/sim" -o "$scratch/o" --frames 5:1
+expect_failure "render --frames: no frame selected" 3 "no frame in --frames 7:9:1 (the frames are 0000 to 0003)" \
+	"$plume" render "$scratch/sim" -o "$scratch/o" --frames 7:9
+echo '{"command": "render frames",
+ "spec": {"simulation": "sim", "output": "render-sweep", "first": 0, "count": 2, "spp": 1, "size": "40x40", "format": "png"},
+ "parameters": [{"path": "$.first", "grid": {"from": 0, "to": 2, "count": 2}}]}' >"$scratch/frames.json"
+"$plume" sweep "$scratch/frames.json" -o "$scratch/frames-sweep" -j 2 >/dev/null 2>"$scratch/err.txt"
+check "frames sweep: 2 ranges ok ($(cat "$scratch/err.txt"))" test "$(grep -c ',ok,$' "$scratch/frames-sweep/results.csv")" -eq 2
+for f in 0000 0001 0002 0003; do
+	check "frames sweep: frame $f equals the whole render's" cmp -s "$scratch/render-all/frames/$f.png" "$scratch/render-sweep/frames/$f.png"
+done
+
+# --- every output key the sweep accepts is one a real run writes ---------------
+# The sweep checks output keys against its own lists before any run; here every
+# listed key is asked of a real run and must come back non-empty.
+all_keys() { # all_keys SWEEP_WITHOUT_OUTPUTS: the keys the unknown-output message lists
+	sed 's/}$/, "outputs": ["?"]}/' "$1" >"$scratch/keys.json"
+	"$plume" sweep "$scratch/keys.json" -o "$scratch/bad" 2>&1 | sed -n 's/.* writes: //p' | tr -d ' '
+}
+every_key_written() { # every_key_written NAME SWEEP_WITHOUT_OUTPUTS
+	local keys
+	keys=$(all_keys "$2")
+	check "$1: keys listed" test -n "$keys"
+	sed "s/}\$/, \"outputs\": [\"${keys//,/\",\"}\"]}/" "$2" >"$scratch/all.json"
+	rm -rf "$scratch/all"
+	"$plume" sweep "$scratch/all.json" -o "$scratch/all" >/dev/null 2>"$scratch/err.txt"
+	check "$1: every listed key has a value ($(tail -1 "$scratch/all/results.csv" 2>/dev/null))" \
+		awk -F, -v n="$(echo "$keys" | tr ',' '\n' | wc -l)" 'NR == 2 { for (i = 3; i < 3 + n; ++i) if ($i == "") bad = 1; if ($(3 + n) != "ok") bad = 1 } END { exit bad || NR != 2 }' "$scratch/all/results.csv"
+}
+echo "{\"command\": \"simulate\", \"spec\": \"$source_dir/examples/scenes/figure1-anisotropic.json\", \"parameters\": [{\"path\": \"\$.duration\", \"values\": [0.011]}]}" >"$scratch/k-simulate.json"
+every_key_written simulate "$scratch/k-simulate.json"
+echo "{\"command\": \"mesh\", \"spec\": \"$source_dir/examples/meshes/guides.json\", \"parameters\": [{\"path\": \"\$.mesh.edge_length\", \"values\": [0.004]}]}" >"$scratch/k-mesh.json"
+every_key_written mesh "$scratch/k-mesh.json"
+echo "{$base, \"parameters\": [{\"path\": \"\$.material.barb_fraction\", \"values\": [0.14]}]}" >"$scratch/k-traction.json"
+every_key_written "lab traction" "$scratch/k-traction.json"
+echo '{"command": "lab calibrate", "spec": {"phi": 0.14, "Eb": 3.92e4, "EB": 2.57e9, "phases": 1, "elements": 300, "macro_elements": 200}, "parameters": [{"path": "$.phi", "values": [0.14]}]}' >"$scratch/k-calibrate.json"
+every_key_written "lab calibrate" "$scratch/k-calibrate.json"
+
+finish
