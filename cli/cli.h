@@ -106,6 +106,7 @@ int cli_simulate(int argc, char **argv);
 int cli_render(int argc, char **argv);
 int cli_lab(int argc, char **argv);
 int cli_demo(int argc, char **argv);
+int cli_view(int argc, char **argv);
 
 void cli_help_generate(void);
 void cli_help_grow(void);
@@ -115,5 +116,6 @@ void cli_help_simulate(void);
 void cli_help_render(void);
 void cli_help_lab(void);
 void cli_help_demo(void);
+void cli_help_view(void);
 
 #endif
