@@ -23,7 +23,8 @@ enum {
 	CLI_FORMAT_OBJ = 1u << 3,
 	CLI_FORMAT_USDA = 1u << 4,
 	CLI_FORMAT_JSON = 1u << 5,
-	CLI_FORMAT_ALL = (1u << 6) - 1,
+	CLI_FORMAT_ALL = (1u << 6) - 1, ///< generate's default set (glb is asked for by name)
+	CLI_FORMAT_GLB = 1u << 6,       ///< glTF 2.0 binary (plume/gltf.h)
 };
 
 /// Prints "plume: message" on stderr and returns the exit code for the status.

@@ -22,7 +22,7 @@ void cli_help_coat(void)
 	     "Options:\n"
 	     "  -o, --output DIR       output folder (created if missing)\n"
 	     "  -s, --seed N           random seed; overrides the coat's \"seed\" (default 1)\n"
-	     "  -f, --format LIST      comma-separated: png,svg,pdf,obj,usda (default: png,obj,usda)\n"
+	     "  -f, --format LIST      comma-separated: png,svg,pdf,obj,usda,glb (default: png,obj,usda)\n"
 	     "      --size WxH         image size in pixels (default 1200x1200)\n"
 	     "      --style STYLE      lines (default) or strips: barbs as alpha-faded triangle\n"
 	     "                         strips (Streit & Heidrich 4.3.1)\n"
@@ -64,6 +64,14 @@ static plume_status write_coat(cli_output *output, const plume_coat *coat, unsig
 	    (status = plume_coat_write_usda(coat, cli_output_path(output, "coat.usda", path, sizeof path), err)) !=
 	        PLUME_OK)
 		return status;
+	if ((formats & CLI_FORMAT_GLB) != 0) {
+		plume_coat_glb_report report;
+		status = plume_coat_write_glb_report(coat, NULL, cli_output_path(output, "coat.glb", path, sizeof path),
+		                                     &report, err);
+		if (status != PLUME_OK)
+			return status;
+		printf("coat.glb: %d feather instances of %d meshes, and the surface\n", report.instances, report.meshes);
+	}
 	for (size_t i = 0; i < sizeof images / sizeof images[0]; ++i)
 		if ((formats & images[i].bit) != 0 &&
 		    (status = plume_coat_render2d(coat, image, images[i].format,
@@ -101,7 +109,7 @@ int cli_coat(int argc, char **argv)
 				return CLI_EXIT_USAGE;
 			if ((formats & CLI_FORMAT_JSON) != 0)
 				return cli_usage_error("coat", "--format json is for single feathers; a coat writes png, svg, pdf, "
-				                               "obj, usda");
+				                               "obj, usda, glb");
 			break;
 		case 'S':
 			if (!cli_parse_size("coat", optarg, &image.width, &image.height))

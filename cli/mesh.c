@@ -30,6 +30,7 @@ void cli_help_mesh(void)
 	     "  DIR/mesh.png    the reference mesh: rachis and vane faces, barb-aligned edges\n"
 	     "  DIR/report.json vertex and face counts, minimum angle, aligned fraction,\n"
 	     "                  guides dropped\n"
+	     "  DIR/mesh.glb    the rest shell as glTF 2.0, with --format glb\n"
 	     "All files appear together, or none when anything fails.\n"
 	     "\n"
 	     "Options:\n"
@@ -38,6 +39,7 @@ void cli_help_mesh(void)
 	     "                          \"mesh\".\"edge_length\", else 0.005, thesis Table 6.1)\n"
 	     "  -s, --seed N            random seed of a feather spec; overrides its \"seed\"\n"
 	     "      --size WxH          image size in pixels (default: 1200 tall)\n"
+	     "  -f, --format LIST       comma-separated: obj,png,glb (default: obj,png)\n"
 	     "  -h, --help              this help\n"
 	     "\n"
 	     "The guides spec is described in docs/meshing.md.");
@@ -169,17 +171,22 @@ static plume_status write_report(const plume_mesh *mesh, const plume_mesh_report
 int cli_mesh(int argc, char **argv)
 {
 	static const struct option options[] = {
-	    {"output", required_argument, NULL, 'o'}, {"edge-length", required_argument, NULL, 'e'},
-	    {"seed", required_argument, NULL, 's'},   {"size", required_argument, NULL, 'S'},
-	    {"help", no_argument, NULL, 'h'},         {NULL, 0, NULL, 0},
+	    {"output", required_argument, NULL, 'o'},
+	    {"edge-length", required_argument, NULL, 'e'},
+	    {"seed", required_argument, NULL, 's'},
+	    {"size", required_argument, NULL, 'S'},
+	    {"help", no_argument, NULL, 'h'},
+	    {"format", required_argument, NULL, 'f'},
+	    {NULL, 0, NULL, 0},
 	};
 	const char *output_dir = NULL;
 	plume_mesh_spec_options spec_options = plume_mesh_spec_default_options();
 	int width = 0, height = 0;
+	unsigned formats = CLI_FORMAT_OBJ | CLI_FORMAT_PNG;
 	int option;
 	optind = 1;
 	opterr = 0;
-	while ((option = getopt_long(argc, argv, ":o:e:s:h", options, NULL)) != -1) {
+	while ((option = getopt_long(argc, argv, ":o:e:s:f:h", options, NULL)) != -1) {
 		switch (option) {
 		case 'o': output_dir = optarg; break;
 		case 'e':
@@ -194,6 +201,12 @@ int cli_mesh(int argc, char **argv)
 		case 'S':
 			if (!cli_parse_size("mesh", optarg, &width, &height))
 				return CLI_EXIT_USAGE;
+			break;
+		case 'f':
+			if (!cli_parse_formats("mesh", optarg, &formats))
+				return CLI_EXIT_USAGE;
+			if ((formats & ~(unsigned)(CLI_FORMAT_OBJ | CLI_FORMAT_PNG | CLI_FORMAT_GLB)) != 0)
+				return cli_usage_error("mesh", "--format '%s': a mesh writes obj, png, glb", optarg);
 			break;
 		case 'h': cli_help_mesh(); return CLI_EXIT_OK;
 		case ':': return cli_usage_error("mesh", "option '%s' needs a value", argv[optind - 1]);
@@ -210,8 +223,13 @@ int cli_mesh(int argc, char **argv)
 	cli_output output;
 	if (status == PLUME_OK && (status = cli_output_begin(&output, output_dir, &err)) == PLUME_OK) {
 		char path[4400];
-		status = plume_mesh_write_obj(mesh, NULL, cli_output_path(&output, "mesh.obj", path, sizeof path), &err);
-		if (status == PLUME_OK)
+		status = PLUME_OK;
+		if ((formats & CLI_FORMAT_OBJ) != 0)
+			status = plume_mesh_write_obj(mesh, NULL, cli_output_path(&output, "mesh.obj", path, sizeof path), &err);
+		if (status == PLUME_OK && (formats & CLI_FORMAT_GLB) != 0)
+			status =
+			    plume_mesh_write_glb(mesh, NULL, NULL, cli_output_path(&output, "mesh.glb", path, sizeof path), &err);
+		if (status == PLUME_OK && (formats & CLI_FORMAT_PNG) != 0)
 			status = draw_mesh(mesh, width, height, cli_output_path(&output, "mesh.png", path, sizeof path), &err);
 		if (status == PLUME_OK)
 			status = write_report(mesh, &report, cli_output_path(&output, "report.json", path, sizeof path), &err);

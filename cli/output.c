@@ -65,8 +65,8 @@ static const struct {
 	const char *name;
 	unsigned bit;
 } format_names[] = {
-    {"png", CLI_FORMAT_PNG}, {"svg", CLI_FORMAT_SVG},   {"pdf", CLI_FORMAT_PDF},
-    {"obj", CLI_FORMAT_OBJ}, {"usda", CLI_FORMAT_USDA}, {"json", CLI_FORMAT_JSON},
+    {"png", CLI_FORMAT_PNG},   {"svg", CLI_FORMAT_SVG},   {"pdf", CLI_FORMAT_PDF}, {"obj", CLI_FORMAT_OBJ},
+    {"usda", CLI_FORMAT_USDA}, {"json", CLI_FORMAT_JSON}, {"glb", CLI_FORMAT_GLB},
 };
 
 bool cli_parse_formats(const char *command, const char *list, unsigned *formats)
@@ -83,7 +83,7 @@ bool cli_parse_formats(const char *command, const char *list, unsigned *formats)
 			}
 		}
 		if (!known) {
-			cli_usage_error(command, "unknown format '%.*s' in --format; allowed: png, svg, pdf, obj, usda, json",
+			cli_usage_error(command, "unknown format '%.*s' in --format; allowed: png, svg, pdf, obj, usda, json, glb",
 			                (int)length, cursor);
 			return false;
 		}
@@ -92,7 +92,7 @@ bool cli_parse_formats(const char *command, const char *list, unsigned *formats)
 			++cursor;
 	}
 	if (*formats == 0) {
-		cli_usage_error(command, "--format needs at least one of png, svg, pdf, obj, usda, json");
+		cli_usage_error(command, "--format needs at least one of png, svg, pdf, obj, usda, json, glb");
 		return false;
 	}
 	return true;
@@ -274,8 +274,8 @@ plume_status cli_write_feather(cli_output *output, const plume_feather *feather,
 		unsigned bit;
 		const char *extension;
 	} order[] = {
-	    {CLI_FORMAT_PNG, "png"}, {CLI_FORMAT_SVG, "svg"},   {CLI_FORMAT_PDF, "pdf"},
-	    {CLI_FORMAT_OBJ, "obj"}, {CLI_FORMAT_USDA, "usda"}, {CLI_FORMAT_JSON, "json"},
+	    {CLI_FORMAT_PNG, "png"},   {CLI_FORMAT_SVG, "svg"},   {CLI_FORMAT_PDF, "pdf"}, {CLI_FORMAT_OBJ, "obj"},
+	    {CLI_FORMAT_USDA, "usda"}, {CLI_FORMAT_JSON, "json"}, {CLI_FORMAT_GLB, "glb"},
 	};
 	plume_render2d_def def = image_def(feather, images);
 	for (size_t i = 0; i < sizeof order / sizeof order[0]; ++i) {
@@ -291,6 +291,12 @@ plume_status cli_write_feather(cli_output *output, const plume_feather *feather,
 		case CLI_FORMAT_PDF: status = plume_render2d(feather, &def, PLUME_IMAGE_PDF, path, err); break;
 		case CLI_FORMAT_OBJ: status = plume_write_obj(feather, path, err); break;
 		case CLI_FORMAT_USDA: status = plume_write_usda(feather, path, err); break;
+		case CLI_FORMAT_GLB: {
+			plume_gltf_def gltf = plume_gltf_default_def();
+			gltf.texture = images->texture;
+			status = plume_write_glb(feather, &gltf, path, err);
+			break;
+		}
 		default: status = plume_write_json(feather, path, err); break;
 		}
 		if (status != PLUME_OK)

@@ -21,6 +21,8 @@ void cli_help_simulate(void)
 	     "  DIR/mesh.obj          the rest shell (UVs, rachis and vane groups)\n"
 	     "  DIR/feather.json      the generated feather (barb-level geometry)\n"
 	     "  DIR/frames/NNNN.obj   the shell at every written step (0000: the start)\n"
+	     "  DIR/sim.glb           all frames as one animated glTF 2.0 file (morph\n"
+	     "                        targets, animation \"simulation\"; Blender, three.js)\n"
 	     "  DIR/frames/NNNN.png   a shaded view of each frame, with --png\n"
 	     "  DIR/stats.csv         per step: time, Newton iterations, gradient norm,\n"
 	     "                        energy, largest barb-edge strain, wall seconds\n"
@@ -90,6 +92,7 @@ typedef struct run_state {
 	int total_steps;
 	bool progress;
 	double max_strain;
+	plume_mesh_animation *animation; ///< every frame, for DIR/sim.glb
 } run_state;
 
 static plume_status write_frame(run_state *run, int frame, const plume_sim *sim, plume_error *err)
@@ -98,6 +101,8 @@ static plume_status write_frame(run_state *run, int frame, const plume_sim *sim,
 	snprintf(name, sizeof name, "frames/%04d.obj", frame);
 	cli_output_path(run->output, name, path, sizeof path);
 	plume_status status = plume_mesh_write_obj(run->scene->mesh, plume_sim_positions(sim), path, err);
+	if (status == PLUME_OK)
+		status = plume_mesh_animation_add_frame(run->animation, plume_sim_time(sim), plume_sim_positions(sim), err);
 	if (status == PLUME_OK && run->png) {
 		snprintf(name, sizeof name, "frames/%04d.png", frame);
 		cli_output_path(run->output, name, path, sizeof path);
@@ -226,6 +231,9 @@ static plume_status simulate(const plume_scene *scene, cli_output *output, run_s
 	if (status != PLUME_OK)
 		return status;
 	snprintf(path, sizeof path, "%s/frames", output->stage);
+	status = plume_mesh_animation_create(scene->mesh, NULL, &run->animation, err);
+	if (status != PLUME_OK)
+		return status;
 	if (mkdir(path, 0777) != 0)
 		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot create: %s", path, "mkdir failed");
 	run->stats = fopen(cli_output_path(output, "stats.csv", path, sizeof path), "wb");
@@ -242,6 +250,9 @@ static plume_status simulate(const plume_scene *scene, cli_output *output, run_s
 	}
 	if (run->render)
 		make_movie(output);
+	status = plume_mesh_animation_write_glb(run->animation, cli_output_path(output, "sim.glb", path, sizeof path), err);
+	if (status != PLUME_OK)
+		return status;
 	status = write_summary(output, scene, summary, run, run_status == PLUME_OK ? NULL : failure, err);
 	return status == PLUME_OK ? run_status : status;
 }
@@ -354,6 +365,7 @@ int cli_simulate(int argc, char **argv)
 		       summary.steps > 0 ? (double)summary.newton_iterations / summary.steps : 0.0, summary.wall_seconds,
 		       summary.max_barb_strain, summary.rachis_tip_deflection, run.frames, output_dir);
 	plume_scene_destroy(scene);
+	plume_mesh_animation_destroy(run.animation);
 	cli_barb_renderer_end(&run.renderer);
 	if (status != PLUME_OK)
 		return cli_fail(status == PLUME_ERROR_NUMERIC && failure.message[0] ? &failure : &err);

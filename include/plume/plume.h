@@ -5,6 +5,7 @@
 #include "plume/core.h"
 #include "plume/feather.h"
 #include "plume/io.h"
+#include "plume/gltf.h"
 #include "plume/lab.h"
 #include "plume/mesh.h"
 #include "plume/model.h"

@@ -1,0 +1,82 @@
+// Private: a glTF 2.0 binary (.glb) builder. The JSON chunk is built with
+// jansson (the project's JSON library) and the binary chunk is one buffer that
+// grows as views are added; plume_glb_write lays out the container (glTF 2.0
+// spec, section 4.4 "GLB File Format Specification") and writes it atomically.
+//
+// Only what plume's writers need: one buffer, tightly packed views, accessors
+// with min/max where the spec requires them (POSITION), meshes, nodes, one
+// scene, materials and animations as plain jansson objects.
+#ifndef PLUME_IO_GLB_H
+#define PLUME_IO_GLB_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include <jansson.h>
+
+#include "plume/core.h"
+
+/// glTF accessor component types (spec 5.1.3).
+enum {
+	GLB_FLOAT = 5126,
+	GLB_UNSIGNED_INT = 5125,
+	GLB_UNSIGNED_SHORT = 5123,
+};
+
+/// bufferView targets (spec 5.11.4).
+enum {
+	GLB_ARRAY_BUFFER = 34962,
+	GLB_ELEMENT_ARRAY_BUFFER = 34963,
+	GLB_NO_TARGET = 0,
+};
+
+typedef struct plume_glb {
+	json_t *root; ///< the glTF document
+	json_t *buffer_views, *accessors, *meshes, *nodes, *materials, *animations;
+	uint8_t *bytes; ///< the binary chunk
+	size_t size, capacity;
+	bool failed; ///< out of memory somewhere: plume_glb_write reports it
+} plume_glb;
+
+/// Starts an empty document (asset, one scene with no nodes yet). On failure the
+/// builder is marked failed and plume_glb_write reports PLUME_ERROR_MEMORY.
+void plume_glb_init(plume_glb *glb, const char *generator);
+void plume_glb_free(plume_glb *glb);
+
+/// Appends count * components floats (given as doubles, rounded to float) as
+/// a new accessor of type "SCALAR", "VEC2", "VEC3" or "VEC4". With bounds, the
+/// accessor carries min and max (required for POSITION). Returns its index.
+int plume_glb_floats(plume_glb *glb, const double *values, int count, int components, int target, bool bounds);
+
+/// The same from floats already rounded.
+int plume_glb_floats_f(plume_glb *glb, const float *values, int count, int components, int target, bool bounds);
+
+/// Appends unsigned 32-bit indices as a SCALAR accessor. Returns its index.
+int plume_glb_indices(plume_glb *glb, const uint32_t *values, int64_t count);
+
+/// Adds obj to the named top-level array (meshes, nodes, ...), which takes the
+/// reference, and returns its index.
+int plume_glb_append(plume_glb *glb, json_t *array, json_t *obj);
+
+/// Makes node a root of the scene.
+void plume_glb_scene_root(plume_glb *glb, int node);
+
+/// A double-sided, rough dielectric material whose base colour is factor
+/// (linear RGBA) times the vertex colours when a primitive has COLOR_0.
+int plume_glb_material(plume_glb *glb, const char *name, const double factor[4]);
+
+/// Writes the container to path atomically.
+plume_status plume_glb_write(plume_glb *glb, const char *path, plume_error *err);
+
+/// sRGB component to linear (glTF's COLOR_0 and baseColorFactor are linear).
+double plume_glb_linear(double srgb);
+
+struct plume_mesh;
+struct plume_gltf_def;
+
+/// A node "name" with mesh "name": the shell's triangles with smooth normals,
+/// texture coordinates and one primitive per material. Returns the node.
+int plume_glb_shell_node(plume_glb *glb, const struct plume_mesh *mesh, const plume_vec3 *positions,
+                         const struct plume_gltf_def *def, const char *name);
+
+#endif

@@ -1,0 +1,467 @@
+// glTF export of feathers and coats: curves as ribbons or line segments.
+//
+// A ribbon follows a curve with two vertices per point, at p -/+ (w/2) s where
+// w is the curve's width there and s = n x t is the unit direction across the
+// curve in the plane facing the curve's normal n (t: the tangent, by central
+// differences). The shaft uses its own frame (s = binormal). Both ribbon edges
+// carry the point's normal, texture coordinates and colour, so a renderer
+// shades the ribbon as the curve it stands for. Triangles wind counter-
+// clockwise seen from n. Colours are converted from sRGB to linear, as glTF's
+// COLOR_0 is linear.
+#include <math.h>
+#include <string.h>
+
+#include "../core/alloc.h"
+#include "glb.h"
+#include "plume/gltf.h"
+
+plume_gltf_def plume_gltf_default_def(void)
+{
+	return (plume_gltf_def){
+	    .curves = PLUME_GLTF_RIBBONS,
+	    .barbules = true,
+	    .texture = NULL,
+	    .barb_color = {0.45, 0.33, 0.22, 1.0},
+	    .shaft_color = {0.78, 0.72, 0.62, 1.0},
+	    .vane_color = {0.70, 0.62, 0.50, 1.0},
+	    .rachis_color = {0.78, 0.72, 0.62, 1.0},
+	};
+}
+
+/// One primitive's arrays, grown as curves are added.
+typedef struct part {
+	double *position, *normal, *uv, *color; // 3, 3, 2, 4 per vertex
+	int vertices, vertex_capacity;
+	uint32_t *indices;
+	int64_t index_count, index_capacity;
+	bool failed;
+} part;
+
+static void part_free(part *p)
+{
+	plume_free(p->position);
+	plume_free(p->normal);
+	plume_free(p->uv);
+	plume_free(p->color);
+	plume_free(p->indices);
+	memset(p, 0, sizeof *p);
+}
+
+static bool part_reserve(part *p, int vertices, int64_t indices)
+{
+	if (p->failed)
+		return false;
+	if (p->vertices + vertices > p->vertex_capacity) {
+		int capacity = p->vertex_capacity > 0 ? p->vertex_capacity : 1024;
+		while (capacity < p->vertices + vertices)
+			capacity *= 2;
+		double *arrays[4] = {p->position, p->normal, p->uv, p->color};
+		static const int widths[4] = {3, 3, 2, 4};
+		for (int k = 0; k < 4; ++k) {
+			double *grown = plume_realloc(arrays[k], (size_t)capacity * (size_t)widths[k] * sizeof(double));
+			if (grown == NULL) {
+				p->failed = true;
+				return false;
+			}
+			arrays[k] = grown;
+		}
+		p->position = arrays[0];
+		p->normal = arrays[1];
+		p->uv = arrays[2];
+		p->color = arrays[3];
+		p->vertex_capacity = capacity;
+	}
+	if (p->index_count + indices > p->index_capacity) {
+		int64_t capacity = p->index_capacity > 0 ? p->index_capacity : 4096;
+		while (capacity < p->index_count + indices)
+			capacity *= 2;
+		uint32_t *grown = plume_realloc(p->indices, (size_t)capacity * sizeof(uint32_t));
+		if (grown == NULL) {
+			p->failed = true;
+			return false;
+		}
+		p->indices = grown;
+		p->index_capacity = capacity;
+	}
+	return true;
+}
+
+static void part_vertex(part *p, plume_vec3 position, plume_vec3 normal, plume_vec2 uv, plume_color color)
+{
+	int v = p->vertices++;
+	double *x = p->position + 3 * v, *n = p->normal + 3 * v, *t = p->uv + 2 * v, *c = p->color + 4 * v;
+	x[0] = position.x;
+	x[1] = position.y;
+	x[2] = position.z;
+	n[0] = normal.x;
+	n[1] = normal.y;
+	n[2] = normal.z;
+	t[0] = uv.x;
+	t[1] = uv.y;
+	c[0] = color.r;
+	c[1] = color.g;
+	c[2] = color.b;
+	c[3] = color.a;
+}
+
+static plume_color linear(plume_color c)
+{
+	return (plume_color){plume_glb_linear(c.r), plume_glb_linear(c.g), plume_glb_linear(c.b), c.a};
+}
+
+/// A unit vector perpendicular to a (for degenerate frames).
+static plume_vec3 any_perpendicular(plume_vec3 a)
+{
+	plume_vec3 axis = fabs(a.x) < 0.9 ? plume_v3(1, 0, 0) : plume_v3(0, 1, 0);
+	return plume_v3_normalize(plume_v3_cross(a, axis));
+}
+
+/// One curve: points, their normals, widths, uvs and colours; across[] given
+/// (the shaft's binormals) or NULL to derive n x t.
+typedef struct curve_in {
+	int count;
+	const plume_vec3 *points;
+	const plume_vec3 *normals; ///< NULL: derived from across and the tangent
+	const plume_vec3 *across;  ///< NULL: n x t
+	const double *widths;
+	const plume_vec2 *uv;
+	plume_vec3 origin; ///< subtracted from every point
+} curve_in;
+
+static void add_curve(part *p, const curve_in *c, plume_gltf_curves mode, const plume_color *colors)
+{
+	int n = c->count;
+	if (n < 2)
+		return;
+	if (mode == PLUME_GLTF_LINES) {
+		if (!part_reserve(p, n, 2 * (int64_t)(n - 1)))
+			return;
+		uint32_t base = (uint32_t)p->vertices;
+		for (int j = 0; j < n; ++j) {
+			plume_vec3 normal = c->normals != NULL ? c->normals[j] : plume_v3(0, 0, 1);
+			part_vertex(p, plume_v3_sub(c->points[j], c->origin), normal, c->uv[j], colors[j]);
+		}
+		for (int j = 0; j + 1 < n; ++j) {
+			p->indices[p->index_count++] = base + (uint32_t)j;
+			p->indices[p->index_count++] = base + (uint32_t)j + 1;
+		}
+		return;
+	}
+	if (!part_reserve(p, 2 * n, 6 * (int64_t)(n - 1)))
+		return;
+	uint32_t base = (uint32_t)p->vertices;
+	for (int j = 0; j < n; ++j) {
+		plume_vec3 tangent = plume_v3_sub(c->points[j + 1 < n ? j + 1 : j], c->points[j > 0 ? j - 1 : j]);
+		tangent = plume_v3_normalize(tangent);
+		plume_vec3 normal, side;
+		if (c->across != NULL) {
+			side = c->across[j];
+			normal = c->normals != NULL ? c->normals[j] : plume_v3_normalize(plume_v3_cross(tangent, side));
+		} else {
+			normal = c->normals[j];
+			side = plume_v3_cross(normal, tangent);
+			double length = plume_v3_length(side);
+			side = length > 1e-12 ? plume_v3_scale(side, 1.0 / length) : any_perpendicular(tangent);
+		}
+		double half = 0.5 * c->widths[j];
+		plume_vec3 centre = plume_v3_sub(c->points[j], c->origin);
+		part_vertex(p, plume_v3_mad(centre, -half, side), normal, c->uv[j], colors[j]);
+		part_vertex(p, plume_v3_mad(centre, half, side), normal, c->uv[j], colors[j]);
+	}
+	for (int j = 0; j + 1 < n; ++j) {
+		uint32_t a0 = base + 2 * (uint32_t)j, b0 = a0 + 1, a1 = a0 + 2, b1 = a0 + 3;
+		uint32_t tri[6] = {a0, a1, b0, b0, a1, b1};
+		memcpy(p->indices + p->index_count, tri, sizeof tri);
+		p->index_count += 6;
+	}
+}
+
+/// Per-point colours of a curve: the texture's at (s, t) on the given side, or a constant.
+static bool curve_colors(plume_color **buffer, int *capacity, int count, const plume_gltf_def *def,
+                         const plume_vec2 *uv, plume_side side, plume_color constant)
+{
+	if (count > *capacity) {
+		plume_color *grown = plume_realloc(*buffer, (size_t)count * sizeof(plume_color));
+		if (grown == NULL)
+			return false;
+		*buffer = grown;
+		*capacity = count;
+	}
+	for (int j = 0; j < count; ++j)
+		(*buffer)[j] =
+		    linear(def->texture != NULL ? plume_texture_sample_vane(def->texture, side, uv[j].x, uv[j].y) : constant);
+	return true;
+}
+
+/// The parts of one feather (not its afterfeather).
+enum { PART_SHAFT, PART_LEFT, PART_RIGHT, PART_BARBULES, PART_COUNT };
+static const char *const part_names[PART_COUNT] = {"shaft", "left_vane", "right_vane", "barbules"};
+
+static bool build_parts(const plume_feather *feather, const plume_gltf_def *def, plume_vec3 origin,
+                        part parts[PART_COUNT])
+{
+	plume_color *colors = NULL;
+	int capacity = 0;
+	bool ok = true;
+	plume_feather_info info = plume_feather_get_info(feather);
+	const plume_shaft_sample *shaft = plume_feather_shaft(feather);
+	int n = info.shaft_sample_count;
+	if (n >= 2) {
+		plume_vec3 *points = plume_alloc((size_t)n * 3 * sizeof(plume_vec3));
+		double *widths = plume_alloc((size_t)n * sizeof(double));
+		plume_vec2 *uv = plume_alloc((size_t)n * sizeof(plume_vec2));
+		ok = points != NULL && widths != NULL && uv != NULL;
+		if (ok) {
+			plume_vec3 *normals = points + n, *across = points + 2 * n;
+			for (int i = 0; i < n; ++i) {
+				points[i] = shaft[i].position;
+				normals[i] = shaft[i].normal;
+				across[i] = shaft[i].binormal;
+				widths[i] = shaft[i].width;
+				uv[i] = (plume_vec2){0.0, shaft[i].t};
+			}
+			// The shaft's colour is the texture's at the rachis (s = 0) of the left vane.
+			ok = curve_colors(&colors, &capacity, n, def, uv, PLUME_SIDE_LEFT, def->shaft_color);
+			curve_in c = {n, points, normals, across, widths, uv, origin};
+			if (ok)
+				add_curve(&parts[PART_SHAFT], &c, def->curves, colors);
+		}
+		plume_free(points);
+		plume_free(widths);
+		plume_free(uv);
+	}
+	for (int i = 0; ok && i < info.barb_count; ++i) {
+		plume_barb barb = plume_feather_barb(feather, i);
+		if (barb.curve.count < 2)
+			continue;
+		ok = curve_colors(&colors, &capacity, barb.curve.count, def, barb.curve.uv, barb.side, def->barb_color);
+		curve_in c = {
+		    barb.curve.count, barb.curve.points, barb.curve.normals, NULL, barb.curve.widths, barb.curve.uv, origin};
+		if (ok)
+			add_curve(&parts[barb.side == PLUME_SIDE_LEFT ? PART_LEFT : PART_RIGHT], &c, def->curves, colors);
+	}
+	for (int i = 0; ok && def->barbules && i < info.barbule_count; ++i) {
+		plume_barbule barbule = plume_feather_barbule(feather, i);
+		if (barbule.curve.count < 2)
+			continue;
+		plume_side side = plume_feather_barb(feather, barbule.barb).side;
+		// A barbule takes its barb's colour where it attaches (its own uv is along the barbule).
+		plume_barb barb = plume_feather_barb(feather, barbule.barb);
+		plume_vec2 at = {barbule.barb_s, barb.curve.count > 0 ? barb.curve.uv[0].y : 0.0};
+		ok = curve_colors(&colors, &capacity, 1, def, &at, side, def->barb_color);
+		if (!ok)
+			break;
+		plume_color one = colors[0];
+		ok = curve_colors(&colors, &capacity, barbule.curve.count, def, barbule.curve.uv, side, def->barb_color);
+		for (int j = 0; ok && j < barbule.curve.count; ++j)
+			colors[j] = one;
+		curve_in c = {barbule.curve.count,
+		              barbule.curve.points,
+		              barbule.curve.normals,
+		              NULL,
+		              barbule.curve.widths,
+		              barbule.curve.uv,
+		              origin};
+		if (ok)
+			add_curve(&parts[PART_BARBULES], &c, def->curves, colors);
+	}
+	plume_free(colors);
+	for (int k = 0; k < PART_COUNT; ++k)
+		ok = ok && !parts[k].failed;
+	return ok;
+}
+
+/// A glTF primitive from a part: attributes, indices, mode, material.
+static json_t *part_primitive(plume_glb *glb, const part *p, plume_gltf_curves mode, int material)
+{
+	int position = plume_glb_floats(glb, p->position, p->vertices, 3, GLB_ARRAY_BUFFER, true);
+	int normal = plume_glb_floats(glb, p->normal, p->vertices, 3, GLB_ARRAY_BUFFER, false);
+	int uv = plume_glb_floats(glb, p->uv, p->vertices, 2, GLB_ARRAY_BUFFER, false);
+	int color = plume_glb_floats(glb, p->color, p->vertices, 4, GLB_ARRAY_BUFFER, false);
+	int indices = plume_glb_indices(glb, p->indices, p->index_count);
+	return json_pack("{s:{s:i, s:i, s:i, s:i}, s:i, s:i, s:i}", "attributes", "POSITION", position, "NORMAL", normal,
+	                 "TEXCOORD_0", uv, "COLOR_0", color, "indices", indices, "mode", mode == PLUME_GLTF_LINES ? 1 : 4,
+	                 "material", material);
+}
+
+/// The two materials every curve file shares (colours are in COLOR_0).
+static void curve_materials(plume_glb *glb, int *shaft, int *vane)
+{
+	static const double white[4] = {1, 1, 1, 1};
+	*shaft = plume_glb_material(glb, "shaft", white);
+	*vane = plume_glb_material(glb, "vane", white);
+}
+
+/// Node "name" with one child node per non-empty part (and, nested, the afterfeather). Returns the node.
+static int write_feather_nodes(plume_glb *glb, const plume_feather *feather, const plume_gltf_def *def,
+                               const char *name, int materials[2], bool *ok)
+{
+	part parts[PART_COUNT];
+	memset(parts, 0, sizeof parts);
+	*ok = *ok && build_parts(feather, def, plume_v3(0, 0, 0), parts);
+	json_t *children = json_array();
+	for (int k = 0; *ok && k < PART_COUNT; ++k) {
+		if (parts[k].vertices == 0)
+			continue;
+		json_t *primitive = part_primitive(glb, &parts[k], def->curves, materials[k == PART_SHAFT ? 0 : 1]);
+		int mesh = plume_glb_append(glb, glb->meshes,
+		                            json_pack("{s:s, s:[o]}", "name", part_names[k], "primitives", primitive));
+		int node = plume_glb_append(glb, glb->nodes, json_pack("{s:s, s:i}", "name", part_names[k], "mesh", mesh));
+		json_array_append_new(children, json_integer(node));
+	}
+	for (int k = 0; k < PART_COUNT; ++k)
+		part_free(&parts[k]);
+	const plume_feather *after = plume_feather_afterfeather(feather);
+	if (*ok && after != NULL) {
+		int node = write_feather_nodes(glb, after, def, "afterfeather", materials, ok);
+		json_array_append_new(children, json_integer(node));
+	}
+	return plume_glb_append(glb, glb->nodes, json_pack("{s:s, s:o}", "name", name, "children", children));
+}
+
+plume_status plume_write_glb(const plume_feather *feather, const plume_gltf_def *def, const char *path,
+                             plume_error *err)
+{
+	plume_gltf_def defaults = plume_gltf_default_def();
+	if (def == NULL)
+		def = &defaults;
+	plume_glb glb;
+	plume_glb_init(&glb, "plume " PLUME_VERSION_STRING);
+	int materials[2];
+	curve_materials(&glb, &materials[0], &materials[1]);
+	bool ok = true;
+	int root = write_feather_nodes(&glb, feather, def, "feather", materials, &ok);
+	plume_glb_scene_root(&glb, root);
+	plume_status status =
+	    ok ? plume_glb_write(&glb, path, err) : plume_error_set(err, PLUME_ERROR_MEMORY, "%s: out of memory", path);
+	plume_glb_free(&glb);
+	return status;
+}
+
+// ---------------------------------------------------------------------------
+// Coats
+
+/// FNV-1a over the bytes of the part arrays: two feathers whose geometry
+/// relative to their follicle is the same give the same hash, and share a mesh
+/// (the arrays are then compared in full, so a collision cannot merge two).
+static uint64_t hash_bytes(uint64_t h, const void *data, size_t size)
+{
+	const uint8_t *bytes = data;
+	for (size_t i = 0; i < size; ++i) {
+		h ^= bytes[i];
+		h *= 1099511628211ull;
+	}
+	return h;
+}
+
+typedef struct coat_mesh {
+	uint64_t hash;
+	part parts[PART_COUNT];
+	int mesh;
+} coat_mesh;
+
+static bool same_parts(const part a[PART_COUNT], const part b[PART_COUNT])
+{
+	for (int k = 0; k < PART_COUNT; ++k) {
+		if (a[k].vertices != b[k].vertices || a[k].index_count != b[k].index_count)
+			return false;
+		size_t v = (size_t)a[k].vertices;
+		if (memcmp(a[k].position, b[k].position, 3 * v * sizeof(double)) != 0 ||
+		    memcmp(a[k].normal, b[k].normal, 3 * v * sizeof(double)) != 0 ||
+		    memcmp(a[k].uv, b[k].uv, 2 * v * sizeof(double)) != 0 ||
+		    memcmp(a[k].color, b[k].color, 4 * v * sizeof(double)) != 0 ||
+		    memcmp(a[k].indices, b[k].indices, (size_t)a[k].index_count * sizeof(uint32_t)) != 0)
+			return false;
+	}
+	return true;
+}
+
+/// All parts of a feather and its afterfeathers, merged per part (the afterfeather's
+/// barbs join its parent's vanes), relative to origin.
+static bool build_coat_parts(const plume_feather *feather, const plume_gltf_def *def, plume_vec3 origin,
+                             part parts[PART_COUNT])
+{
+	bool ok = true;
+	for (const plume_feather *f = feather; ok && f != NULL; f = plume_feather_afterfeather(f))
+		ok = build_parts(f, def, origin, parts);
+	return ok;
+}
+
+plume_status plume_coat_write_glb_report(const plume_coat *coat, const plume_gltf_def *def, const char *path,
+                                         plume_coat_glb_report *report, plume_error *err)
+{
+	plume_gltf_def defaults = plume_gltf_default_def();
+	if (def == NULL)
+		def = &defaults;
+	plume_glb glb;
+	plume_glb_init(&glb, "plume " PLUME_VERSION_STRING);
+	int materials[2];
+	curve_materials(&glb, &materials[0], &materials[1]);
+	int count = plume_coat_feather_count(coat);
+	coat_mesh *meshes = plume_calloc(count > 0 ? (size_t)count : 1, sizeof(coat_mesh));
+	json_t *children = json_array();
+	int mesh_count = 0;
+	bool ok = meshes != NULL && children != NULL;
+	for (int i = 0; ok && i < count; ++i) {
+		plume_vec3 follicle, normal;
+		plume_coat_follicle(coat, i, &follicle, &normal);
+		coat_mesh *candidate = &meshes[mesh_count];
+		ok = build_coat_parts(plume_coat_feather(coat, i), def, follicle, candidate->parts);
+		if (!ok)
+			break;
+		uint64_t h = 14695981039346656037ull;
+		for (int k = 0; k < PART_COUNT; ++k) {
+			h = hash_bytes(h, candidate->parts[k].position, 3 * (size_t)candidate->parts[k].vertices * sizeof(double));
+			h = hash_bytes(h, candidate->parts[k].color, 4 * (size_t)candidate->parts[k].vertices * sizeof(double));
+		}
+		candidate->hash = h;
+		int mesh = -1;
+		for (int m = 0; m < mesh_count && mesh < 0; ++m)
+			if (meshes[m].hash == h && same_parts(meshes[m].parts, candidate->parts))
+				mesh = meshes[m].mesh;
+		if (mesh < 0) {
+			json_t *primitives = json_array();
+			for (int k = 0; k < PART_COUNT; ++k)
+				if (candidate->parts[k].vertices > 0)
+					json_array_append_new(primitives, part_primitive(&glb, &candidate->parts[k], def->curves,
+					                                                 materials[k == PART_SHAFT ? 0 : 1]));
+			char name[32];
+			snprintf(name, sizeof name, "feather_%05d", i);
+			mesh = plume_glb_append(&glb, glb.meshes, json_pack("{s:s, s:o}", "name", name, "primitives", primitives));
+			candidate->mesh = mesh;
+			++mesh_count;
+		} else {
+			for (int k = 0; k < PART_COUNT; ++k)
+				part_free(&candidate->parts[k]);
+		}
+		char name[32];
+		snprintf(name, sizeof name, "feather_%05d", i);
+		int node = plume_glb_append(&glb, glb.nodes,
+		                            json_pack("{s:s, s:i, s:[f,f,f]}", "name", name, "mesh", mesh, "translation",
+		                                      follicle.x, follicle.y, follicle.z));
+		json_array_append_new(children, json_integer(node));
+	}
+	if (ok) {
+		int surface = plume_glb_shell_node(&glb, plume_coat_surface(coat), NULL, def, "surface");
+		json_array_append_new(children, json_integer(surface));
+		int root = plume_glb_append(&glb, glb.nodes, json_pack("{s:s, s:o}", "name", "coat", "children", children));
+		plume_glb_scene_root(&glb, root);
+		children = NULL;
+	}
+	json_decref(children);
+	for (int m = 0; meshes != NULL && m <= mesh_count && m < count; ++m)
+		for (int k = 0; k < PART_COUNT; ++k)
+			part_free(&meshes[m].parts[k]);
+	plume_free(meshes);
+	if (report != NULL)
+		*report = (plume_coat_glb_report){ok ? count : 0, ok ? mesh_count : 0};
+	plume_status status =
+	    ok ? plume_glb_write(&glb, path, err) : plume_error_set(err, PLUME_ERROR_MEMORY, "%s: out of memory", path);
+	plume_glb_free(&glb);
+	return status;
+}
+
+plume_status plume_coat_write_glb(const plume_coat *coat, const plume_gltf_def *def, const char *path, plume_error *err)
+{
+	return plume_coat_write_glb_report(coat, def, path, NULL, err);
+}

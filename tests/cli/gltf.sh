@@ -1,0 +1,64 @@
+#!/usr/bin/env bash
+# Scenario tests of the glTF outputs: `generate/mesh/coat --format glb` and
+# `simulate`'s sim.glb, read back by tests/glb_check.py (struct + json, not
+# plume's code): the animation's frames equal the OBJ frames to 1e-6 m, the
+# coat has one instance per feather, counts match the feather's.
+# Usage: gltf.sh PLUME_BINARY SOURCE_DIR
+# (Each status is saved before `check`: a $(...) in the check's name would reset $?.)
+source "$(dirname "$0")/../cli_support.sh" "$@"
+py=/usr/bin/python3
+checker="$source_dir/tests/glb_check.py"
+field() { # field FILE.glb KEY: one count from glb_check.py counts
+	"$py" "$checker" counts "$1" | "$py" -c "import json,sys; print(json.load(sys.stdin)['$2'])"
+}
+
+# A feather: feather.glb beside the OBJ; ribbons have two vertices per curve point.
+"$plume" generate "$source_dir/examples/franco-walter/blue.json" -o "$scratch/blue" --format glb,obj >/dev/null 2>"$scratch/err.txt"
+status=$?
+check "generate --format glb: exit 0 ($(cat "$scratch/err.txt"))" test "$status" -eq 0
+check "generate writes feather.glb" test -s "$scratch/blue/feather.glb"
+check "generate writes only what was asked" test ! -e "$scratch/blue/feather.png"
+obj_points=$(grep -c '^v ' "$scratch/blue/feather.obj")
+check "ribbons: 2 vertices per OBJ vertex ($obj_points)" test "$(field "$scratch/blue/feather.glb" vertices)" -eq $((2 * obj_points))
+expect_failure "unknown format" 2 "allowed: png, svg, pdf, obj, usda, json, glb" \
+	"$plume" generate "$source_dir/examples/franco-walter/blue.json" -o "$scratch/bad" --format gltf
+check "unknown format: nothing written" test ! -e "$scratch/bad"
+
+# A shell.
+"$plume" mesh "$source_dir/examples/franco-walter/blue.json" -o "$scratch/mesh" --format glb -e 0.01 >/dev/null 2>"$scratch/err.txt"
+status=$?
+check "mesh --format glb: exit 0 ($(cat "$scratch/err.txt"))" test "$status" -eq 0
+check "mesh writes mesh.glb and not mesh.obj" test -s "$scratch/mesh/mesh.glb" -a ! -e "$scratch/mesh/mesh.obj"
+faces=$("$py" -c "import json; print(json.load(open('$scratch/mesh/report.json'))['face_count'])")
+check "mesh.glb has the report's $faces faces" test "$(field "$scratch/mesh/mesh.glb" triangles)" -eq "$faces"
+expect_failure "mesh --format json" 2 "a mesh writes obj, png, glb" \
+	"$plume" mesh "$source_dir/examples/franco-walter/blue.json" -o "$scratch/bad" --format json
+
+# A coat: one node instance per feather, plus the surface.
+"$plume" coat "$source_dir/examples/coats/figure15-hexagonal.json" -o "$scratch/coat" --format glb >"$scratch/out.txt" 2>"$scratch/err.txt"
+status=$?
+check "coat --format glb: exit 0 ($(cat "$scratch/err.txt"))" test "$status" -eq 0
+feathers=$(grep -c '^o ' <("$plume" coat "$source_dir/examples/coats/figure15-hexagonal.json" -o "$scratch/coat-obj" --format obj >/dev/null 2>&1; cat "$scratch/coat-obj/coat.obj"))
+check "coat says its instances" grep -q "coat.glb: $feathers feather instances" "$scratch/out.txt"
+check "coat.glb: $feathers feathers + the surface" test "$(field "$scratch/coat/coat.glb" mesh_instances)" -eq $((feathers + 1))
+
+# A simulation: one animated file whose frames are the OBJ frames.
+cat >"$scratch/swing.json" <<JSON
+{
+  "feather": "$source_dir/examples/franco-walter/blue.json",
+  "mesh": {"edge_length": 0.01},
+  "handles": [{"group": "rachis_clamp"}],
+  "gravity": [0, 0, -9.81],
+  "duration": 0.055,
+  "frame_every": 2
+}
+JSON
+"$plume" simulate "$scratch/swing.json" -o "$scratch/swing" >/dev/null 2>"$scratch/err.txt"
+status=$?
+check "simulate: exit 0 ($(cat "$scratch/err.txt"))" test "$status" -eq 0
+check "simulate writes sim.glb" test -s "$scratch/swing/sim.glb"
+"$py" "$checker" frames "$scratch/swing/sim.glb" "$scratch/swing/frames" >"$scratch/out.txt" 2>&1
+status=$?
+check "sim.glb frames = OBJ frames to 1e-6 m ($(cat "$scratch/out.txt"))" test "$status" -eq 0
+check "sim.glb: 4 animation keys" test "$(field "$scratch/swing/sim.glb" animation_keys)" -eq 4
+finish

@@ -1,0 +1,106 @@
+#!/usr/bin/env python3
+"""Reads plume's .glb files back without plume's code (struct + json only).
+
+  glb_check.py frames SIM.glb FRAMES_DIR   each frame (base + morph target k) equals
+                                           FRAMES_DIR/kkkk.obj's vertices to 1e-6 m
+  glb_check.py counts FILE.glb             prints JSON: nodes, meshes, primitives,
+                                           vertices (per-primitive, summed), triangles,
+                                           lines, morph targets, animation keys
+"""
+import json
+import os
+import struct
+import sys
+
+COMPONENTS = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4}
+FORMATS = {5126: "f", 5125: "I", 5123: "H"}
+
+
+def load(path):
+    data = open(path, "rb").read()
+    magic, version, length = struct.unpack_from("<4sII", data, 0)
+    if magic != b"glTF" or version != 2 or length != len(data):
+        sys.exit(f"{path}: not a glTF 2.0 binary (magic {magic!r}, version {version}, length {length})")
+    json_length, json_type = struct.unpack_from("<I4s", data, 12)
+    doc = json.loads(data[20:20 + json_length])
+    at = 20 + json_length
+    binary = b""
+    if at < len(data):
+        bin_length, bin_type = struct.unpack_from("<I4s", data, at)
+        if bin_type != b"BIN\0":
+            sys.exit(f"{path}: second chunk is {bin_type!r}, not BIN")
+        binary = data[at + 8:at + 8 + bin_length]
+    return doc, binary
+
+
+def accessor(doc, binary, index):
+    a = doc["accessors"][index]
+    view = doc["bufferViews"][a["bufferView"]]
+    n = a["count"] * COMPONENTS[a["type"]]
+    start = view.get("byteOffset", 0) + a.get("byteOffset", 0)
+    values = struct.unpack_from("<%d%s" % (n, FORMATS[a["componentType"]]), binary, start)
+    c = COMPONENTS[a["type"]]
+    return [values[i:i + c] for i in range(0, n, c)] if c > 1 else list(values)
+
+
+def obj_vertices(path):
+    with open(path) as f:
+        return [tuple(map(float, line.split()[1:4])) for line in f if line.startswith("v ")]
+
+
+def frames(glb_path, frames_dir):
+    doc, binary = load(glb_path)
+    mesh = doc["meshes"][0]
+    primitive = mesh["primitives"][0]
+    base = accessor(doc, binary, primitive["attributes"]["POSITION"])
+    targets = primitive.get("targets", [])
+    files = sorted(f for f in os.listdir(frames_dir) if f.endswith(".obj"))
+    if len(targets) != len(files):
+        sys.exit(f"{glb_path}: {len(targets)} morph targets, {frames_dir} has {len(files)} frames")
+    sampler = doc["animations"][0]["samplers"][0]
+    times = accessor(doc, binary, sampler["input"])
+    weights = accessor(doc, binary, sampler["output"])
+    k = len(files)
+    if len(times) != k or len(weights) != k * k:
+        sys.exit(f"{glb_path}: {len(times)} keys and {len(weights)} weights for {k} frames")
+    worst = 0.0
+    for i, name in enumerate(files):
+        if any(weights[i * k + j] != (1.0 if i == j else 0.0) for j in range(k)):
+            sys.exit(f"{glb_path}: key {i} does not select target {i} alone")
+        d = accessor(doc, binary, targets[i]["POSITION"])
+        want = obj_vertices(os.path.join(frames_dir, name))
+        if len(want) != len(base):
+            sys.exit(f"{name}: {len(want)} vertices, the .glb has {len(base)}")
+        for b, dv, w in zip(base, d, want):
+            worst = max(worst, max(abs(b[c] + dv[c] - w[c]) for c in range(3)))
+    print(f"{k} frames, {len(base)} vertices, largest difference {worst:.3g} m")
+    if worst > 1e-6:
+        sys.exit(f"{glb_path}: frames differ from the OBJ frames by {worst:.3g} m > 1e-6 m")
+
+
+def counts(glb_path):
+    doc, binary = load(glb_path)
+    result = {"nodes": len(doc.get("nodes", [])), "meshes": len(doc.get("meshes", [])), "primitives": 0,
+              "vertices": 0, "triangles": 0, "lines": 0, "morph_targets": 0, "animation_keys": 0,
+              "mesh_instances": sum(1 for n in doc.get("nodes", []) if "mesh" in n)}
+    for mesh in doc.get("meshes", []):
+        for p in mesh["primitives"]:
+            result["primitives"] += 1
+            result["vertices"] += doc["accessors"][p["attributes"]["POSITION"]]["count"]
+            n = doc["accessors"][p["indices"]]["count"]
+            mode = p.get("mode", 4)
+            result["triangles" if mode == 4 else "lines"] += n // 3 if mode == 4 else n // 2
+            result["morph_targets"] += len(p.get("targets", []))
+    for animation in doc.get("animations", []):
+        for s in animation["samplers"]:
+            result["animation_keys"] = max(result["animation_keys"], doc["accessors"][s["input"]]["count"])
+    print(json.dumps(result))
+
+
+if __name__ == "__main__":
+    if len(sys.argv) == 4 and sys.argv[1] == "frames":
+        frames(sys.argv[2], sys.argv[3])
+    elif len(sys.argv) == 3 and sys.argv[1] == "counts":
+        counts(sys.argv[2])
+    else:
+        sys.exit(__doc__)
