@@ -122,6 +122,10 @@ def main():
     keep = args[args.index("--keep") + 1] if "--keep" in args else None
     blender = shutil.which("blender")
     pvbatch = shutil.which("pvbatch3.11") or shutil.which("pvbatch")
+    if pvbatch and subprocess.run([pvbatch, "-c", "import paraview.simple"], stdout=subprocess.DEVNULL,
+                                  stderr=subprocess.DEVNULL).returncode != 0:
+        print("note: %s cannot import paraview.simple (apt-get install python3-paraview)" % pvbatch)
+        pvbatch = None
     if not blender and not pvbatch:
         print("interop test skipped: neither blender nor pvbatch3.11 is installed (apt-get install blender paraview)")
         return 0
