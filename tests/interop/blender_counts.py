@@ -1,7 +1,12 @@
-# Runs inside Blender (blender -b --factory-startup --python THIS -- JOBS.json
-# RESULTS.json): imports each job's file with the named importer into an empty
+# Runs inside Blender: imports a file with the named importer into an empty
 # scene and reports what Blender holds afterwards. No judgement here: the
 # counts are compared with what plume wrote by interop.py.
+#   blender -b --factory-startup --python THIS -- JOBS.json RESULTS.json
+#       every job {"path", "importer", ...} of JOBS.json, results to RESULTS.json
+#   blender -b --factory-startup --python THIS -- IMPORTER FILE
+#       one file; prints "PLUME_COUNTS {json}" (docs/formats.md)
+# IMPORTER: obj (bpy.ops.wm.obj_import, the default), obj-legacy
+# (bpy.ops.import_scene.obj), gltf (bpy.ops.import_scene.gltf), gltf-default.
 import json
 import sys
 
@@ -50,7 +55,10 @@ def counts():
 
 def main():
     args = sys.argv[sys.argv.index("--") + 1 :]
-    jobs = json.load(open(args[0]))
+    if args[0] in IMPORTERS:
+        jobs = [{"importer": args[0], "path": args[1]}]
+    else:
+        jobs = json.load(open(args[0]))
     results = []
     for job in jobs:
         bpy.ops.wm.read_factory_settings(use_empty=True)
@@ -60,6 +68,9 @@ def main():
         except Exception as error:  # an importer that throws is a result too
             result = {"error": "%s: %s" % (type(error).__name__, error)}
         results.append(dict(job, blender=result))
+    if args[0] in IMPORTERS:
+        print("PLUME_COUNTS " + json.dumps(results[0]["blender"]))
+        sys.exit(1 if "error" in results[0]["blender"] else 0)
     json.dump(results, open(args[1], "w"), indent=1)
 
 

@@ -39,6 +39,8 @@ const message = $("message");
 // preserveDrawingBuffer: the test and the screenshot read the canvas back.
 const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
 renderer.setPixelRatio(window.devicePixelRatio || 1);
+// Tone mapping keeps pale feathers (and shells) from washing out to white.
+renderer.toneMapping = THREE.NeutralToneMapping;
 view.appendChild(renderer.domElement);
 
 const scene = new THREE.Scene();
@@ -49,8 +51,8 @@ scene.background = new THREE.Color(0x2f3338);
 // side (a metallic default would otherwise render black).
 const pmrem = new THREE.PMREMGenerator(renderer);
 scene.environment = pmrem.fromScene(new RoomEnvironment(), 0.04).texture;
-scene.add(new THREE.HemisphereLight(0xffffff, 0x8a8070, 0.6));
-const sun = new THREE.DirectionalLight(0xffffff, 1.2);
+scene.environmentIntensity = 0.8;
+const sun = new THREE.DirectionalLight(0xffffff, 0.9);
 scene.add(sun);
 
 const camera = new THREE.PerspectiveCamera(35, 1, 0.001, 1000);
@@ -115,7 +117,9 @@ function frameCamera(box) {
 	const center = box.getCenter(new THREE.Vector3());
 	const radius = Math.max(box.getSize(new THREE.Vector3()).length() / 2, 1e-6);
 	const distance = (1.15 * radius) / Math.sin(THREE.MathUtils.degToRad(camera.fov / 2));
-	const direction = new THREE.Vector3(0.35, 0.3, 1).normalize();
+	// Three-quarters from the front (+z) and a little above: bending out of the
+	// vane's plane shows, and a flat feather still fills the view.
+	const direction = new THREE.Vector3(0.6, 0.25, 1).normalize();
 	camera.position.copy(center).addScaledVector(direction, distance);
 	camera.near = distance / 100;
 	camera.far = distance * 100;
