@@ -10,9 +10,10 @@ extern "C" {
 #endif
 PLUME_API_BEGIN
 
-/// Wavefront OBJ: shaft and barbs (and barbules) as polyline elements
-/// "l v/vt ..." with texture coordinates, one object per part, so Blender and
-/// Houdini import them as curves.
+/// Wavefront OBJ: shaft and barbs (and barbules) as polylines with texture
+/// coordinates, each written as consecutive two-vertex elements "l a b"
+/// (which every importer reads whole), one object per part; one "vt" per "v",
+/// in the same order.
 plume_status plume_write_obj(const plume_feather *feather, const char *path, plume_error *err);
 
 /// USD text (.usda): shaft and barbs as BasisCurves with widths (diameters),

@@ -46,6 +46,12 @@ plume_status plume_text_close(plume_text_file *text, plume_status status, plume_
 	return status;
 }
 
+void plume_obj_polyline(FILE *stream, long long first, int count)
+{
+	for (int j = 0; j + 1 < count; ++j)
+		fprintf(stream, "l %lld %lld\n", first + j, first + j + 1);
+}
+
 int plume_curve_set_range(const plume_feather *feather, plume_curve_set set)
 {
 	return set == PLUME_CURVES_BARBULES ? feather->barbule_count : feather->barb_count;

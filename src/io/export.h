@@ -38,6 +38,15 @@ plume_status plume_text_open(plume_text_file *text, const char *path, plume_erro
 /// (a failed commit turns PLUME_OK into PLUME_ERROR_IO).
 plume_status plume_text_close(plume_text_file *text, plume_status status, plume_error *err);
 
+/// A polyline of count vertices whose first vertex has the 1-based OBJ index
+/// first, as count - 1 two-vertex line elements "l a b". Blender 3.4's default
+/// OBJ importer keeps only the first segment of a longer "l" element, and
+/// misreads "l a/ta b/tb" (it drops and reconnects vertices), so the elements
+/// carry no texture index: the file has one "vt" per "v", in the same order
+/// (vt i belongs to v i). Checked with Blender's default and legacy importers
+/// and ParaView (docs/formats.md).
+void plume_obj_polyline(FILE *stream, long long first, int count);
+
 /// Which curves of a feather one exported object holds.
 typedef enum plume_curve_set {
 	PLUME_CURVES_LEFT,     ///< barbs of the left vane

@@ -1,6 +1,9 @@
-// Wavefront OBJ export: every curve is a polyline element "l v/vt v/vt ...",
-// grouped into one object per part (shaft, left vane, right vane, barbules),
-// so that Blender and Houdini import each part as a curve object.
+// Wavefront OBJ export: every curve is a run of two-vertex line elements
+// "l a b" over its consecutive vertices (plume_obj_polyline: Blender 3.4's
+// default importer reads only the first segment of a longer "l" and misreads
+// "l a/ta b/tb"), grouped into one object per part (shaft, left vane, right
+// vane, barbules), so that Blender and ParaView import each part whole, as
+// connected edges. Texture coordinates are one "vt" per "v", in the same order.
 //
 // Numbers are printed with "%.9g": nine significant digits keep a relative
 // error below 5e-10 (a fraction of a nanometre on a 0.2 m feather) and
@@ -29,10 +32,7 @@ static void write_shaft(FILE *stream, const plume_feather *feather, const char *
 		fprintf(stream, "v %.9g %.9g %.9g\n", shaft[i].position.x, shaft[i].position.y, shaft[i].position.z);
 	for (int i = 0; i < count; ++i)
 		fprintf(stream, "vt 0 %.9g\n", shaft[i].t);
-	fputc('l', stream);
-	for (int i = 0; i < count; ++i)
-		fprintf(stream, " %lld/%lld", *next + i, *next + i);
-	fputc('\n', stream);
+	plume_obj_polyline(stream, *next, count);
 	*next += count;
 }
 
@@ -61,10 +61,7 @@ static void write_curves(FILE *stream, const plume_feather *feather, plume_curve
 	for (int i = 0; i < range; ++i) {
 		if (!plume_curve_set_get(feather, set, i, &curve))
 			continue;
-		fputc('l', stream);
-		for (int j = 0; j < curve.count; ++j)
-			fprintf(stream, " %lld/%lld", *next + j, *next + j);
-		fputc('\n', stream);
+		plume_obj_polyline(stream, *next, curve.count);
 		*next += curve.count;
 	}
 }
@@ -94,9 +91,10 @@ plume_status plume_write_obj(const plume_feather *feather, const char *path, plu
 		return status;
 	plume_feather_info info = plume_feather_get_info(feather);
 	fprintf(text.stream,
-	        "# plume %s: a feather as polylines (l v/vt ...)\n"
+	        "# plume %s: a feather as polylines, each as consecutive segments (l a b)\n"
 	        "# units: metres; the shaft runs along +y, the vanes lie near z = 0, +z is the front\n"
-	        "# texture coordinates: barbs s = arc-length fraction from the rachis, t = shaft fraction of the root;"
+	        "# texture coordinates: one vt per v, in the same order (vt i belongs to v i);"
+	        " barbs s = arc-length fraction from the rachis, t = shaft fraction of the root;"
 	        " shaft s = 0, t = shaft fraction\n"
 	        "# %d shaft samples, %d barbs (%d left, %d right), %d barbules, %d barb and barbule points, "
 	        "afterfeather: %s\n",

@@ -115,10 +115,7 @@ static void obj_visit(void *context, int count, const plume_vec3 *points, const 
 		for (int i = 0; i < count; ++i)
 			fprintf(pass->stream, "vt %.9g %.9g\n", uv[i].x, uv[i].y);
 	else {
-		fputc('l', pass->stream);
-		for (int i = 0; i < count; ++i)
-			fprintf(pass->stream, " %lld/%lld", pass->next + i, pass->next + i);
-		fputc('\n', pass->stream);
+		plume_obj_polyline(pass->stream, pass->next, count);
 		pass->next += count;
 	}
 }
@@ -132,7 +129,9 @@ plume_status plume_coat_write_obj(const plume_coat *coat, const char *path, plum
 		return status;
 	int count = plume_coat_feather_count(coat);
 	fprintf(text.stream,
-	        "# plume %s: a feather coat, %d feathers as polylines (l v/vt ...), one object each in drawing order\n"
+	        "# plume %s: a feather coat, %d feathers as polylines (consecutive segments l a b; one vt per v, same "
+	        "order), one object each in "
+	        "drawing order\n"
 	        "# (bottom to top), shaft first, then barbs and afterfeather; metres, world coordinates\n",
 	        PLUME_VERSION_STRING, count);
 	obj_pass pass = {.stream = text.stream, .next = 1};
