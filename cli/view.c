@@ -125,7 +125,10 @@ static plume_status find_inputs(const char *input, view_file *files, int *count,
 		return plume_error_set(err, PLUME_ERROR_IO,
 		                       "%s: no .glb file in this folder (write one with --format glb, or simulate)", input);
 	qsort(files, (size_t)*count, sizeof files[0], compare_files);
-	snprintf(default_dir, size, "%s/view", input);
+	int length = (int)strlen(input);
+	while (length > 1 && input[length - 1] == '/') // "sim/" -> "sim/view", not "sim//view"
+		--length;
+	snprintf(default_dir, size, "%.*s/view", length, input);
 	return PLUME_OK;
 }
 

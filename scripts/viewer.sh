@@ -30,7 +30,7 @@ major=$(node -p 'process.versions.node.split(".")[0]')
 # npm ci only when the installed packages are not those of the lock file.
 if [[ ! -f viewer/node_modules/.package-lock.json || viewer/package-lock.json -nt viewer/node_modules/.package-lock.json ]]; then
 	echo "plume: viewer: npm ci (three.js, esbuild, playwright-core)" >&2
-	(cd viewer && npm ci --no-audit --no-fund --loglevel=error >/dev/null) || give_up "npm ci failed in viewer/ (no network?)"
+	(cd viewer && npm ci --prefer-offline --no-audit --no-fund --loglevel=error >/dev/null) || give_up "npm ci failed in viewer/ (no network?)"
 fi
 
 # Bundle only when a source is newer than the bundle.

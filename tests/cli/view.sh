@@ -39,6 +39,8 @@ check "view: only the .glb files, sorted" test "$(grep -o '"name": "[^"]*"' "$pa
 for f in a b c; do
 	check "view: $f.glb decodes back to its bytes" cmp -s <(decoded "$page/models.js" $f.glb) "$in/$f.glb"
 done
+"$plume" view "$in///" --viewer "$viewer" >"$scratch/slash.txt" 2>&1
+check "view: a trailing slash gives the same page" grep -qF "$in/view/index.html" "$scratch/slash.txt"
 check "view: prints the file:// address" grep -qF "file://$(realpath "$page")/index.html" "$scratch/out.txt"
 cp "$page/models.js" "$scratch/models-first.js"
 "$plume" view "$in" --viewer "$viewer" >/dev/null 2>&1
