@@ -140,7 +140,8 @@ def main():
     glb = writes_glb(plume, "generate")
     formats = "obj,json" + (",glb" if glb else "")
     run(plume, "generate", os.path.join(ex, "franco-walter", "hawk.json"), "-o", out + "/feather", "--format", formats)
-    run(plume, "mesh", os.path.join(ex, "franco-walter", "hawk.json"), "-o", out + "/mesh")
+    mesh_args = ["--format", "obj,glb"] if writes_glb(plume, "mesh") else []
+    run(plume, "mesh", os.path.join(ex, "franco-walter", "hawk.json"), "-o", out + "/mesh", *mesh_args)
     sim_args = [plume, "simulate", os.path.join(ex, "scenes", "figure1-anisotropic.json"), "-o", out + "/sim"]
     fields = "--fields" in subprocess.run([plume, "simulate", "--help"], stdout=subprocess.PIPE, text=True).stdout
     run(*(sim_args + (["--fields"] if fields else [])))
@@ -159,25 +160,44 @@ def main():
     check(len(frame_objs) == summary["frames"], "simulation: %d frame OBJ files, summary.json says %d frames"
           % (len(frame_objs), summary["frames"]))
 
-    # Jobs: (file, importer, expected counts, label).
+    # The coat's OBJ: its header names the feathers, the file holds the v and l lines.
+    coat_obj = out + "/coat/coat.obj"
+    with open(coat_obj) as f:
+        header = f.readline()
+        coat_v = coat_l = 0
+        for line in f:
+            coat_v += line.startswith("v ")
+            coat_l += line.startswith("l ")
+    match = re.search(r"(\d+) feathers", header)
+    check(match is not None, "coat.obj's header names its feathers: " + header.strip()[:100])
+    coat_feathers = int(match.group(1)) if match else -1
+
+    # Jobs: file, importer, expected counts, label.
     jobs = []
     for importer in ("obj", "obj-legacy"):
         jobs.append(dict(path=out + "/feather/feather.obj", importer=importer, label="hawk feather.obj",
                          expect={"vertices": curves["points"], "edges": curves["segments"]}))
         jobs.append(dict(path=out + "/mesh/mesh.obj", importer=importer, label="hawk mesh.obj",
                          expect={"vertices": report["vertex_count"], "faces": report["face_count"]}))
+        coat_expect = {"vertices": coat_v, "edges": coat_l}
+        if importer == "obj":  # one object per `o` (the legacy importer is asked for one object)
+            coat_expect["objects"] = coat_feathers
+        jobs.append(dict(path=coat_obj, importer=importer, label="coat coat.obj", expect=coat_expect))
         for frame in (frame_objs[0], frame_objs[-1]):
             jobs.append(dict(path=frame, importer=importer, label="simulation frames/" + os.path.basename(frame),
                              expect={"vertices": summary["vertices"], "faces": summary["faces"]}))
     glbs = {}
-    for path, label in ((out + "/feather/feather.glb", "hawk feather.glb"), (out + "/sim/sim.glb", "simulation sim.glb"),
-                        (out + "/coat/coat.glb", "coat coat.glb")):
+    for path, label in ((out + "/feather/feather.glb", "hawk feather.glb"), (out + "/mesh/mesh.glb", "hawk mesh.glb"),
+                        (out + "/sim/sim.glb", "simulation sim.glb"), (out + "/coat/coat.glb", "coat coat.glb")):
         if os.path.exists(path):
             glbs[path] = glb_counts(path)
             c = glbs[path]
             expect = {"objects": c["objects"], "meshes": c["meshes"], "triangles": c["triangles"]}
             if c["frames"]:
                 expect.update(frames=c["frames"], shape_keys=c["targets"])
+            if label == "hawk mesh.glb":
+                check(c["triangles"] == report["face_count"], "mesh.glb: %d triangles, report.json says %d faces"
+                      % (c["triangles"], report["face_count"]))
             if label.startswith("coat"):
                 # What `plume coat` printed: "N feather instances of M meshes, and the surface".
                 match = re.search(r"(\d+) feather instances of (\d+) meshes, and the surface", coat_report)
@@ -220,7 +240,8 @@ def main():
         pv_jobs = [dict(path=out + "/feather/feather.obj", label="hawk feather.obj",
                         expect={"points": curves["points"], "line_segments": curves["segments"]}),
                    dict(path=out + "/mesh/mesh.obj", label="hawk mesh.obj",
-                        expect={"points": report["vertex_count"], "polys": report["face_count"]})]
+                        expect={"points": report["vertex_count"], "polys": report["face_count"]}),
+                   dict(path=coat_obj, label="coat coat.obj", expect={"points": coat_v, "line_segments": coat_l})]
         for pvd in sorted(glob.glob(out + "/sim/*.pvd")):
             pv_jobs.append(dict(path=pvd, label="simulation " + os.path.basename(pvd),
                                 expect={"timesteps": summary["frames"], "points": summary["vertices"],
