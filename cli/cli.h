@@ -99,6 +99,23 @@ plume_status cli_barb_renderer_frame(const cli_barb_renderer *renderer, const pl
                                      plume_error *err);
 void cli_barb_renderer_end(cli_barb_renderer *renderer);
 
+/// A progress line with a time estimate on stderr, when it is a terminal (cli/progress.c).
+typedef struct cli_progress {
+	const char *what;
+	int total;
+	double start;
+	bool shown;
+} cli_progress;
+void cli_progress_begin(cli_progress *progress, const char *what, int total);
+/// done items of total finished; prints a newline when done reaches total.
+void cli_progress_update(cli_progress *progress, int done);
+
+/// simulate --fields (cli/fields.c): DIR/fields/NNNN.vtu for the simulator's current state.
+plume_status cli_fields_write_frame(cli_output *output, const plume_scene *scene, const plume_sim *sim, int frame,
+                                    plume_error *err);
+/// DIR/fields.pvd listing fields/0000.vtu ... with their times.
+plume_status cli_fields_write_pvd(cli_output *output, const double *times, int frames, plume_error *err);
+
 int cli_generate(int argc, char **argv);
 int cli_grow(int argc, char **argv);
 int cli_mesh(int argc, char **argv);

@@ -175,8 +175,6 @@ static plume_status make_def(const render_options *o, const plume_texture *textu
 	return PLUME_OK;
 }
 
-static bool interactive(void) { return isatty(STDERR_FILENO) != 0; }
-
 /// A subfolder of the staging folder, registered as one output name.
 static plume_status stage_folder(cli_output *output, const char *name, char *path, size_t size, plume_error *err)
 {
@@ -250,15 +248,15 @@ static plume_status render_spec(const render_options *o, const plume_raytrace_de
 		plume_vec3 lo, hi;
 		plume_raytrace_scene_bounds(&scene, &lo, &hi);
 		frame.camera = plume_camera_frame_bounds(&def->camera, lo, hi);
+		cli_progress progress;
+		cli_progress_begin(&progress, "render", o->turntable);
 		for (int i = 0; i < o->turntable && status == PLUME_OK; ++i) {
 			frame.camera.turntable = 2.0 * 3.14159265358979323846 * i / o->turntable;
 			snprintf(path, sizeof path, "%s/%04d.png", folder, i);
 			status = plume_raytrace_render_png(&scene, &frame, path, NULL, err);
-			if (interactive())
-				fprintf(stderr, "\rplume render: %d/%d", i + 1, o->turntable);
+			if (status == PLUME_OK)
+				cli_progress_update(&progress, i + 1);
 		}
-		if (interactive())
-			fputc('\n', stderr);
 	}
 	free(list);
 	plume_feather_destroy(feather);
@@ -427,6 +425,8 @@ static plume_status render_sim(const render_options *o, const plume_raytrace_def
 	uint8_t *strip = slots > 0 ? calloc(4 * (size_t)w * (size_t)h, (size_t)slots) : NULL;
 	if (status == PLUME_OK && (image == NULL || (slots > 0 && strip == NULL)))
 		status = plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory for the images");
+	cli_progress progress;
+	cli_progress_begin(&progress, "render frames", in.frame_count);
 	for (int i = 0; i < in.frame_count && status == PLUME_OK; ++i) {
 		plume_feather *moved = NULL;
 		if ((status = plume_embedding_apply(embedding, in.positions[i], &moved, err)) != PLUME_OK)
@@ -458,11 +458,9 @@ static plume_status render_sim(const render_options *o, const plume_raytrace_def
 			status = plume_write_usda(moved, path, err);
 		}
 		plume_feather_destroy(moved);
-		if (interactive())
-			fprintf(stderr, "\rplume render: frame %d/%d", i + 1, in.frame_count);
+		if (status == PLUME_OK)
+			cli_progress_update(&progress, i + 1);
 	}
-	if (interactive() && in.frame_count > 0)
-		fputc('\n', stderr);
 	if (status == PLUME_OK && strip != NULL) {
 		char path[4608];
 		cli_output_path(output, "strip.png", path, sizeof path);

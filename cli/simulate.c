@@ -23,9 +23,12 @@ void cli_help_simulate(void)
 	     "  DIR/frames/NNNN.obj   the shell at every written step (0000: the start)\n"
 	     "  DIR/sim.glb           all frames as one animated glTF 2.0 file (morph\n"
 	     "                        targets, animation \"simulation\"; Blender, three.js)\n"
+	     "  DIR/sim.usda          the same as USD text: time-sampled points\n"
 	     "  DIR/frames/NNNN.png   a shaded view of each frame, with --png\n"
 	     "  DIR/stats.csv         per step: time, Newton iterations, gradient norm,\n"
-	     "                        energy, largest barb-edge strain, wall seconds\n"
+	     "                        energy, largest barb-edge strain, wall seconds, and\n"
+	     "                        per handle N (in the scene's order) the reaction force\n"
+	     "                        handleN_f{x,y,z} (N) and displacement handleN_d{x,y,z} (m)\n"
 	     "  DIR/summary.json      steps, iterations, timings, largest barb strain,\n"
 	     "                        rachis tip deflection\n"
 	     "Bad input writes nothing. If a step fails even with substeps, the frames\n"
@@ -43,6 +46,11 @@ void cli_help_simulate(void)
 	     "                      carried by the shell) to frames/NNNN-rt.png, and make\n"
 	     "                      DIR/movie.mp4 when ffmpeg is installed\n"
 	     "      --spp N         samples per pixel of --render (default 4)\n"
+	     "      --fields        also write DIR/fields/NNNN.vtu and DIR/fields.pvd for\n"
+	     "                      ParaView: per face Green strain and 2nd Piola-Kirchhoff\n"
+	     "                      stress in the barb frame, barb angle, material, membrane,\n"
+	     "                      compression and bending energy densities; per vertex\n"
+	     "                      velocity and handle (docs/formats.md)\n"
 	     "  -h, --help          this help\n"
 	     "\n"
 	     "Scenes are described in docs/scene.md; examples/scenes/ has ready ones.");
@@ -93,6 +101,9 @@ typedef struct run_state {
 	bool progress;
 	double max_strain;
 	plume_mesh_animation *animation; ///< every frame, for DIR/sim.glb
+	bool fields;                     ///< --fields: DIR/fields/NNNN.vtu and DIR/fields.pvd
+	double *field_times;             ///< the time of every frame written, for the .pvd
+	int field_capacity;
 } run_state;
 
 static plume_status write_frame(run_state *run, int frame, const plume_sim *sim, plume_error *err)
@@ -103,6 +114,18 @@ static plume_status write_frame(run_state *run, int frame, const plume_sim *sim,
 	plume_status status = plume_mesh_write_obj(run->scene->mesh, plume_sim_positions(sim), path, err);
 	if (status == PLUME_OK)
 		status = plume_mesh_animation_add_frame(run->animation, plume_sim_time(sim), plume_sim_positions(sim), err);
+	if (status == PLUME_OK && run->fields) {
+		if (frame >= run->field_capacity) {
+			int capacity = run->field_capacity > 0 ? 2 * run->field_capacity : 64;
+			double *times = realloc(run->field_times, (size_t)capacity * sizeof *times);
+			if (times == NULL)
+				return plume_error_set(err, PLUME_ERROR_MEMORY, "fields: out of memory");
+			run->field_times = times;
+			run->field_capacity = capacity;
+		}
+		run->field_times[frame] = plume_sim_time(sim);
+		status = cli_fields_write_frame(run->output, run->scene, sim, frame, err);
+	}
 	if (status == PLUME_OK && run->png) {
 		snprintf(name, sizeof name, "frames/%04d.png", frame);
 		cli_output_path(run->output, name, path, sizeof path);
@@ -115,6 +138,23 @@ static plume_status write_frame(run_state *run, int frame, const plume_sim *sim,
 	}
 	run->frames = frame + 1;
 	return status;
+}
+
+/// Per handle: the reaction force it applies (N) and its displacement (the pose's
+/// translation, m) at this step, appended to the stats row.
+static void write_handle_columns(run_state *run, double time, const plume_sim *sim)
+{
+	for (int h = 0; h < run->scene->handle_count; ++h) {
+		const plume_scene_handle *handle = &run->scene->handles[h];
+		plume_vec3 force = {NAN, NAN, NAN}, translation;
+		plume_mat3 rotation;
+		// plume_scene_run hands its own (non-const) simulator to the callback as const; the
+		// reaction only re-evaluates forces at the current state and changes nothing it reports.
+		plume_sim_group_reaction((plume_sim *)sim, handle->group, &force);
+		plume_scene_handle_pose(handle, time, &translation, &rotation);
+		fprintf(run->stats, ",%.9e,%.9e,%.9e,%.9g,%.9g,%.9g", force.x, force.y, force.z, translation.x, translation.y,
+		        translation.z);
+	}
 }
 
 static void show_progress(const run_state *run, int step, double time)
@@ -134,8 +174,10 @@ static plume_status on_step(void *user, int step, double time, const plume_sim *
 {
 	run_state *run = user;
 	if (report != NULL) {
-		fprintf(run->stats, "%.9g,%d,%.6e,%.12e,%.6e,%.6f\n", time, report->newton_iterations, report->gradient_norm,
+		fprintf(run->stats, "%.9g,%d,%.6e,%.12e,%.6e,%.6f", time, report->newton_iterations, report->gradient_norm,
 		        report->energy, report->max_barb_strain, wall_seconds);
+		write_handle_columns(run, time, sim);
+		fputc('\n', run->stats);
 		run->max_strain = fmax(run->max_strain, report->max_barb_strain);
 	}
 	if (run->progress)
@@ -236,10 +278,17 @@ static plume_status simulate(const plume_scene *scene, cli_output *output, run_s
 		return status;
 	if (mkdir(path, 0777) != 0)
 		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot create: %s", path, "mkdir failed");
+	snprintf(path, sizeof path, "%s/fields", output->stage);
+	if (run->fields && mkdir(path, 0777) != 0)
+		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot create: %s", path, "mkdir failed");
 	run->stats = fopen(cli_output_path(output, "stats.csv", path, sizeof path), "wb");
 	if (run->stats == NULL)
 		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write", path);
-	fprintf(run->stats, "time,newton_iterations,gradient_norm,energy,max_barb_strain,wall_seconds\n");
+	fprintf(run->stats, "time,newton_iterations,gradient_norm,energy,max_barb_strain,wall_seconds");
+	for (int h = 0; h < scene->handle_count; ++h)
+		fprintf(run->stats, ",handle%d_fx,handle%d_fy,handle%d_fz,handle%d_dx,handle%d_dy,handle%d_dz", h, h, h, h, h,
+		        h);
+	fputc('\n', run->stats);
 	plume_status run_status = plume_scene_run(scene, on_step, run, summary, failure);
 	if (fclose(run->stats) != 0)
 		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write", path);
@@ -251,6 +300,11 @@ static plume_status simulate(const plume_scene *scene, cli_output *output, run_s
 	if (run->render)
 		make_movie(output);
 	status = plume_mesh_animation_write_glb(run->animation, cli_output_path(output, "sim.glb", path, sizeof path), err);
+	if (status == PLUME_OK)
+		status = plume_mesh_animation_write_usda(run->animation, cli_output_path(output, "sim.usda", path, sizeof path),
+		                                         err);
+	if (status == PLUME_OK && run->fields)
+		status = cli_fields_write_pvd(output, run->field_times, run->frames, err);
 	if (status != PLUME_OK)
 		return status;
 	status = write_summary(output, scene, summary, run, run_status == PLUME_OK ? NULL : failure, err);
@@ -260,15 +314,11 @@ static plume_status simulate(const plume_scene *scene, cli_output *output, run_s
 int cli_simulate(int argc, char **argv)
 {
 	static const struct option options[] = {
-	    {"output", required_argument, NULL, 'o'},
-	    {"seed", required_argument, NULL, 's'},
-	    {"png", no_argument, NULL, 'p'},
-	    {"size", required_argument, NULL, 'S'},
-	    {"view", required_argument, NULL, 'V'},
-	    {"render", no_argument, NULL, 'R'},
-	    {"spp", required_argument, NULL, 'P'},
-	    {"help", no_argument, NULL, 'h'},
-	    {NULL, 0, NULL, 0},
+	    {"output", required_argument, NULL, 'o'}, {"seed", required_argument, NULL, 's'},
+	    {"png", no_argument, NULL, 'p'},          {"size", required_argument, NULL, 'S'},
+	    {"view", required_argument, NULL, 'V'},   {"render", no_argument, NULL, 'R'},
+	    {"spp", required_argument, NULL, 'P'},    {"fields", no_argument, NULL, 'F'},
+	    {"help", no_argument, NULL, 'h'},         {NULL, 0, NULL, 0},
 	};
 	const char *output_dir = NULL;
 	plume_spec_options spec_options = {0};
@@ -302,6 +352,7 @@ int cli_simulate(int argc, char **argv)
 			break;
 		}
 		case 'R': run.render = true; break;
+		case 'F': run.fields = true; break;
 		case 'P': {
 			char *end = NULL;
 			long value = strtol(optarg, &end, 10);
@@ -366,6 +417,7 @@ int cli_simulate(int argc, char **argv)
 		       summary.max_barb_strain, summary.rachis_tip_deflection, run.frames, output_dir);
 	plume_scene_destroy(scene);
 	plume_mesh_animation_destroy(run.animation);
+	free(run.field_times);
 	cli_barb_renderer_end(&run.renderer);
 	if (status != PLUME_OK)
 		return cli_fail(status == PLUME_ERROR_NUMERIC && failure.message[0] ? &failure : &err);

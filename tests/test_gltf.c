@@ -268,6 +268,44 @@ static plume_mesh *blue_mesh(plume_feather *feather)
 	return mesh;
 }
 
+/// The USD file's points time samples: one per frame at time code 24 t, each the frame's points.
+static void check_usda_frames(const char *path, const plume_mesh *mesh, const double times[3])
+{
+	char *text = (char *)test_read_file(path, NULL);
+	assert_non_null(text);
+	assert_non_null(strstr(text, "timeCodesPerSecond = 24\n"));
+	char *at = strstr(text, "point3f[] points.timeSamples = {\n");
+	assert_non_null(at);
+	at = strchr(at, '\n') + 1;
+	for (int k = 0; k < 3; ++k) {
+		char *end;
+		double code = strtod(at, &end);
+		assert_close(code, 24 * times[k], 1e-9);
+		assert_true(strncmp(end, ": [", 3) == 0);
+		at = end + 3;
+		for (int i = 0; i < mesh->vertex_count; ++i) {
+			double p[3];
+			int used = 0;
+			if (i > 0) {
+				assert_true(strncmp(at, ", ", 2) == 0);
+				at += 2;
+			}
+			assert_int_equal(sscanf(at, "(%lf, %lf, %lf)%n", &p[0], &p[1], &p[2], &used), 3);
+			at += used;
+			plume_vec3 want =
+			    plume_v3_add(mesh->rest[i], plume_v3(0.01 * k * mesh->rest[i].y, 0.003 * k, -0.02 * k * k));
+			assert_close(p[0], want.x, 1e-6);
+			assert_close(p[1], want.y, 1e-6);
+			assert_close(p[2], want.z, 1e-6);
+		}
+		assert_true(strncmp(at, "],\n", 3) == 0);
+		at += 3;
+	}
+	assert_true(strncmp(at, "    }", 5) == 0);
+	assert_non_null(strstr(text, "color3f[] primvars:displayColor = ["));
+	free(text);
+}
+
 static void test_shell_and_animation_read_back(void **state)
 {
 	(void)state;
@@ -319,7 +357,11 @@ static void test_shell_and_animation_read_back(void **state)
 	assert_int_equal(plume_mesh_animation_frame_count(animation), 3);
 	snprintf(path, sizeof path, "%s/sim.glb", scratch);
 	assert_int_equal(plume_mesh_animation_write_glb(animation, path, &err), PLUME_OK);
+	char usda[512];
+	snprintf(usda, sizeof usda, "%s/sim.usda", scratch);
+	assert_int_equal(plume_mesh_animation_write_usda(animation, usda, &err), PLUME_OK);
 	plume_mesh_animation_destroy(animation);
+	check_usda_frames(usda, mesh, times);
 	g = glb_read(path);
 	json_t *primitive = primitive_of(&g, "shell", 0);
 	json_t *targets = json_object_get(primitive, "targets");
@@ -412,6 +454,36 @@ static void test_coat_instances(void **state)
 	accessor(&g, (int)json_integer_value(json_object_get(surface, "indices")), 5125, &ni, &ci);
 	assert_int_equal(ni, 3 * plume_coat_surface(coat)->face_count);
 	glb_free(&g);
+
+	// USD: a PointInstancer with one prototype per feather, instance i at follicle i.
+	snprintf(path, sizeof path, "%s/coat.usda", scratch);
+	assert_int_equal(plume_coat_write_usda(coat, path, &err), PLUME_OK);
+	char *text = (char *)test_read_file(path, NULL);
+	assert_non_null(text);
+	char *instancer = strstr(text, "def PointInstancer \"feathers\"");
+	assert_non_null(instancer);
+	char *positions = strstr(instancer, "point3f[] positions = [");
+	assert_non_null(positions);
+	positions += strlen("point3f[] positions = [");
+	for (int i = 0; i < count; ++i) {
+		double p[3];
+		int used = 0;
+		assert_int_equal(sscanf(positions, "%*[, ](%lf, %lf, %lf)%n", &p[0], &p[1], &p[2], &used) == 3 ||
+		                     sscanf(positions, "(%lf, %lf, %lf)%n", &p[0], &p[1], &p[2], &used) == 3,
+		                 1);
+		positions += used;
+		plume_vec3 follicle, normal;
+		plume_coat_follicle(coat, i, &follicle, &normal);
+		assert_close(p[0], follicle.x, 1e-6);
+		assert_close(p[2], follicle.z, 1e-6);
+		char name[64];
+		snprintf(name, sizeof name, "</coat/feathers/prototypes/feather_%05d>", i);
+		assert_non_null(strstr(instancer, name));
+		snprintf(name, sizeof name, "def BasisCurves \"feather_%05d\"", i);
+		assert_non_null(strstr(instancer, name));
+	}
+	assert_true(strncmp(positions, "]\n", 2) == 0);
+	free(text);
 	plume_coat_destroy(coat);
 }
 

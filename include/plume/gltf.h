@@ -101,6 +101,12 @@ int plume_mesh_animation_frame_count(const plume_mesh_animation *animation);
 /// Writes the frames so far (at least one) as .glb.
 plume_status plume_mesh_animation_write_glb(const plume_mesh_animation *animation, const char *path, plume_error *err);
 
+/// Writes the frames so far (at least one) as USD text: one Mesh whose points
+/// (and extent) are time samples at each frame's time code (seconds x 24,
+/// timeCodesPerSecond 24), primvars:st, and primvars:displayColor per face
+/// from the vane and rachis colours.
+plume_status plume_mesh_animation_write_usda(const plume_mesh_animation *animation, const char *path, plume_error *err);
+
 void plume_mesh_animation_destroy(plume_mesh_animation *animation);
 
 PLUME_API_END

@@ -45,10 +45,9 @@ typedef struct plume_material {
 	/// Hold every barb-aligned edge of these faces at its reference length (eps_vv = 0).
 	bool barb_constraint;
 	/// Bending moduli, N m (thesis eq. 6.4), continuum plate moduli: a flat sheet rolled
-	/// into a cylinder of radius R stores (1/2) D A / R^2 (docs/physics-energies.md): `bending_along` for an edge parallel to the
-	/// barbs (a hinge that keeps the barbs straight; soft), `bending_across` for an edge
-	/// across them (bends the barbs; stiff). Isotropic materials use bending_along for both
-	/// when bending_across is negative.
+	/// into a cylinder of radius R stores (1/2) D A / R^2 (docs/physics-energies.md): `bending_along` for an edge
+	/// parallel to the barbs (a hinge that keeps the barbs straight; soft), `bending_across` for an edge across them
+	/// (bends the barbs; stiff). Isotropic materials use bending_along for both when bending_across is negative.
 	double bending_along;
 	double bending_across;
 	/// Kikuuwe coefficient kappa, Pa (thesis eq. 6.6); 0 disables the compression term.
@@ -164,6 +163,27 @@ typedef struct plume_sim_energies {
 	double kinetic;
 } plume_sim_energies;
 plume_sim_energies plume_sim_energy(plume_sim *sim);
+
+/// What one face carries at the current state (plume_sim_face_fields). Tensors are
+/// in the reference plane's (x, y) frame as tensor components (not Voigt's doubled
+/// shear); rotate them by the face's barb angle (plume_mesh.barb_angle) for the barb frame.
+typedef struct plume_sim_face_field {
+	/// Green strain E = (F^T F - I) / 2: xx, yy, xy.
+	double strain[3];
+	/// Second Piola-Kirchhoff stress of the St-Venant-Kirchhoff membrane, Pa: xx, yy, xy
+	/// (S = C : E with the face's material tensor, divided by nothing: the shell's
+	/// thickness is in the energy, not in S).
+	double stress[3];
+	/// Energy per unit reference area, J/m^2: St-Venant-Kirchhoff membrane, Kikuuwe
+	/// compression term, and bending (half of each adjacent hinge's energy).
+	double membrane_energy_density;
+	double compression_energy_density;
+	double bending_energy_density;
+} plume_sim_face_field;
+
+/// Fills out[f] for every face of the mesh the simulator was created from (face_count
+/// entries), at the current positions. PLUME_ERROR_MEMORY when scratch cannot be allocated.
+plume_status plume_sim_face_fields(const plume_sim *sim, plume_sim_face_field *out, plume_error *err);
 
 PLUME_API_END
 #ifdef __cplusplus

@@ -16,6 +16,7 @@
 #include <string.h>
 
 #include "../core/alloc.h"
+#include "animation.h"
 #include "glb.h"
 #include "plume/gltf.h"
 
@@ -150,15 +151,6 @@ plume_status plume_mesh_write_glb(const plume_mesh *mesh, const plume_vec3 *posi
 
 // ---------------------------------------------------------------------------
 // Animation
-
-struct plume_mesh_animation {
-	const plume_mesh *mesh;
-	plume_gltf_def def;
-	int frame_count, frame_capacity;
-	double *times;
-	double *first;        ///< the first frame in double, the base the displacements are taken from
-	float *displacements; ///< frame_count * vertex_count * 3: frame minus first frame
-};
 
 plume_status plume_mesh_animation_create(const plume_mesh *mesh, const plume_gltf_def *def, plume_mesh_animation **out,
                                          plume_error *err)

@@ -10,6 +10,8 @@
 // - For linear curves "vertex" and "varying" data both hold one value per
 //   point; "vertex" is used throughout, which every importer handles.
 // - Per-curve data ("primvars:side", ...) is "uniform": one value per curve.
+// - primvars:displayColor (linear RGB, constant per prim) gives every prim the
+//   ray tracer's default colours, so viewers without materials show a feather.
 // Points, normals and widths are single precision in USD (point3f, normal3f,
 // float): each value is rounded to float and printed with "%.9g", which
 // reproduces that float exactly. The text is written in the "C" numeric
@@ -70,6 +72,22 @@ static void write_extent(FILE *stream, int depth, const extent *box)
 
 static const extent empty_extent = {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}, 0.0};
 
+/// primvars:displayColor, constant over a prim: sRGB colour converted to linear
+/// (USD's colours are linear), the ray tracer's default shaft and barb colours.
+static void write_display_color(FILE *stream, int depth, double r, double g, double b)
+{
+	double c[3] = {r, g, b};
+	for (int k = 0; k < 3; ++k)
+		c[k] = c[k] <= 0.04045 ? c[k] / 12.92 : pow((c[k] + 0.055) / 1.055, 2.4);
+	indent(stream, depth);
+	fprintf(stream, "color3f[] primvars:displayColor = [(%.9g, %.9g, %.9g)] (\n", (float)c[0], (float)c[1],
+	        (float)c[2]);
+	indent(stream, depth + 1);
+	fputs("interpolation = \"constant\"\n", stream);
+	indent(stream, depth);
+	fputs(")\n", stream);
+}
+
 /// The curve type attributes every prim here shares.
 static void write_curve_type(FILE *stream, int depth)
 {
@@ -116,6 +134,7 @@ static void write_shaft(FILE *stream, const plume_feather *feather, int depth)
 	for (int i = 0; i < count; ++i)
 		fprintf(stream, "%s(0, %.9g)", i > 0 ? ", " : "", (float)shaft[i].t);
 	end_array(stream, inner, "vertex");
+	write_display_color(stream, inner, 0.78, 0.72, 0.62);
 	indent(stream, depth);
 	fputs("}\n", stream);
 }
@@ -218,6 +237,7 @@ static void write_curves(FILE *stream, const plume_feather *feather, plume_curve
 	fputs("texCoord2f[] primvars:st = [", stream);
 	write_point_data(stream, feather, set, inner, POINT_UV);
 	end_array(stream, inner, "vertex");
+	write_display_color(stream, inner, 0.45, 0.33, 0.22);
 
 	// Per-curve integers, named as in plume's structure (0 = left / distal, 1 = right / proximal).
 	static const struct {

@@ -151,6 +151,7 @@ typedef struct usd_pass {
 	FILE *stream;
 	int what; ///< 0: counts, 1: points, 2: widths, 3: uv
 	bool first;
+	plume_vec3 origin; ///< subtracted from points: prototypes are relative to their follicle
 } usd_pass;
 
 static void usd_visit(void *context, int count, const plume_vec3 *points, const double *widths, const plume_vec2 *uv)
@@ -167,12 +168,23 @@ static void usd_visit(void *context, int count, const plume_vec3 *points, const 
 			fputs(", ", s);
 		pass->first = false;
 		if (pass->what == 1)
-			fprintf(s, "(%.9g, %.9g, %.9g)", (float)points[i].x, (float)points[i].y, (float)points[i].z);
+			fprintf(s, "(%.9g, %.9g, %.9g)", (float)(points[i].x - pass->origin.x),
+			        (float)(points[i].y - pass->origin.y), (float)(points[i].z - pass->origin.z));
 		else if (pass->what == 2)
 			fprintf(s, "%.9g", (float)widths[i]);
 		else
 			fprintf(s, "(%.9g, %.9g)", (float)uv[i].x, (float)uv[i].y);
 	}
+}
+
+/// sRGB to linear (USD's displayColor is linear), IEC 61966-2-1.
+static double linear(double c) { return c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4); }
+
+/// A constant primvars:displayColor from an sRGB colour, at the given indentation.
+static void usd_display_color(FILE *s, const char *indent, double r, double g, double b)
+{
+	fprintf(s, "%scolor3f[] primvars:displayColor = [(%.9g, %.9g, %.9g)] (\n%s    interpolation = \"constant\"\n%s)\n",
+	        indent, (float)linear(r), (float)linear(g), (float)linear(b), indent, indent);
 }
 
 static void usd_surface(FILE *s, const plume_mesh *mesh)
@@ -187,7 +199,9 @@ static void usd_surface(FILE *s, const plume_mesh *mesh)
 	for (int v = 0; v < mesh->vertex_count; ++v)
 		fprintf(s, "%s(%.9g, %.9g, %.9g)", v > 0 ? ", " : "", (float)mesh->rest[v].x, (float)mesh->rest[v].y,
 		        (float)mesh->rest[v].z);
-	fputs("]\n        uniform token subdivisionScheme = \"none\"\n    }\n", s);
+	fputs("]\n        uniform token subdivisionScheme = \"none\"\n", s);
+	usd_display_color(s, "        ", 0.70, 0.62, 0.50); // the ray tracer's shell colour
+	fputs("    }\n", s);
 }
 
 plume_status plume_coat_write_usda(const plume_coat *coat, const char *path, plume_error *err)
@@ -201,27 +215,48 @@ plume_status plume_coat_write_usda(const plume_coat *coat, const char *path, plu
 	int count = plume_coat_feather_count(coat);
 	fprintf(s,
 	        "#usda 1.0\n(\n    defaultPrim = \"coat\"\n    doc = \"\"\"plume %s: a feather coat, %d feathers as linear "
-	        "curves in drawing order (bottom to top), and its surface.\"\"\"\n    metersPerUnit = 1\n"
+	        "curves in drawing order (bottom to top), placed by a PointInstancer at their follicles, and its "
+	        "surface.\"\"\"\n    metersPerUnit = 1\n"
 	        "    upAxis = \"Y\"\n)\n\ndef Xform \"coat\"\n{\n",
 	        PLUME_VERSION_STRING, count);
 	usd_surface(s, plume_coat_surface(coat));
+	// UsdGeomPointInstancer: instance i is prototype i (every interpolated feather is its own shape)
+	// translated to its follicle; the prototypes sit under the instancer, relative to the follicle.
+	fputs("    def PointInstancer \"feathers\"\n    {\n        rel prototypes = [", s);
+	for (int f = 0; f < count; ++f)
+		fprintf(s, "%s</coat/feathers/prototypes/feather_%05d>", f > 0 ? ", " : "", f);
+	fputs("]\n        int[] protoIndices = [", s);
+	for (int f = 0; f < count; ++f)
+		fprintf(s, f > 0 ? ", %d" : "%d", f);
+	fputs("]\n        point3f[] positions = [", s);
+	for (int f = 0; f < count; ++f) {
+		plume_vec3 follicle, normal;
+		plume_coat_follicle(coat, f, &follicle, &normal);
+		fprintf(s, "%s(%.9g, %.9g, %.9g)", f > 0 ? ", " : "", (float)follicle.x, (float)follicle.y, (float)follicle.z);
+	}
+	fputs("]\n\n        def Scope \"prototypes\"\n        {\n", s);
 	static const char *const heads[4] = {"        int[] curveVertexCounts = [", "        point3f[] points = [",
 	                                     "        float[] widths = [", "        texCoord2f[] primvars:st = ["};
 	for (int f = 0; f < count; ++f) {
 		fprintf(s,
-		        "    def BasisCurves \"feather_%05d\"\n    {\n        uniform token type = \"linear\"\n"
-		        "        uniform token wrap = \"nonperiodic\"\n",
+		        "            def BasisCurves \"feather_%05d\"\n            {\n                uniform token type = "
+		        "\"linear\"\n"
+		        "                uniform token wrap = \"nonperiodic\"\n",
 		        f);
 		usd_pass pass = {.stream = s};
+		plume_vec3 normal;
+		plume_coat_follicle(coat, f, &pass.origin, &normal);
 		for (pass.what = 0; pass.what < 4; ++pass.what) {
-			fputs(heads[pass.what], s);
+			fprintf(s, "        %s", heads[pass.what]);
 			pass.first = true;
 			visit_curves(plume_coat_feather(coat, f), usd_visit, &pass, scratch.points, scratch.widths, scratch.uv);
-			fputs(pass.what >= 2 ? "] (\n            interpolation = \"vertex\"\n        )\n" : "]\n", s);
+			fputs(pass.what >= 2 ? "] (\n                    interpolation = \"vertex\"\n                )\n" : "]\n",
+			      s);
 		}
-		fputs("    }\n", s);
+		usd_display_color(s, "                ", 0.45, 0.33, 0.22); // the ray tracer's barb colour
+		fputs("            }\n", s);
 	}
-	fputs("}\n", s);
+	fputs("        }\n    }\n}\n", s);
 	scratch_free(&scratch);
 	return plume_text_close(&text, PLUME_OK, err);
 }

@@ -57,8 +57,36 @@ JSON
 status=$?
 check "simulate: exit 0 ($(cat "$scratch/err.txt"))" test "$status" -eq 0
 check "simulate writes sim.glb" test -s "$scratch/swing/sim.glb"
+check "sim.usda has 4 time samples of the points" test "$(sed -n '/points.timeSamples/,/^    }/p' "$scratch/swing/sim.usda" | grep -c ': \[')" -eq 4
 "$py" "$checker" frames "$scratch/swing/sim.glb" "$scratch/swing/frames" >"$scratch/out.txt" 2>&1
 status=$?
 check "sim.glb frames = OBJ frames to 1e-6 m ($(cat "$scratch/out.txt"))" test "$status" -eq 0
 check "sim.glb: 4 animation keys" test "$(field "$scratch/swing/sim.glb" animation_keys)" -eq 4
+
+# --fields: a .vtu per frame listed by fields.pvd; the handle's vertices are still.
+"$plume" simulate "$scratch/swing.json" -o "$scratch/fields" --fields >/dev/null 2>"$scratch/err.txt"
+status=$?
+check "simulate --fields: exit 0 ($(cat "$scratch/err.txt"))" test "$status" -eq 0
+"$py" - "$scratch/fields" >"$scratch/out.txt" 2>&1 <<'PY'
+import sys, xml.etree.ElementTree as ET
+folder = sys.argv[1]
+sets = ET.parse(folder + "/fields.pvd").getroot().find("Collection").findall("DataSet")
+assert len(sets) == 4, len(sets)
+faces = sum(1 for line in open(folder + "/mesh.obj") if line.startswith("f "))
+for d in sets:
+    piece = ET.parse(folder + "/" + d.get("file")).getroot().find("UnstructuredGrid/Piece")
+    assert int(piece.get("NumberOfCells")) == faces, (piece.get("NumberOfCells"), faces)
+    arrays = {a.get("Name"): a.text.split() for a in piece.iter("DataArray")}
+    for name in ("green_strain_barb", "pk2_stress_barb"):
+        assert len(arrays[name]) == 3 * faces, name
+    handle = [int(h) for h in arrays["handle"]]
+    velocity = [float(v) for v in arrays["velocity"]]
+    held = [i for i, h in enumerate(handle) if h == 0]
+    assert held, "no vertex in handle 0"
+    assert all(velocity[3 * i + c] == 0.0 for i in held for c in range(3)), "a held vertex moves"
+print("ok")
+PY
+status=$?
+check "fields.pvd and .vtu read back ($(cat "$scratch/out.txt"))" test "$status" -eq 0
+check "stats.csv has the handle's reaction and displacement" grep -q "handle0_fx,handle0_fy,handle0_fz,handle0_dx,handle0_dy,handle0_dz" "$scratch/fields/stats.csv"
 finish
