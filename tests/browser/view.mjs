@@ -93,9 +93,10 @@ try {
 		page.on("pageerror", (e) => errors.push(e.message));
 		page.on("console", (m) => m.type() === "error" && errors.push(m.text()));
 		const started = Date.now();
-		await page.goto(url);
+		// Generous: SwiftShader on a loaded 2-core machine takes tens of seconds.
+		await page.goto(url, { timeout: 180000 });
 		await page.waitForFunction(() => window.plumeViewer && (window.plumeViewer.ready || window.plumeViewer.error), null, {
-			timeout: 120000,
+			timeout: 180000,
 		});
 		const state = await page.evaluate(() => ({ ...window.plumeViewer }));
 		check(!state.error && errors.length === 0, `${file}: loaded ${state.file} in ${Date.now() - started} ms ${state.error || errors.join("; ")}`);

@@ -6,7 +6,6 @@
 import * as THREE from "three";
 import { GLTFLoader } from "three/examples/jsm/loaders/GLTFLoader.js";
 import { OrbitControls } from "three/examples/jsm/controls/OrbitControls.js";
-import { RoomEnvironment } from "three/examples/jsm/environments/RoomEnvironment.js";
 
 const models = Array.isArray(window.PLUME_MODELS) ? window.PLUME_MODELS : [];
 const params = new URLSearchParams(window.location.search);
@@ -26,6 +25,7 @@ const state = {
 	frames: 0, // frames drawn since the page loaded
 };
 window.plumeViewer = state;
+state.scriptAt = Math.round(performance.now()); // after the page and models.js were read
 
 const $ = (id) => document.getElementById(id);
 const view = $("view");
@@ -47,12 +47,12 @@ const scene = new THREE.Scene();
 // A dark backdrop: feathers range from white down to near black, and light
 // ones (and unlit line strips) vanish on a pale one.
 scene.background = new THREE.Color(0x2f3338);
-// glTF materials are physically based; an environment lights them from every
-// side (a metallic default would otherwise render black).
-const pmrem = new THREE.PMREMGenerator(renderer);
-scene.environment = pmrem.fromScene(new RoomEnvironment(), 0.04).texture;
-scene.environmentIntensity = 0.8;
-const sun = new THREE.DirectionalLight(0xffffff, 0.9);
+// Plain lights, no environment map: a PMREM environment costs seconds in a
+// software WebGL (13 s in SwiftShader on a loaded 2-core machine), and plume's
+// materials are non-metallic, so sky, ground and a key light from the camera's
+// side are enough.
+scene.add(new THREE.HemisphereLight(0xfff8f0, 0x6b6257, 1.6));
+const sun = new THREE.DirectionalLight(0xffffff, 1.8);
 scene.add(sun);
 
 const camera = new THREE.PerspectiveCamera(35, 1, 0.001, 1000);
@@ -80,6 +80,8 @@ function resize() {
 window.addEventListener("resize", resize);
 
 function decodeBase64(text) {
+	// Native where the browser has it (Chromium 140+), else through atob.
+	if (typeof Uint8Array.fromBase64 === "function") return Uint8Array.fromBase64(text).buffer;
 	const binary = atob(text);
 	const bytes = new Uint8Array(binary.length);
 	for (let i = 0; i < binary.length; i++) bytes[i] = binary.charCodeAt(i);
@@ -220,10 +222,19 @@ function load(index) {
 	state.error = null;
 	message.textContent = "";
 	const loader = new GLTFLoader();
-	const done = (gltf) => show(gltf, model.name);
+	const requested = performance.now();
+	const done = (gltf) => {
+		state.parseMs = Math.round(performance.now() - requested);
+		show(gltf, model.name);
+	};
 	const error = (e) => fail(`plume viewer: cannot read ${model.name}: ${e && e.message ? e.message : e}`);
 	try {
-		if (model.data !== undefined) loader.parse(decodeBase64(model.data), "", done, error);
+		if (model.data !== undefined) {
+			const started = performance.now();
+			const buffer = decodeBase64(model.data);
+			state.decodeMs = Math.round(performance.now() - started);
+			loader.parse(buffer, "", done, error);
+		}
 		else loader.load(model.url, done, undefined, error);
 	} catch (e) {
 		error(e);
