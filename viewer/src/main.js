@@ -51,8 +51,8 @@ scene.background = new THREE.Color(0x2f3338);
 // software WebGL (13 s in SwiftShader on a loaded 2-core machine), and plume's
 // materials are non-metallic, so sky, ground and a key light from the camera's
 // side are enough.
-scene.add(new THREE.HemisphereLight(0xfff8f0, 0x6b6257, 1.6));
-const sun = new THREE.DirectionalLight(0xffffff, 1.8);
+scene.add(new THREE.HemisphereLight(0xfff8f0, 0x6b6257, 2.2));
+const sun = new THREE.DirectionalLight(0xffffff, 2.4);
 scene.add(sun);
 
 const camera = new THREE.PerspectiveCamera(35, 1, 0.001, 1000);
