@@ -38,6 +38,8 @@ void cli_help_lab(void)
 	     "  --phases K             band phases the tilted slope is averaged over (default 4)\n"
 	     "  --macro-elements N     macroscale tilted mesh size (default 2000)\n"
 	     "  --unconstrained        fit E_vw without the barb constraint\n"
+	     "  -o DIR                 also write DIR/calibration.json (the printed JSON) and\n"
+	     "                         DIR/slopes.csv (each matched slope, Pa)\n"
 	     "\n"
 	     "study: writes DIR/<study>.csv, .png and .svg and prints a JSON summary.\n"
 	     "  --scale S              element counts times S (default 1; e.g. 0.25 for a quick look)\n"
@@ -179,6 +181,66 @@ static int run_traction(int argc, char **argv)
 // ---------------------------------------------------------------------------
 // calibrate
 
+/// The calibration's JSON: moduli, the slopes matched, the inputs and the counts.
+static void print_calibration(FILE *out, const plume_calibration_def *d, const plume_calibration_result *result)
+{
+	const plume_calibration_def def = *d;
+	const plume_calibration_result r = *result;
+	fprintf(out, "{\n  \"E_vv\": %.6g,\n  \"E_ww\": %.6g,\n  \"E_vw\": %.6g,\n", r.E_vv, r.E_ww, r.E_vw);
+	fprintf(out,
+	        "  \"slopes\": {\"longitudinal\": %.8g, \"transverse\": %.8g, \"tilted_mesoscale\": %.8g, "
+	        "\"tilted_macroscale\": %.8g},\n",
+	        r.slope_longitudinal, r.slope_transverse, r.slope_tilted, r.slope_tilted_macroscale);
+	fprintf(out,
+	        "  \"phi\": %.6g,\n  \"E_b\": %.6g,\n  \"E_B\": %.6g,\n  \"aspect\": %.6g,\n  \"period\": %.6g,\n"
+	        "  \"phases\": %d,\n",
+	        def.mesoscale.bands.barb_fraction, def.mesoscale.E_b, def.mesoscale.E_B, def.aspect_ratio,
+	        def.mesoscale.bands.period, def.phase_count);
+	fprintf(
+	    out,
+	    "  \"barb_constraint\": %s,\n  \"traction_tests\": %d,\n  \"solves\": %d,\n  \"bisection_iterations\": %d\n}\n",
+	    def.barb_constraint ? "true" : "false", r.traction_count, r.solve_count, r.bisection_iterations);
+}
+
+/// -o DIR: DIR/calibration.json (what stdout shows) and DIR/slopes.csv, together or not at all.
+static int write_calibration(const char *dir, const plume_calibration_def *def, const plume_calibration_result *r)
+{
+	plume_error err = {0};
+	cli_output output;
+	plume_status status = cli_output_begin(&output, dir, &err);
+	if (status != PLUME_OK)
+		return cli_fail(&err);
+	char path[4352];
+	FILE *json = fopen(cli_output_path(&output, "calibration.json", path, sizeof path), "wb");
+	if (json != NULL) {
+		print_calibration(json, def, r);
+		if (ferror(json) != 0 || fclose(json) != 0)
+			status = plume_error_set(&err, PLUME_ERROR_IO, "%s: cannot write", path);
+	} else {
+		status = plume_error_set(&err, PLUME_ERROR_IO, "%s: cannot write", path);
+	}
+	FILE *csv = status == PLUME_OK ? fopen(cli_output_path(&output, "slopes.csv", path, sizeof path), "wb") : NULL;
+	if (status == PLUME_OK && csv == NULL)
+		status = plume_error_set(&err, PLUME_ERROR_IO, "%s: cannot write", path);
+	if (csv != NULL) {
+		// Each matched stress-strain slope (Pa) and the modulus it determines.
+		fprintf(csv,
+		        "test,model,slope_pa,determines\n"
+		        "longitudinal,mesoscale,%.9g,E_vv\n"
+		        "transverse,mesoscale,%.9g,E_ww\n"
+		        "tilted,mesoscale,%.9g,target of E_vw\n"
+		        "tilted,macroscale,%.9g,E_vw (matched to the mesoscale slope)\n",
+		        r->slope_longitudinal, r->slope_transverse, r->slope_tilted, r->slope_tilted_macroscale);
+		if (ferror(csv) != 0 || fclose(csv) != 0)
+			status = plume_error_set(&err, PLUME_ERROR_IO, "%s: cannot write", path);
+	}
+	if (status == PLUME_OK)
+		status = cli_output_commit(&output, &err);
+	else
+		cli_output_abort(&output);
+	return status == PLUME_OK ? CLI_EXIT_OK : cli_fail(&err);
+}
+
 static int run_calibrate(int argc, char **argv)
 {
 	static const struct option options[] = {
@@ -192,15 +254,17 @@ static int run_calibrate(int argc, char **argv)
 	    {"macro-elements", required_argument, NULL, 'm'},
 	    {"phases", required_argument, NULL, 'k'},
 	    {"unconstrained", no_argument, NULL, 'u'},
+	    {"output", required_argument, NULL, 'o'},
 	    {"help", no_argument, NULL, 'h'},
 	    {NULL, 0, NULL, 0},
 	};
 	plume_calibration_def def = plume_calibration_default_def();
 	bool phi_given = false, Eb_given = false, EB_given = false;
+	const char *output_dir = NULL;
 	int option;
 	optind = 1;
 	opterr = 0;
-	while ((option = getopt_long(argc, argv, ":h", options, NULL)) != -1) {
+	while ((option = getopt_long(argc, argv, ":o:h", options, NULL)) != -1) {
 		bool ok = true;
 		switch (option) {
 		case 'p':
@@ -222,6 +286,7 @@ static int run_calibrate(int argc, char **argv)
 		case 'm': ok = parse_int("--macro-elements", optarg, &def.macroscale_elements); break;
 		case 'k': ok = parse_int("--phases", optarg, &def.phase_count); break;
 		case 'u': def.barb_constraint = false; break;
+		case 'o': output_dir = optarg; break;
 		case 'h': cli_help_lab(); return CLI_EXIT_OK;
 		case ':': return cli_usage_error("lab", "option '%s' needs a value", argv[optind - 1]);
 		default: return cli_usage_error("lab", "unknown option '%s'", argv[optind - 1]);
@@ -242,17 +307,9 @@ static int run_calibrate(int argc, char **argv)
 	plume_status status = plume_lab_calibrate(&def, &r, &err);
 	if (status != PLUME_OK)
 		return cli_fail(&err);
-	printf("{\n  \"E_vv\": %.6g,\n  \"E_ww\": %.6g,\n  \"E_vw\": %.6g,\n", r.E_vv, r.E_ww, r.E_vw);
-	printf("  \"slopes\": {\"longitudinal\": %.8g, \"transverse\": %.8g, \"tilted_mesoscale\": %.8g, "
-	       "\"tilted_macroscale\": %.8g},\n",
-	       r.slope_longitudinal, r.slope_transverse, r.slope_tilted, r.slope_tilted_macroscale);
-	printf("  \"phi\": %.6g,\n  \"E_b\": %.6g,\n  \"E_B\": %.6g,\n  \"aspect\": %.6g,\n  \"period\": %.6g,\n"
-	       "  \"phases\": %d,\n",
-	       def.mesoscale.bands.barb_fraction, def.mesoscale.E_b, def.mesoscale.E_B, def.aspect_ratio,
-	       def.mesoscale.bands.period, def.phase_count);
-	printf(
-	    "  \"barb_constraint\": %s,\n  \"traction_tests\": %d,\n  \"solves\": %d,\n  \"bisection_iterations\": %d\n}\n",
-	    def.barb_constraint ? "true" : "false", r.traction_count, r.solve_count, r.bisection_iterations);
+	print_calibration(stdout, &def, &r);
+	if (output_dir != NULL)
+		return write_calibration(output_dir, &def, &r);
 	return CLI_EXIT_OK;
 }
 

@@ -46,6 +46,9 @@ void cli_help_simulate(void)
 	     "                      carried by the shell) to frames/NNNN-rt.png, and make\n"
 	     "                      DIR/movie.mp4 when ffmpeg is installed\n"
 	     "      --spp N         samples per pixel of --render (default 4)\n"
+	     "      --glb-feather   sim.glb also carries the feather's barbs (line segments\n"
+	     "                      moved by the shell, one morph target per frame; large:\n"
+	     "                      about 12 bytes per barb point and frame)\n"
 	     "      --fields        also write DIR/fields/NNNN.vtu and DIR/fields.pvd for\n"
 	     "                      ParaView: per face Green strain and 2nd Piola-Kirchhoff\n"
 	     "                      stress in the barb frame, barb angle, material, membrane,\n"
@@ -102,6 +105,8 @@ typedef struct run_state {
 	double max_strain;
 	plume_mesh_animation *animation; ///< every frame, for DIR/sim.glb
 	bool fields;                     ///< --fields: DIR/fields/NNNN.vtu and DIR/fields.pvd
+	bool glb_feather;                ///< --glb-feather: sim.glb also carries the feather
+	plume_barb_embedding *carried;   ///< its embedding
 	double *field_times;             ///< the time of every frame written, for the .pvd
 	int field_capacity;
 } run_state;
@@ -274,6 +279,11 @@ static plume_status simulate(const plume_scene *scene, cli_output *output, run_s
 		return status;
 	snprintf(path, sizeof path, "%s/frames", output->stage);
 	status = plume_mesh_animation_create(scene->mesh, NULL, &run->animation, err);
+	if (status == PLUME_OK && run->glb_feather) {
+		status = plume_embedding_create(scene->feather, scene->mesh, &run->carried, err);
+		if (status == PLUME_OK)
+			plume_mesh_animation_set_feather(run->animation, run->carried);
+	}
 	if (status != PLUME_OK)
 		return status;
 	if (mkdir(path, 0777) != 0)
@@ -314,11 +324,17 @@ static plume_status simulate(const plume_scene *scene, cli_output *output, run_s
 int cli_simulate(int argc, char **argv)
 {
 	static const struct option options[] = {
-	    {"output", required_argument, NULL, 'o'}, {"seed", required_argument, NULL, 's'},
-	    {"png", no_argument, NULL, 'p'},          {"size", required_argument, NULL, 'S'},
-	    {"view", required_argument, NULL, 'V'},   {"render", no_argument, NULL, 'R'},
-	    {"spp", required_argument, NULL, 'P'},    {"fields", no_argument, NULL, 'F'},
-	    {"help", no_argument, NULL, 'h'},         {NULL, 0, NULL, 0},
+	    {"output", required_argument, NULL, 'o'},
+	    {"seed", required_argument, NULL, 's'},
+	    {"png", no_argument, NULL, 'p'},
+	    {"size", required_argument, NULL, 'S'},
+	    {"view", required_argument, NULL, 'V'},
+	    {"render", no_argument, NULL, 'R'},
+	    {"spp", required_argument, NULL, 'P'},
+	    {"fields", no_argument, NULL, 'F'},
+	    {"glb-feather", no_argument, NULL, 'G'},
+	    {"help", no_argument, NULL, 'h'},
+	    {NULL, 0, NULL, 0},
 	};
 	const char *output_dir = NULL;
 	plume_spec_options spec_options = {0};
@@ -353,6 +369,7 @@ int cli_simulate(int argc, char **argv)
 		}
 		case 'R': run.render = true; break;
 		case 'F': run.fields = true; break;
+		case 'G': run.glb_feather = true; break;
 		case 'P': {
 			char *end = NULL;
 			long value = strtol(optarg, &end, 10);
@@ -384,6 +401,10 @@ int cli_simulate(int argc, char **argv)
 	if (scene->handle_count > 0) {
 		run.view.bounds_min = lo;
 		run.view.bounds_max = hi;
+	}
+	if (run.glb_feather && scene->feather == NULL) {
+		plume_scene_destroy(scene);
+		return cli_usage_error("simulate", "--glb-feather needs a scene whose feather is generated (not guides)");
 	}
 	if (run.render) {
 		if (scene->feather == NULL) {
@@ -417,6 +438,7 @@ int cli_simulate(int argc, char **argv)
 		       summary.max_barb_strain, summary.rachis_tip_deflection, run.frames, output_dir);
 	plume_scene_destroy(scene);
 	plume_mesh_animation_destroy(run.animation);
+	plume_embedding_destroy(run.carried);
 	free(run.field_times);
 	cli_barb_renderer_end(&run.renderer);
 	if (status != PLUME_OK)

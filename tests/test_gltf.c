@@ -405,6 +405,86 @@ static void test_shell_and_animation_read_back(void **state)
 	plume_feather_destroy(feather);
 }
 
+/// Points of a feather in the order the carried-feather lines hold them: shaft, left
+/// barbs, right barbs, barbules (curves of two points or more).
+static int feather_points(const plume_feather *feather, plume_vec3 *out)
+{
+	plume_feather_info info = plume_feather_get_info(feather);
+	int n = 0;
+	if (info.shaft_sample_count >= 2)
+		for (int i = 0; i < info.shaft_sample_count; ++i)
+			out[n++] = plume_feather_shaft(feather)[i].position;
+	for (int side = 0; side < 2; ++side)
+		for (int b = 0; b < info.barb_count; ++b) {
+			plume_barb barb = plume_feather_barb(feather, b);
+			if ((int)barb.side == side && barb.curve.count >= 2)
+				for (int j = 0; j < barb.curve.count; ++j)
+					out[n++] = barb.curve.points[j];
+		}
+	for (int b = 0; b < info.barbule_count; ++b) {
+		plume_barbule barbule = plume_feather_barbule(feather, b);
+		if (barbule.curve.count >= 2)
+			for (int j = 0; j < barbule.curve.count; ++j)
+				out[n++] = barbule.curve.points[j];
+	}
+	return n;
+}
+
+static void test_carried_feather(void **state)
+{
+	(void)state;
+	plume_feather *feather = blue();
+	plume_mesh *mesh = blue_mesh(feather);
+	plume_error err;
+	plume_barb_embedding *embedding = NULL;
+	assert_int_equal(plume_embedding_create(feather, mesh, &embedding, &err), PLUME_OK);
+	plume_mesh_animation *animation = NULL;
+	assert_int_equal(plume_mesh_animation_create(mesh, NULL, &animation, &err), PLUME_OK);
+	plume_mesh_animation_set_feather(animation, embedding);
+	plume_vec3 *x[2];
+	for (int k = 0; k < 2; ++k) {
+		x[k] = malloc((size_t)mesh->vertex_count * sizeof(plume_vec3));
+		for (int i = 0; i < mesh->vertex_count; ++i) // frame 1: the shell bends out of its plane
+			x[k][i] = plume_v3_add(mesh->rest[i], plume_v3(0, 0, 0.3 * k * mesh->rest[i].y * mesh->rest[i].y));
+		assert_int_equal(plume_mesh_animation_add_frame(animation, 0.1 * k, x[k], &err), PLUME_OK);
+	}
+	char path[512];
+	snprintf(path, sizeof path, "%s/carried.glb", scratch);
+	assert_int_equal(plume_mesh_animation_write_glb(animation, path, &err), PLUME_OK);
+	glb_file g = glb_read(path);
+	json_t *primitive = primitive_of(&g, "feather", 0);
+	assert_int_equal(json_integer_value(json_object_get(primitive, "mode")), 1);
+	int n;
+	const float *base = floats(&g, attribute(primitive, "POSITION"), &n, 3);
+	plume_feather_info info = plume_feather_get_info(feather);
+	plume_vec3 *want = malloc((size_t)(info.point_count + info.shaft_sample_count) * sizeof(plume_vec3));
+	for (int k = 0; k < 2; ++k) {
+		plume_feather *moved = NULL;
+		assert_int_equal(plume_embedding_apply(embedding, x[k], &moved, &err), PLUME_OK);
+		assert_int_equal(feather_points(moved, want), n);
+		int nt;
+		json_t *target = json_array_get(json_object_get(primitive, "targets"), (size_t)k);
+		const float *d = floats(&g, (int)json_integer_value(json_object_get(target, "POSITION")), &nt, 3);
+		assert_int_equal(nt, n);
+		for (int i = 0; i < n; ++i) {
+			assert_close((double)base[3 * i] + d[3 * i], want[i].x, 1e-6);
+			assert_close((double)base[3 * i + 2] + d[3 * i + 2], want[i].z, 1e-6);
+		}
+		plume_feather_destroy(moved);
+	}
+	// The animation drives both nodes.
+	json_t *channels = json_object_get(json_array_get(json_object_get(g.doc, "animations"), 0), "channels");
+	assert_int_equal(json_array_size(channels), 2);
+	glb_free(&g);
+	free(want);
+	free(x[0]);
+	free(x[1]);
+	plume_mesh_animation_destroy(animation);
+	plume_embedding_destroy(embedding);
+	plume_mesh_destroy(mesh);
+	plume_feather_destroy(feather);
+}
+
 static void test_coat_instances(void **state)
 {
 	(void)state;
@@ -492,6 +572,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test(test_feather_ribbons_read_back),
 	    cmocka_unit_test(test_shell_and_animation_read_back),
+	    cmocka_unit_test(test_carried_feather),
 	    cmocka_unit_test(test_coat_instances),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);

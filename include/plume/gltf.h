@@ -98,6 +98,15 @@ plume_status plume_mesh_animation_add_frame(plume_mesh_animation *animation, dou
 
 int plume_mesh_animation_frame_count(const plume_mesh_animation *animation);
 
+struct plume_barb_embedding;
+
+/// Carries a feather by the shell (include/plume/embed.h): the .glb then also has a
+/// node "feather", the embedded feather's shaft, barbs and barbules as line
+/// segments (LINES, with texture coordinates and colours) with one morph target per
+/// frame, played by the same animation. At barb level this is large: about 12 bytes
+/// per feather point and frame. The embedding must outlive the animation.
+void plume_mesh_animation_set_feather(plume_mesh_animation *animation, const struct plume_barb_embedding *embedding);
+
 /// Writes the frames so far (at least one) as .glb.
 plume_status plume_mesh_animation_write_glb(const plume_mesh_animation *animation, const char *path, plume_error *err);
 

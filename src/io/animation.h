@@ -11,6 +11,7 @@ struct plume_mesh_animation {
 	double *times;
 	double *first;        ///< the first frame in double, the base the displacements are taken from
 	float *displacements; ///< frame_count * vertex_count * 3: frame minus first frame
+	const struct plume_barb_embedding *embedding; ///< the carried feather (plume_mesh_animation_set_feather), or NULL
 };
 
 #endif

@@ -13,6 +13,7 @@
 
 #include "../core/alloc.h"
 #include "glb.h"
+#include "plume/embed.h"
 #include "plume/gltf.h"
 
 plume_gltf_def plume_gltf_default_def(void)
@@ -464,4 +465,96 @@ plume_status plume_coat_write_glb_report(const plume_coat *coat, const plume_glt
 plume_status plume_coat_write_glb(const plume_coat *coat, const plume_gltf_def *def, const char *path, plume_error *err)
 {
 	return plume_coat_write_glb_report(coat, def, path, NULL, err);
+}
+
+// ---------------------------------------------------------------------------
+// A feather carried by an animated shell
+
+/// Appends part b's vertices and indices to a (lines only: no ribbons across parts).
+static bool part_append(part *a, const part *b)
+{
+	if (b->vertices == 0) // an empty part has no arrays (memcpy from NULL is undefined even for 0 bytes)
+		return !a->failed;
+	if (!part_reserve(a, b->vertices, b->index_count))
+		return false;
+	int v = a->vertices;
+	memcpy(a->position + 3 * v, b->position, 3 * (size_t)b->vertices * sizeof(double));
+	memcpy(a->normal + 3 * v, b->normal, 3 * (size_t)b->vertices * sizeof(double));
+	memcpy(a->uv + 2 * v, b->uv, 2 * (size_t)b->vertices * sizeof(double));
+	memcpy(a->color + 4 * v, b->color, 4 * (size_t)b->vertices * sizeof(double));
+	for (int64_t i = 0; i < b->index_count; ++i)
+		a->indices[a->index_count + i] = b->indices[i] + (uint32_t)v;
+	a->vertices += b->vertices;
+	a->index_count += b->index_count;
+	return true;
+}
+
+/// The moved feather of one frame as a single part of line segments.
+static bool carried_lines(const plume_barb_embedding *embedding, const plume_vec3 *positions, const plume_gltf_def *def,
+                          part *out)
+{
+	plume_feather *moved = NULL;
+	plume_error err;
+	if (plume_embedding_apply(embedding, positions, &moved, &err) != PLUME_OK)
+		return false;
+	plume_gltf_def lines = *def;
+	lines.curves = PLUME_GLTF_LINES;
+	part parts[PART_COUNT];
+	memset(parts, 0, sizeof parts);
+	bool ok = build_parts(moved, &lines, plume_v3(0, 0, 0), parts);
+	memset(out, 0, sizeof *out);
+	for (int k = 0; ok && k < PART_COUNT; ++k)
+		ok = part_append(out, &parts[k]);
+	for (int k = 0; k < PART_COUNT; ++k)
+		part_free(&parts[k]);
+	plume_feather_destroy(moved);
+	return ok;
+}
+
+int plume_glb_carried_feather(plume_glb *glb, const plume_barb_embedding *embedding, const plume_vec3 *const *frames,
+                              int frame_count, const plume_gltf_def *def, bool *ok)
+{
+	part base;
+	if (!carried_lines(embedding, frames[0], def, &base)) {
+		*ok = false;
+		return 0;
+	}
+	json_t *targets = json_array();
+	float *displacement = plume_alloc(3 * (size_t)(base.vertices > 0 ? base.vertices : 1) * sizeof(float));
+	*ok = targets != NULL && displacement != NULL;
+	for (int k = 0; *ok && k < frame_count; ++k) {
+		part moved;
+		*ok = carried_lines(embedding, frames[k], def, &moved) && moved.vertices == base.vertices;
+		for (int i = 0; *ok && i < 3 * base.vertices; ++i)
+			displacement[i] = (float)(moved.position[i] - base.position[i]);
+		if (*ok)
+			json_array_append_new(
+			    targets, json_pack("{s:i}", "POSITION",
+			                       plume_glb_floats_f(glb, displacement, base.vertices, 3, GLB_ARRAY_BUFFER, true)));
+		part_free(&moved);
+	}
+	int node = 0;
+	if (*ok) {
+		int position = plume_glb_floats(glb, base.position, base.vertices, 3, GLB_ARRAY_BUFFER, true);
+		int uv = plume_glb_floats(glb, base.uv, base.vertices, 2, GLB_ARRAY_BUFFER, false);
+		int color = plume_glb_floats(glb, base.color, base.vertices, 4, GLB_ARRAY_BUFFER, false);
+		int indices = plume_glb_indices(glb, base.indices, base.index_count);
+		static const double white[4] = {1, 1, 1, 1};
+		int material = plume_glb_material(glb, "barbs", white);
+		json_t *weights = json_array();
+		for (int k = 0; k < frame_count; ++k)
+			json_array_append_new(weights, json_real(k == 0 ? 1.0 : 0.0));
+		json_t *primitive =
+		    json_pack("{s:{s:i, s:i, s:i}, s:i, s:i, s:i, s:o}", "attributes", "POSITION", position, "TEXCOORD_0", uv,
+		              "COLOR_0", color, "indices", indices, "mode", 1, "material", material, "targets", targets);
+		targets = NULL;
+		int mesh = plume_glb_append(
+		    glb, glb->meshes,
+		    json_pack("{s:s, s:[o], s:o}", "name", "feather", "primitives", primitive, "weights", weights));
+		node = plume_glb_append(glb, glb->nodes, json_pack("{s:s, s:i}", "name", "feather", "mesh", mesh));
+	}
+	json_decref(targets);
+	plume_free(displacement);
+	part_free(&base);
+	return node;
 }

@@ -208,6 +208,35 @@ plume_status plume_mesh_animation_add_frame(plume_mesh_animation *a, double time
 
 int plume_mesh_animation_frame_count(const plume_mesh_animation *a) { return a->frame_count; }
 
+void plume_mesh_animation_set_feather(plume_mesh_animation *a, const struct plume_barb_embedding *embedding)
+{
+	a->embedding = embedding;
+}
+
+/// The feather carried by every frame (plume_glb_carried_feather), frames rebuilt from the stored floats.
+static int carried_feather(plume_glb *glb, const plume_mesh_animation *a, bool *ok)
+{
+	int n = a->mesh->vertex_count, frames = a->frame_count;
+	plume_vec3 *positions = plume_alloc((size_t)frames * (size_t)(n > 0 ? n : 1) * sizeof(plume_vec3));
+	const plume_vec3 **list = plume_alloc((size_t)frames * sizeof *list);
+	int node = 0;
+	*ok = positions != NULL && list != NULL;
+	if (*ok) {
+		for (int k = 0; k < frames; ++k) {
+			plume_vec3 *x = positions + (size_t)k * (size_t)n;
+			const float *d = a->displacements + (size_t)k * 3 * (size_t)n;
+			for (int i = 0; i < n; ++i)
+				x[i] = plume_v3(a->first[3 * i] + d[3 * i], a->first[3 * i + 1] + d[3 * i + 1],
+				                a->first[3 * i + 2] + d[3 * i + 2]);
+			list[k] = x;
+		}
+		node = plume_glb_carried_feather(glb, a->embedding, list, frames, &a->def, ok);
+	}
+	plume_free(positions);
+	plume_free(list);
+	return node;
+}
+
 plume_status plume_mesh_animation_write_glb(const plume_mesh_animation *a, const char *path, plume_error *err)
 {
 	if (a->frame_count == 0)
@@ -247,6 +276,11 @@ plume_status plume_mesh_animation_write_glb(const plume_mesh_animation *a, const
 		                                            primitives, "weights", initial, "extras", "targetNames", names));
 		int node = plume_glb_append(&glb, glb.nodes, json_pack("{s:s, s:i}", "name", "shell", "mesh", mesh_index));
 		plume_glb_scene_root(&glb, node);
+		int feather = -1;
+		if (ok && a->embedding != NULL) {
+			feather = carried_feather(&glb, a, &ok);
+			plume_glb_scene_root(&glb, feather);
+		}
 
 		float *times = plume_alloc((size_t)frames * sizeof(float));
 		ok = ok && times != NULL;
@@ -261,6 +295,11 @@ plume_status plume_mesh_animation_write_glb(const plume_mesh_animation *a, const
 			json_t *animation = json_pack("{s:s, s:[{s:i, s:s, s:i}], s:[{s:i, s:{s:i, s:s}}]}", "name", "simulation",
 			                              "samplers", "input", input, "interpolation", "LINEAR", "output", output,
 			                              "channels", "sampler", 0, "target", "node", node, "path", "weights");
+			// The carried feather's weights follow the same keys (it has as many targets).
+			if (feather >= 0)
+				json_array_append_new(
+				    json_object_get(animation, "channels"),
+				    json_pack("{s:i, s:{s:i, s:s}}", "sampler", 0, "target", "node", feather, "path", "weights"));
 			json_t *animations = json_array();
 			plume_glb_append(&glb, animations, animation);
 			if (json_object_set_new(glb.root, "animations", animations) != 0)

@@ -56,8 +56,11 @@ expect_failure "calibrate negative Eb" 3 "E_b is -1" "$plume" lab calibrate --ph
 expect_failure "calibrate aspect" 3 "aspect ratio" "$plume" lab calibrate --phi 0.14 --Eb 3.92e4 --EB 2.57e9 --aspect 0.0001
 expect_failure "calibrate not a number" 2 "--aspect expects a number" "$plume" lab calibrate --phi 0.14 --Eb 3.92e4 --EB 2.57e9 --aspect tall
 # A coarse, quick calibration: E_vv and E_ww of thesis Table 5.2.
-"$plume" lab calibrate --phi 0.14 --Eb 3.92e4 --EB 2.57e9 --elements 600 --macro-elements 300 --unconstrained --phases 1 >"$scratch/cal.json" 2>"$scratch/err.txt"
-check "calibrate succeeds ($(cat "$scratch/err.txt"))" test $? -eq 0
+"$plume" lab calibrate --phi 0.14 --Eb 3.92e4 --EB 2.57e9 --elements 600 --macro-elements 300 --unconstrained --phases 1 -o "$scratch/cal" >"$scratch/cal.json" 2>"$scratch/err.txt"
+status=$?
+check "calibrate succeeds ($(cat "$scratch/err.txt"))" test "$status" -eq 0
+check "calibrate -o: calibration.json is what stdout showed" cmp -s "$scratch/cal.json" "$scratch/cal/calibration.json"
+check "calibrate -o: slopes.csv has four slopes" test "$(grep -c ',mesoscale,\|,macroscale,' "$scratch/cal/slopes.csv")" -eq 4
 check "calibrate: JSON" python3 -c "
 import json, sys
 r = json.load(open('$scratch/cal.json'))  # stdout holds the JSON and nothing else
