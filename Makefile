@@ -1,11 +1,12 @@
 # plume — the two commands of the README, and a few conveniences.
 #   make demo   install missing Debian packages (as root), build, run `plume demo`
 #   make test   the same setup, then every test through CTest
+#   make viewer the browser viewer of `plume view` (node and npm; make build tries it too)
 BUILD ?= build
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 CMAKE_FLAGS ?= -DCMAKE_BUILD_TYPE=Release
 
-.PHONY: all deps configure build demo test bench install clean format blender-addon
+.PHONY: all deps configure build demo test bench install clean format viewer blender-addon
 
 all: build
 
@@ -17,6 +18,10 @@ configure: deps
 
 build: configure
 	@cmake --build $(BUILD) -j $(JOBS)
+	@scripts/viewer.sh $(BUILD) --optional
+
+viewer: build
+	@scripts/viewer.sh $(BUILD)
 
 demo: build
 	$(BUILD)/plume demo -o plume-demo

@@ -125,6 +125,7 @@ int cli_render(int argc, char **argv);
 int cli_lab(int argc, char **argv);
 int cli_demo(int argc, char **argv);
 int cli_sweep(int argc, char **argv);
+int cli_view(int argc, char **argv);
 
 void cli_help_generate(void);
 void cli_help_grow(void);
@@ -135,5 +136,6 @@ void cli_help_render(void);
 void cli_help_lab(void);
 void cli_help_demo(void);
 void cli_help_sweep(void);
+void cli_help_view(void);
 
 #endif

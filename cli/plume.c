@@ -20,6 +20,7 @@ static const command commands[] = {
     {"render", "ray-trace a feather, a coat or a simulation", cli_render, cli_help_render},
     {"lab", "virtual lab: traction tests, calibration, studies", cli_lab, cli_help_lab},
     {"sweep", "run a command over many parameter values, locally (-j N) or with MPI", cli_sweep, cli_help_sweep},
+    {"view", "write a web page that shows .glb files in a browser (three.js)", cli_view, cli_help_view},
     {"demo", "generate the built-in feather end to end, no input needed", cli_demo, cli_help_demo},
 };
 enum { COMMAND_COUNT = sizeof commands / sizeof commands[0] };
