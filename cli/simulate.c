@@ -111,14 +111,16 @@ typedef struct run_state {
 	int field_capacity;
 } run_state;
 
-static plume_status write_frame(run_state *run, int frame, const plume_sim *sim, plume_error *err)
+// time: the scene's time of the step (plume_sim_time stays 0 in quasi-static scenes,
+// whose keyframed handles still move with it).
+static plume_status write_frame(run_state *run, int frame, double time, const plume_sim *sim, plume_error *err)
 {
 	char name[64], path[4352];
 	snprintf(name, sizeof name, "frames/%04d.obj", frame);
 	cli_output_path(run->output, name, path, sizeof path);
 	plume_status status = plume_mesh_write_obj(run->scene->mesh, plume_sim_positions(sim), path, err);
 	if (status == PLUME_OK)
-		status = plume_mesh_animation_add_frame(run->animation, plume_sim_time(sim), plume_sim_positions(sim), err);
+		status = plume_mesh_animation_add_frame(run->animation, time, plume_sim_positions(sim), err);
 	if (status == PLUME_OK && run->fields) {
 		if (frame >= run->field_capacity) {
 			int capacity = run->field_capacity > 0 ? 2 * run->field_capacity : 64;
@@ -128,7 +130,7 @@ static plume_status write_frame(run_state *run, int frame, const plume_sim *sim,
 			run->field_times = times;
 			run->field_capacity = capacity;
 		}
-		run->field_times[frame] = plume_sim_time(sim);
+		run->field_times[frame] = time;
 		status = cli_fields_write_frame(run->output, run->scene, sim, frame, err);
 	}
 	if (status == PLUME_OK && run->png) {
@@ -189,7 +191,7 @@ static plume_status on_step(void *user, int step, double time, const plume_sim *
 		show_progress(run, step, time);
 	bool last = step == run->total_steps;
 	if (step % run->scene->frame_every == 0 || last)
-		return write_frame(run, run->frames, sim, err);
+		return write_frame(run, run->frames, time, sim, err);
 	return PLUME_OK;
 }
 
