@@ -22,6 +22,19 @@ check() { # check NAME CONDITION...
 	fi
 }
 
+# succeeded NAME: the command just before exited 0; when it did not, its exit
+# code and $scratch/err.txt. Call it on the next line: it reads $? first, so
+# NAME must hold no command substitution ("$(...)" would reset $? to 0).
+succeeded() {
+	local status=$? name=$1
+	if [ "$status" -eq 0 ]; then
+		passed=$((passed + 1))
+	else
+		failed=$((failed + 1))
+		echo "FAIL: $name (exit $status): $(cat "$scratch/err.txt" 2>/dev/null)" >&2
+	fi
+}
+
 # expect_failure NAME EXIT_CODE MESSAGE_FRAGMENT COMMAND...: the exit code and
 # the message on stderr.
 expect_failure() {

@@ -12,7 +12,7 @@ for spec in "$presets"/*.json; do
 	name=$(basename "$spec" .json)
 	out=$scratch/$name
 	"$plume" generate "$spec" -o "$out" --format png,obj,usda --size 200x300 2>"$scratch/err.txt"
-	check "$name: generate succeeds ($(cat "$scratch/err.txt"))" test $? -eq 0
+	succeeded "$name: generate succeeds"
 	for ext in png obj usda; do
 		check "$name: feather.$ext written" test -s "$out/feather.$ext"
 	done
@@ -29,7 +29,7 @@ check "another seed, another down feather" bash -c "! cmp -s '$scratch/a/feather
 
 # --- grow -------------------------------------------------------------------------
 "$plume" grow "$presets/contour.json" -o "$scratch/grow" --frames 5 --size 160x240 2>"$scratch/err.txt"
-check "grow succeeds ($(cat "$scratch/err.txt"))" test $? -eq 0
+succeeded "grow succeeds"
 check "grow: 5 frames x png, obj, usda" test "$(ls "$scratch/grow" | wc -l)" -eq 15
 for i in 0000 0004; do
 	for ext in png obj usda; do
@@ -68,7 +68,7 @@ check "grow: adds frames to an existing folder" test "$(ls "$scratch/existing" |
 for spec in "$coats"/figure15-hexagonal.json "$coats"/figure16-poisson.json; do
 	name=$(basename "$spec" .json)
 	"$plume" coat "$spec" -o "$scratch/$name" --size 300x300 2>"$scratch/err.txt"
-	check "$name: coat succeeds ($(cat "$scratch/err.txt"))" test $? -eq 0
+	succeeded "$name: coat succeeds"
 	for file in coat.png coat.obj coat.usda; do
 		check "$name: $file written" test -s "$scratch/$name/$file"
 	done

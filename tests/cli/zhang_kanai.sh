@@ -12,7 +12,7 @@ for spec in "$examples"/*.json; do
 	name=$(basename "$spec" .json)
 	out=$scratch/$name
 	"$plume" generate "$spec" -o "$out" --format png,obj,usda,json --size 200x400 >"$scratch/stdout.txt" 2>"$scratch/err.txt"
-	check "$name: generate succeeds ($(cat "$scratch/err.txt"))" test $? -eq 0
+	succeeded "$name: generate succeeds"
 	for ext in png obj usda json; do
 		check "$name: feather.$ext written" test -s "$out/feather.$ext"
 	done
@@ -43,7 +43,7 @@ done
 # --- growth and unfurling sequences through plume grow -----------------------
 "$plume" grow "$examples/figure8-contour.json" -o "$scratch/grow" --frames 4 --format png,obj --size 200x400 \
 	>/dev/null 2>"$scratch/err.txt"
-check "grow: succeeds ($(cat "$scratch/err.txt"))" test $? -eq 0
+succeeded "grow: succeeds"
 check "grow: four PNG frames" test "$(ls "$scratch/grow"/frame-*.png 2>/dev/null | wc -l)" -eq 4
 barbs() { grep -c '^l ' "$1"; }
 if [ -s "$scratch/grow/frame-0003.obj" ]; then
@@ -53,7 +53,7 @@ if [ -s "$scratch/grow/frame-0003.obj" ]; then
 	check "grow: the last frame is the finished feather" cmp -s "$scratch/grow/frame-0003.obj" "$scratch/final/feather.obj"
 fi
 "$plume" grow "$examples/figure8-contour.json" -o "$scratch/unfurl" --frames 3 --unfurl --format obj >/dev/null 2>"$scratch/err.txt"
-check "grow --unfurl: succeeds ($(cat "$scratch/err.txt"))" test $? -eq 0
+succeeded "grow --unfurl: succeeds"
 if [ -s "$scratch/unfurl/frame-0000.obj" ] && [ -s "$scratch/unfurl/frame-0002.obj" ]; then
 	check "grow --unfurl: frames differ" bash -c "! cmp -s '$scratch/unfurl/frame-0000.obj' '$scratch/unfurl/frame-0002.obj'"
 	check "grow --unfurl: same barbs in every frame" test "$(barbs "$scratch/unfurl/frame-0000.obj")" -eq \
