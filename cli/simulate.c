@@ -164,8 +164,12 @@ static plume_status write_summary(cli_output *output, const plume_scene *scene, 
 {
 	json_t *root = json_object();
 	json_object_set_new(root, "completed", json_boolean(failure == NULL));
-	if (failure != NULL)
+	if (failure != NULL) {
 		json_object_set_new(root, "error", json_string(failure->message));
+		// Where it stopped: the first step that did not converge, and its time.
+		json_object_set_new(root, "failed_step", json_integer(summary->steps + 1));
+		json_object_set_new(root, "failed_time", json_real((summary->steps + 1) * scene->sim.time_step));
+	}
 	json_object_set_new(root, "steps", json_integer(summary->steps));
 	json_object_set_new(root, "frames", json_integer(run->frames));
 	json_object_set_new(root, "time", json_real(summary->steps * scene->sim.time_step));
@@ -236,7 +240,8 @@ static plume_status simulate(const plume_scene *scene, cli_output *output, run_s
 	if (fclose(run->stats) != 0)
 		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write", path);
 	// A run that failed part way keeps what it wrote; input and I/O errors keep nothing.
-	if (run_status != PLUME_OK && (run_status != PLUME_ERROR_NUMERIC || summary->steps == 0)) {
+	// A failed first step keeps frame 0 and a summary saying so (docs/cli.md).
+	if (run_status != PLUME_OK && run_status != PLUME_ERROR_NUMERIC) {
 		*err = *failure;
 		return run_status;
 	}
@@ -342,12 +347,12 @@ int cli_simulate(int argc, char **argv)
 	status = cli_output_begin(&output, output_dir, &err);
 	if (status == PLUME_OK) {
 		plume_status run_status = simulate(scene, &output, &run, &summary, &failure, &err);
-		bool keep = run_status == PLUME_OK || (run_status == PLUME_ERROR_NUMERIC && summary.steps > 0);
+		bool keep = run_status == PLUME_OK || run_status == PLUME_ERROR_NUMERIC;
 		status = keep ? cli_output_commit(&output, &err) : (cli_output_abort(&output), run_status);
 		if (status == PLUME_OK)
 			status = run_status;
 	}
-	if (status == PLUME_OK || summary.steps > 0)
+	if (status == PLUME_OK || status == PLUME_ERROR_NUMERIC)
 		printf("%d steps, %d Newton iterations (%.2f a step), %.2f s wall; largest barb strain %.3g; "
 		       "rachis tip deflection %.6g m; %d frames in %s\n",
 		       summary.steps, summary.newton_iterations,

@@ -43,6 +43,7 @@ typedef enum plume_status {
 	PLUME_ERROR_MEMORY = 4,      ///< an allocation failed
 	PLUME_ERROR_NUMERIC = 5,     ///< a computation did not converge or produced NaN
 	PLUME_ERROR_UNSUPPORTED = 6, ///< a format or feature that this build does not have
+	PLUME_ERROR_LIMIT = 7,       ///< the work would pass a resource limit (see plume_spec_options.max_memory)
 } plume_status;
 
 /// Human-readable message for a failed call. Filled by the callee, never
