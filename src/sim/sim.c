@@ -561,7 +561,9 @@ plume_status plume_sim_solve_static(plume_sim *sim, plume_solve_report *report, 
 			if (status != PLUME_OK)
 				break;
 		}
-		if (status == PLUME_OK)
+		// Substeps help a step that did not converge, not one that ran out of memory:
+		// a retry that then succeeded would make the result depend on the allocator.
+		if (status != PLUME_ERROR_NUMERIC)
 			break;
 	}
 	total.max_barb_strain = plume_sim_max_barb_strain(sim, sim->x);
@@ -617,7 +619,9 @@ plume_status plume_sim_step(plume_sim *sim, plume_solve_report *report, plume_er
 			for (int i = 0; i < sim->vertex_count; ++i)
 				sim->v[i] = plume_v3_scale(plume_v3_sub(sim->x[i], sim->previous[i]), 1 / h);
 		}
-		if (status == PLUME_OK)
+		// Substeps help a step that did not converge, not one that ran out of memory:
+		// a retry that then succeeded would make the result depend on the allocator.
+		if (status != PLUME_ERROR_NUMERIC)
 			break;
 	}
 	if (status != PLUME_OK) {
