@@ -53,6 +53,12 @@ typedef struct plume_error {
 	char message[1024];
 } plume_error;
 
+/// Set by the *_default_def() functions in a definition's `cookie` field, and
+/// asserted by the functions that take the definition: a definition struct that
+/// was declared but never initialised from its default is a programmer error
+/// caught in debug builds (Box2D's b2_secret_cookie).
+#define PLUME_DEF_COOKIE 0x706c756du
+
 /// Short stable name of a status ("io", "syntax", "spec", ...).
 const char *plume_status_name(plume_status status);
 

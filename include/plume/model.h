@@ -74,6 +74,8 @@ typedef struct plume_fw_def {
 	/// Barb width at its root and at its tip, m, > 0. Defaults 1.5e-4 and 3e-5.
 	double barb_width_base;
 	double barb_width_tip;
+	/// PLUME_DEF_COOKIE, set by plume_fw_default_def; do not change.
+	uint32_t cookie;
 } plume_fw_def;
 
 /// A 0.2 m contour feather close to the paper's hawk feather (Table 2).

@@ -2,6 +2,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "spec.h"
 
+#include <assert.h>
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
@@ -300,7 +301,8 @@ bool plume_spec_points2(plume_spec_reader *reader, const json_t *object, const c
 		return false;
 	}
 	plume_vec2 points[64];
-	for (int i = 0; i < count && i < 64; ++i) {
+	assert(count >= 0 && count <= 64 && "plume_spec_points2 reads at most 64 points");
+	for (int i = 0; i < count; ++i) {
 		const json_t *point = json_array_get(value, (size_t)i);
 		char item[540];
 		plume_spec_index_path(item, sizeof item, child, (size_t)i);

@@ -1,6 +1,7 @@
 // Feather coats (Streit & Heidrich 4.4): follicles on a surface, key feathers,
 // interpolated feathers placed by normal, direction field and lift, in drawing
 // order from the bottom feather to the top one.
+#include <assert.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -29,11 +30,16 @@ const plume_feather *plume_coat_feather(const plume_coat *coat, int index)
 
 void plume_coat_follicle(const plume_coat *coat, int index, plume_vec3 *position, plume_vec3 *normal)
 {
+	assert(coat != NULL && index >= 0 && index < coat->count);
 	*position = coat->roots[index];
 	*normal = coat->normals[index];
 }
 
-bool plume_coat_is_key(const plume_coat *coat, int index) { return coat->is_key[index]; }
+bool plume_coat_is_key(const plume_coat *coat, int index)
+{
+	assert(coat != NULL && index >= 0 && index < coat->count);
+	return coat->is_key[index];
+}
 
 const plume_mesh *plume_coat_surface(const plume_coat *coat) { return coat->surface; }
 
