@@ -13,7 +13,7 @@
 #include <string.h>
 
 #include "../core/alloc.h"
-#include "../io/export.h"
+#include "export.h"
 #include "plume/mesh.h"
 
 /// Group names the writer gives each material; the reader maps them back.
