@@ -41,6 +41,7 @@ void cli_help_simulate(void)
 	     "                      carried by the shell) to frames/NNNN-rt.png, and make\n"
 	     "                      DIR/movie.mp4 when ffmpeg is installed\n"
 	     "      --spp N         samples per pixel of --render (default 4)\n"
+	     "      --max-memory SIZE  refuse a run whose frames would pass SIZE bytes (default 4G)\n"
 	     "  -h, --help          this help\n"
 	     "\n"
 	     "Scenes are described in docs/scene.md; examples/scenes/ has ready ones.");
@@ -262,10 +263,12 @@ int cli_simulate(int argc, char **argv)
 	    {"render", no_argument, NULL, 'R'},
 	    {"spp", required_argument, NULL, 'P'},
 	    {"help", no_argument, NULL, 'h'},
+	    {"max-memory", required_argument, NULL, 'M'},
 	    {NULL, 0, NULL, 0},
 	};
 	const char *output_dir = NULL;
 	plume_spec_options spec_options = {0};
+	uint64_t max_bytes = PLUME_DEFAULT_MAX_MEMORY;
 	run_state run = {0};
 	run.view = plume_shell_view_default_def();
 	int spp = 4;
@@ -304,6 +307,10 @@ int cli_simulate(int argc, char **argv)
 			spp = (int)value;
 			break;
 		}
+		case 'M':
+			if (!cli_parse_memory("simulate", optarg, &max_bytes))
+				return CLI_EXIT_USAGE;
+			break;
 		case 'h': cli_help_simulate(); return CLI_EXIT_OK;
 		case ':': return cli_usage_error("simulate", "option '%s' needs a value", argv[optind - 1]);
 		default: return cli_usage_error("simulate", "unknown option '%s'", argv[optind - 1]);
@@ -319,6 +326,19 @@ int cli_simulate(int argc, char **argv)
 		return cli_fail(&err);
 	run.scene = scene;
 	run.total_steps = (int)ceil(scene->duration / scene->sim.time_step - 1e-9);
+	// The frames' bytes before the run: an OBJ line is at most about 80 bytes
+	// (three %.17g coordinates), a PNG at most its raw pixels.
+	double frame_count = (double)run.total_steps / scene->frame_every + 2.0;
+	double frame_bytes = 80.0 * (scene->mesh->vertex_count + scene->mesh->face_count) +
+	                     ((run.png ? 1 : 0) + (run.render ? 1 : 0)) * 4.0 * run.view.width * run.view.height;
+	if (frame_count * frame_bytes > (double)max_bytes) {
+		fprintf(stderr,
+		        "plume: %s: $.duration: %.0f frames of up to %.3g MB each would write %.3g GB; the limit is %.3g GB "
+		        "(raise it with --max-memory, or raise $.frame_every or $.time_step)\n",
+		        argv[optind], frame_count, frame_bytes / 1e6, frame_count * frame_bytes / 1e9, (double)max_bytes / 1e9);
+		plume_scene_destroy(scene);
+		return CLI_EXIT_LIMIT;
+	}
 	run.progress = isatty(STDERR_FILENO);
 	// Handles keep the feather in place: one framing for the whole sequence. A free
 	// feather (falling) is followed frame by frame.

@@ -105,6 +105,16 @@ expect_no_output "render feather.json 1e308" 3 'feather.json: $.' "$scratch/o14"
 	$T "$plume" render "$sim" -o "$scratch/o14" --spp 1 --size 32x32
 check "render 1e308: names the range" grep -qF 'is outside the range of any value plume reads' "$scratch/err.txt"
 
+# --- a simulation whose frames would pass --max-memory: refused before the run -----------
+edit "$bad/scene-short.json" "$bad/scene-long.json" "d['duration'] = 1e4; d['time_step'] = 0.001; d['frame_every'] = 1"
+expect_no_output "frames past the limit" 5 'frames of up to' "$scratch/o15" \
+	$T "$plume" simulate "$bad/scene-long.json" -o "$scratch/o15"
+check "frames limit names --max-memory" grep -qF 'raise it with --max-memory' "$scratch/err.txt"
+expect_no_output "PNG frames past a 1M limit" 5 'the limit is 0.00105 GB' "$scratch/o16" \
+	$T "$plume" simulate "$bad/scene-short.json" -o "$scratch/o16" --png --max-memory 1M
+$T "$plume" simulate "$bad/scene-short.json" -o "$scratch/o17" --max-memory 64M >/dev/null 2>&1
+check "a short run fits in 64M" test -s "$scratch/o17/summary.json"
+
 # --- all or nothing over an earlier run (cli/output.c) -----------------------------------
 edit "$bad/scene-short.json" "$bad/scene-three.json" "d['duration'] = 0.033"
 run=$scratch/run
