@@ -189,6 +189,11 @@ bool cli_parse_memory(const char *command, const char *text, uint64_t *bytes)
 
 static void remove_tree(const char *path)
 {
+	struct stat link_info;
+	if (lstat(path, &link_info) == 0 && S_ISLNK(link_info.st_mode)) {
+		unlink(path); // never into what a link points at
+		return;
+	}
 	DIR *dir = opendir(path);
 	if (dir != NULL) {
 		struct dirent *entry;
@@ -269,6 +274,17 @@ plume_status cli_output_begin(cli_output *output, const char *dir, plume_error *
 	remove_stale_staging(parent_dir, prefix);
 	if (output->dir_existed)
 		remove_stale_staging(output->dir, ".plume-staging-");
+	// DIR a symbolic link to a folder: swapping would replace the link, not the
+	// folder; stage inside the folder it names and move entry by entry instead.
+	struct stat link_info;
+	if (output->dir_existed && lstat(output->dir, &link_info) == 0 && S_ISLNK(link_info.st_mode)) {
+		output->stage_inside = true;
+		snprintf(output->stage, sizeof output->stage, "%s/.plume-staging-%ld-XXXXXX", output->dir, (long)getpid());
+		if (mkdtemp(output->stage) == NULL)
+			return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write the output folder: %s", output->dir,
+			                       strerror(errno));
+		return PLUME_OK;
+	}
 	snprintf(output->stage, sizeof output->stage, "%.*s%s%ld-XXXXXX", parent, output->dir, prefix, (long)getpid());
 	if (mkdtemp(output->stage) != NULL)
 		return PLUME_OK;

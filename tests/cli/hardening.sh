@@ -153,4 +153,14 @@ expect_failure "a folder named like an output" 4 'feather.obj: the run writes a 
 check "that folder is intact" test "$(cat "$gen/feather.obj/inside.txt")" = mine
 check "no staging left after the conflict" test -z "$(ls -A "$scratch" | grep plume-staging)"
 
+# DIR a symbolic link to a folder: the folder gets the run, the link stays a link.
+mkdir -p "$scratch/real"
+echo mine >"$scratch/real/notes.txt"
+ln -s real "$scratch/link"
+$T "$plume" generate "$examples/franco-walter/blue.json" -o "$scratch/link" --format json >/dev/null 2>&1
+check "a linked DIR: still a link" test -L "$scratch/link"
+check "a linked DIR: the run is in the folder" test -s "$scratch/real/feather.json"
+check "a linked DIR: the user's file kept" test "$(cat "$scratch/real/notes.txt")" = mine
+check "a linked DIR: no staging left" test -z "$(ls -A "$scratch" "$scratch/real" | grep plume-staging)"
+
 finish
