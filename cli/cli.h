@@ -13,6 +13,7 @@ enum {
 	CLI_EXIT_USAGE = 2,   ///< bad command line
 	CLI_EXIT_INPUT = 3,   ///< a spec or input file is malformed or has a bad value
 	CLI_EXIT_IO = 4,      ///< a file could not be read or written
+	CLI_EXIT_LIMIT = 5,   ///< refused before the work: past a resource limit (--max-memory)
 };
 
 /// Output formats, as a bit set.
@@ -52,6 +53,8 @@ bool cli_parse_style(const char *command, const char *text, plume_render_style *
 
 /// Parses a decimal seed.
 bool cli_parse_seed(const char *command, const char *text, uint64_t *seed);
+/// Parses --max-memory: bytes with an optional K, M, G or T suffix (powers of 1024), at least 1M.
+bool cli_parse_memory(const char *command, const char *text, uint64_t *bytes);
 
 /// How a feather's images are drawn.
 typedef struct cli_image_options {
@@ -60,12 +63,13 @@ typedef struct cli_image_options {
 } cli_image_options;
 
 // A set of output files written all together or not at all: files go to a
-// staging folder beside or inside the destination and are moved in place only
-// when every one of them was written.
+// staging folder beside the destination, which replaces it in one rename only
+// when every one of them was written (cli/output.c says how).
 typedef struct cli_output {
 	char dir[2048];
 	char stage[4160];
 	bool dir_existed;
+	bool stage_inside; ///< staged inside DIR (its parent is not writable): committed entry by entry
 	char names[32][80];
 	int name_count;
 } cli_output;

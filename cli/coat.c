@@ -27,6 +27,7 @@ void cli_help_coat(void)
 	     "      --style STYLE      lines (default) or strips: barbs as alpha-faded triangle\n"
 	     "                         strips (Streit & Heidrich 4.3.1)\n"
 	     "      --stage G          grow every feather to stage G in [0, 1] (default 1)\n"
+	     "      --max-memory SIZE  refuse a coat estimated to need more (default 4G; docs/cli.md)\n"
 	     "  -h, --help             this help\n"
 	     "\n"
 	     "Coat specs are described in docs/coats.md; examples/coats/ has ready ones.");
@@ -83,10 +84,15 @@ static plume_status write_coat(cli_output *output, const plume_coat *coat, unsig
 int cli_coat(int argc, char **argv)
 {
 	static const struct option options[] = {
-	    {"output", required_argument, NULL, 'o'}, {"seed", required_argument, NULL, 's'},
-	    {"format", required_argument, NULL, 'f'}, {"size", required_argument, NULL, 'S'},
-	    {"style", required_argument, NULL, 'y'},  {"stage", required_argument, NULL, 'g'},
-	    {"help", no_argument, NULL, 'h'},         {NULL, 0, NULL, 0},
+	    {"output", required_argument, NULL, 'o'},
+	    {"seed", required_argument, NULL, 's'},
+	    {"format", required_argument, NULL, 'f'},
+	    {"size", required_argument, NULL, 'S'},
+	    {"style", required_argument, NULL, 'y'},
+	    {"stage", required_argument, NULL, 'g'},
+	    {"help", no_argument, NULL, 'h'},
+	    {"max-memory", required_argument, NULL, 'M'},
+	    {NULL, 0, NULL, 0},
 	};
 	const char *output_dir = NULL;
 	unsigned formats = CLI_FORMAT_PNG | CLI_FORMAT_OBJ | CLI_FORMAT_USDA;
@@ -123,6 +129,10 @@ int cli_coat(int argc, char **argv)
 			if (!parse_stage(optarg, &spec_options.stage))
 				return CLI_EXIT_USAGE;
 			spec_options.stage_kind = PLUME_STAGE_GROWTH;
+			break;
+		case 'M':
+			if (!cli_parse_memory("coat", optarg, &spec_options.max_memory))
+				return CLI_EXIT_USAGE;
 			break;
 		case 'h': cli_help_coat(); return CLI_EXIT_OK;
 		case ':': return cli_usage_error("coat", "option '%s' needs a value", argv[optind - 1]);

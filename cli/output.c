@@ -1,6 +1,8 @@
 // Output sets: all files of one run appear together or not at all.
-#define _POSIX_C_SOURCE 200809L
+#define _GNU_SOURCE // renameat2
 #include <dirent.h>
+#include <fcntl.h>
+#include <signal.h>
 #include <errno.h>
 #include <limits.h>
 #include <stdarg.h>
@@ -20,6 +22,7 @@ int cli_fail(const plume_error *err)
 	case PLUME_ERROR_IO: return CLI_EXIT_IO;
 	case PLUME_ERROR_SYNTAX:
 	case PLUME_ERROR_SPEC: return CLI_EXIT_INPUT;
+	case PLUME_ERROR_LIMIT: return CLI_EXIT_LIMIT;
 	default: return CLI_EXIT_FAILURE;
 	}
 }
@@ -122,11 +125,75 @@ bool cli_parse_seed(const char *command, const char *text, uint64_t *seed)
 	return true;
 }
 
+bool cli_parse_memory(const char *command, const char *text, uint64_t *bytes)
+{
+	char *end;
+	errno = 0;
+	double value = strtod(text, &end);
+	double unit = 1.0;
+	switch (*end) {
+	case 'K':
+	case 'k':
+		unit = 1024.0;
+		++end;
+		break;
+	case 'M':
+	case 'm':
+		unit = 1048576.0;
+		++end;
+		break;
+	case 'G':
+	case 'g':
+		unit = 1073741824.0;
+		++end;
+		break;
+	case 'T':
+	case 't':
+		unit = 1099511627776.0;
+		++end;
+		break;
+	default: break;
+	}
+	if (*end == 'B' || *end == 'b')
+		++end;
+	double total = value * unit;
+	if (errno != 0 || end == text || *end != '\0' || !(total >= 1048576.0 && total <= 1e18)) {
+		cli_usage_error(command, "--max-memory '%s' must be a size such as 512M, 8G or 1T, at least 1M", text);
+		return false;
+	}
+	*bytes = (uint64_t)total;
+	return true;
+}
+
 // ---------------------------------------------------------------------------
 // Staging
+//
+// A run writes into a staging folder beside DIR, ".NAME.plume-staging-PID-XXXXXX"
+// (same parent, so the same file system). When every file is written:
+//  - a new DIR: the staging folder is renamed to DIR;
+//  - an existing DIR: every entry of DIR the run does not write is hard-linked
+//    into the staging folder (a folder the run writes too, such as frames/, is
+//    merged: the user's files in it are linked, the earlier run's frames are
+//    not), then renameat2(RENAME_EXCHANGE) swaps the two folders in one step and
+//    the earlier run, now under the staging name, is removed. The user's files
+//    live on through their second link; nothing plume did not write is lost,
+//    and a reader sees the whole earlier run or the whole new one, never a mix.
+// Without RENAME_EXCHANGE (a kernel or file system without it) DIR is renamed
+// aside and the staging folder renamed into place: two renames with a moment
+// in between where DIR is absent, but never mixed. Without hard links (vfat)
+// the run fails and DIR keeps the earlier run. When the parent folder is not
+// writable, the staging folder goes inside DIR and entries move one by one.
+// The PID in the name lets a later run remove staging folders whose run died
+// (Ctrl-C, a kill, a crash): only folders of exactly that pattern, only when
+// that process is gone.
 
 static void remove_tree(const char *path)
 {
+	struct stat link_info;
+	if (lstat(path, &link_info) == 0 && S_ISLNK(link_info.st_mode)) {
+		unlink(path); // never into what a link points at
+		return;
+	}
 	DIR *dir = opendir(path);
 	if (dir != NULL) {
 		struct dirent *entry;
@@ -135,7 +202,11 @@ static void remove_tree(const char *path)
 				continue;
 			char child[4352];
 			snprintf(child, sizeof child, "%s/%s", path, entry->d_name);
-			remove_tree(child);
+			struct stat info;
+			if (lstat(child, &info) == 0 && S_ISDIR(info.st_mode))
+				remove_tree(child);
+			else
+				unlink(child);
 		}
 		closedir(dir);
 		rmdir(path);
@@ -144,13 +215,47 @@ static void remove_tree(const char *path)
 	}
 }
 
+/// True for "PREFIX<pid>-XXXXXX" whose process no longer runs; *pid receives it.
+static bool stale_staging(const char *name, const char *prefix)
+{
+	size_t length = strlen(prefix);
+	if (strncmp(name, prefix, length) != 0)
+		return false;
+	char *end;
+	errno = 0;
+	long pid = strtol(name + length, &end, 10);
+	if (errno != 0 || end == name + length || pid <= 0 || *end != '-' || strlen(end + 1) != 6)
+		return false;
+	return pid != (long)getpid() && kill((pid_t)pid, 0) != 0 && errno == ESRCH;
+}
+
+/// Removes staging folders an earlier, dead plume left beside DIR (and, from
+/// plume versions that staged inside DIR, those in it).
+static void remove_stale_staging(const char *parent, const char *prefix)
+{
+	DIR *dir = opendir(parent);
+	if (dir == NULL)
+		return;
+	struct dirent *entry;
+	while ((entry = readdir(dir)) != NULL) {
+		if (!stale_staging(entry->d_name, prefix))
+			continue;
+		char path[4608];
+		snprintf(path, sizeof path, "%s/%s", parent, entry->d_name);
+		struct stat info;
+		if (lstat(path, &info) == 0 && S_ISDIR(info.st_mode) && info.st_uid == geteuid())
+			remove_tree(path);
+	}
+	closedir(dir);
+}
+
 plume_status cli_output_begin(cli_output *output, const char *dir, plume_error *err)
 {
 	memset(output, 0, sizeof *output);
 	size_t length = strlen(dir);
 	while (length > 1 && dir[length - 1] == '/')
 		--length;
-	if (length == 0 || length + 32 >= sizeof output->dir)
+	if (length == 0 || length + 64 >= sizeof output->dir)
 		return plume_error_set(err, PLUME_ERROR_IO, "'%s': not a usable output folder", dir);
 	memcpy(output->dir, dir, length);
 	output->dir[length] = '\0';
@@ -160,14 +265,35 @@ plume_status cli_output_begin(cli_output *output, const char *dir, plume_error *
 		if (!S_ISDIR(info.st_mode))
 			return plume_error_set(err, PLUME_ERROR_IO, "%s: exists and is not a folder", output->dir);
 		output->dir_existed = true;
-		snprintf(output->stage, sizeof output->stage, "%s/.plume-staging-XXXXXX", output->dir);
-	} else {
-		// A new folder is staged beside it and renamed into place whole.
-		const char *slash = strrchr(output->dir, '/');
-		int parent = slash != NULL ? (int)(slash - output->dir + 1) : 0;
-		snprintf(output->stage, sizeof output->stage, "%.*s.%s.plume-staging-XXXXXX", parent, output->dir,
-		         output->dir + parent);
 	}
+	const char *slash = strrchr(output->dir, '/');
+	int parent = slash != NULL ? (int)(slash - output->dir + 1) : 0;
+	char prefix[2200], parent_dir[2100];
+	snprintf(prefix, sizeof prefix, ".%s.plume-staging-", output->dir + parent);
+	snprintf(parent_dir, sizeof parent_dir, "%.*s", parent > 0 ? parent : 1, parent > 0 ? output->dir : ".");
+	remove_stale_staging(parent_dir, prefix);
+	if (output->dir_existed)
+		remove_stale_staging(output->dir, ".plume-staging-");
+	// DIR a symbolic link to a folder: swapping would replace the link, not the
+	// folder; stage inside the folder it names and move entry by entry instead.
+	struct stat link_info;
+	if (output->dir_existed && lstat(output->dir, &link_info) == 0 && S_ISLNK(link_info.st_mode)) {
+		output->stage_inside = true;
+		snprintf(output->stage, sizeof output->stage, "%s/.plume-staging-%ld-XXXXXX", output->dir, (long)getpid());
+		if (mkdtemp(output->stage) == NULL)
+			return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write the output folder: %s", output->dir,
+			                       strerror(errno));
+		return PLUME_OK;
+	}
+	snprintf(output->stage, sizeof output->stage, "%.*s%s%ld-XXXXXX", parent, output->dir, prefix, (long)getpid());
+	if (mkdtemp(output->stage) != NULL)
+		return PLUME_OK;
+	if (!output->dir_existed)
+		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write the output folder: %s", output->dir,
+		                       strerror(errno));
+	// An existing DIR in a parent we may not write: stage inside DIR, move entry by entry.
+	output->stage_inside = true;
+	snprintf(output->stage, sizeof output->stage, "%s/.plume-staging-%ld-XXXXXX", output->dir, (long)getpid());
 	if (mkdtemp(output->stage) == NULL)
 		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write the output folder: %s", output->dir,
 		                       strerror(errno));
@@ -184,23 +310,79 @@ const char *cli_output_path(cli_output *output, const char *name, char *buffer, 
 	return buffer;
 }
 
-plume_status cli_output_commit(cli_output *output, plume_error *err)
+/// Whether name is one plume writes inside a folder of a run (frames/0012.obj,
+/// 0012-rt.png, ...): a digit first. An earlier run's files of that kind are
+/// replaced by the new run's folder; anything else in it is the user's.
+static bool plume_frame_name(const char *name) { return name[0] >= '0' && name[0] <= '9'; }
+
+/// Hard-links the tree at from to to (folders recreated with their mode). 0 or an errno.
+static int link_tree(const char *from, const char *to)
 {
-	if (!output->dir_existed) {
-		// mkdtemp made the folder 0700; a results folder is ordinary.
-		mode_t mask = umask(0);
-		umask(mask);
-		chmod(output->stage, 0777 & ~mask);
-		if (rename(output->stage, output->dir) != 0) {
-			plume_error_set(err, PLUME_ERROR_IO, "%s: cannot create the output folder: %s", output->dir,
-			                strerror(errno));
-			cli_output_abort(output);
-			return PLUME_ERROR_IO;
-		}
-		return PLUME_OK;
+	struct stat info;
+	if (lstat(from, &info) != 0)
+		return errno;
+	if (!S_ISDIR(info.st_mode))
+		return linkat(AT_FDCWD, from, AT_FDCWD, to, 0) == 0 ? 0 : errno;
+	if (mkdir(to, info.st_mode & 07777) != 0)
+		return errno;
+	DIR *dir = opendir(from);
+	if (dir == NULL)
+		return errno;
+	int failure = 0;
+	struct dirent *entry;
+	while (failure == 0 && (entry = readdir(dir)) != NULL) {
+		if (strcmp(entry->d_name, ".") == 0 || strcmp(entry->d_name, "..") == 0)
+			continue;
+		char a[4608], b[4608];
+		snprintf(a, sizeof a, "%s/%s", from, entry->d_name);
+		snprintf(b, sizeof b, "%s/%s", to, entry->d_name);
+		failure = link_tree(a, b);
 	}
-	// Every entry of the staging folder replaces its namesake. A folder (frames/) that
-	// exists is moved aside first and removed only once the new one is in place.
+	closedir(dir);
+	return failure;
+}
+
+/// Carries every entry of old (DIR or a folder in it) that the run did not
+/// write into stage, by hard links. 0, an errno, or -1 when a folder of DIR
+/// has the name of a file of the run (or the reverse): plume will not delete it.
+static int carry_over(const char *old, const char *stage, int depth, char *conflict, size_t conflict_size)
+{
+	DIR *dir = opendir(old);
+	if (dir == NULL)
+		return errno;
+	int failure = 0;
+	struct dirent *entry;
+	while (failure == 0 && (entry = readdir(dir)) != NULL) {
+		const char *name = entry->d_name;
+		if (strcmp(name, ".") == 0 || strcmp(name, "..") == 0 || strncmp(name, ".plume-staging-", 15) == 0)
+			continue;
+		char a[4608], b[4608];
+		snprintf(a, sizeof a, "%s/%s", old, name);
+		snprintf(b, sizeof b, "%s/%s", stage, name);
+		struct stat old_info, new_info;
+		if (lstat(a, &old_info) != 0)
+			continue;
+		if (lstat(b, &new_info) == 0) {
+			if (S_ISDIR(old_info.st_mode) && S_ISDIR(new_info.st_mode)) {
+				failure = carry_over(a, b, depth + 1, conflict, conflict_size);
+			} else if (S_ISDIR(old_info.st_mode) != S_ISDIR(new_info.st_mode)) {
+				snprintf(conflict, conflict_size, "%s", a);
+				failure = -1;
+			}
+			continue; // the run's file replaces the earlier one
+		}
+		if (depth > 0 && plume_frame_name(name) && !S_ISDIR(old_info.st_mode))
+			continue; // an earlier run's frame: the new frames/ replaces it
+		failure = link_tree(a, b);
+	}
+	closedir(dir);
+	return failure;
+}
+
+/// The per-entry commit, for an existing DIR whose parent plume may not write (so
+/// nothing can be staged beside it): each staged entry replaces its namesake.
+static plume_status commit_by_moves(cli_output *output, plume_error *err)
+{
 	DIR *stage = opendir(output->stage);
 	if (stage == NULL) {
 		plume_error_set(err, PLUME_ERROR_IO, "%s: cannot read the staging folder: %s", output->stage, strerror(errno));
@@ -236,6 +418,76 @@ plume_status cli_output_commit(cli_output *output, plume_error *err)
 		return status;
 	}
 	rmdir(output->stage);
+	return PLUME_OK;
+}
+
+/// Swaps stage and dir in one step; falls back to two renames. 0 or an errno.
+static int exchange(const char *stage, const char *dir)
+{
+#ifdef RENAME_EXCHANGE
+	if (renameat2(AT_FDCWD, stage, AT_FDCWD, dir, RENAME_EXCHANGE) == 0)
+		return 0;
+	if (errno != EINVAL && errno != ENOSYS && errno != ENOTSUP)
+		return errno;
+#endif
+	char aside[4200];
+	snprintf(aside, sizeof aside, "%s-old", stage); // still the staging pattern's prefix: removed if we die here
+	if (rename(dir, aside) != 0)
+		return errno;
+	if (rename(stage, dir) != 0) {
+		int failure = errno;
+		rename(aside, dir);
+		return failure;
+	}
+	return rename(aside, stage) == 0 ? 0 : errno;
+}
+
+plume_status cli_output_commit(cli_output *output, plume_error *err)
+{
+	if (output->stage_inside)
+		return commit_by_moves(output, err);
+	struct stat info;
+	if (!output->dir_existed || stat(output->dir, &info) != 0) {
+		// mkdtemp made the folder 0700; a results folder is ordinary.
+		mode_t mask = umask(0);
+		umask(mask);
+		chmod(output->stage, 0777 & ~mask);
+		if (rename(output->stage, output->dir) != 0) {
+			plume_error_set(err, PLUME_ERROR_IO, "%s: cannot create the output folder: %s", output->dir,
+			                strerror(errno));
+			cli_output_abort(output);
+			return PLUME_ERROR_IO;
+		}
+		return PLUME_OK;
+	}
+	char conflict[4608] = "";
+	int failure = carry_over(output->dir, output->stage, 0, conflict, sizeof conflict);
+	if (failure == EPERM || failure == ENOTSUP || failure == EXDEV || failure == EMLINK) {
+		// No hard links here (vfat, some network file systems): keeping the earlier
+		// run intact matters more than this run; say how to get it.
+		plume_error_set(err, PLUME_ERROR_IO,
+		                "%s: this file system cannot hard-link the folder's other files into the new run (%s); "
+		                "write to a new folder instead",
+		                output->dir, strerror(failure));
+		cli_output_abort(output);
+		return PLUME_ERROR_IO;
+	}
+	if (failure == -1) {
+		plume_error_set(err, PLUME_ERROR_IO, "%s: the run writes a file or folder of that name; move it away first",
+		                conflict);
+		cli_output_abort(output);
+		return PLUME_ERROR_IO;
+	}
+	if (failure == 0) {
+		chmod(output->stage, info.st_mode & 07777);
+		failure = exchange(output->stage, output->dir);
+	}
+	if (failure != 0) {
+		plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write: %s", output->dir, strerror(failure));
+		cli_output_abort(output);
+		return PLUME_ERROR_IO;
+	}
+	remove_tree(output->stage); // the earlier run; the user's files live on in DIR
 	return PLUME_OK;
 }
 

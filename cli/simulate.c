@@ -54,6 +54,7 @@ void cli_help_simulate(void)
 	     "                      stress in the barb frame, barb angle, material, membrane,\n"
 	     "                      compression and bending energy densities; per vertex\n"
 	     "                      velocity and handle (docs/formats.md)\n"
+	     "      --max-memory SIZE  refuse a run whose frames would pass SIZE bytes (default 4G)\n"
 	     "  -h, --help          this help\n"
 	     "\n"
 	     "Scenes are described in docs/scene.md; examples/scenes/ has ready ones.");
@@ -218,8 +219,12 @@ static plume_status write_summary(cli_output *output, const plume_scene *scene, 
 {
 	json_t *root = json_object();
 	json_object_set_new(root, "completed", json_boolean(failure == NULL));
-	if (failure != NULL)
+	if (failure != NULL) {
 		json_object_set_new(root, "error", json_string(failure->message));
+		// Where it stopped: the first step that did not converge, and its time.
+		json_object_set_new(root, "failed_step", json_integer(summary->steps + 1));
+		json_object_set_new(root, "failed_time", json_real((summary->steps + 1) * scene->sim.time_step));
+	}
 	json_object_set_new(root, "steps", json_integer(summary->steps));
 	json_object_set_new(root, "frames", json_integer(run->frames));
 	json_object_set_new(root, "time", json_real(summary->steps * scene->sim.time_step));
@@ -305,7 +310,8 @@ static plume_status simulate(const plume_scene *scene, cli_output *output, run_s
 	if (fclose(run->stats) != 0)
 		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write", path);
 	// A run that failed part way keeps what it wrote; input and I/O errors keep nothing.
-	if (run_status != PLUME_OK && (run_status != PLUME_ERROR_NUMERIC || summary->steps == 0)) {
+	// A failed first step keeps frame 0 and a summary saying so (docs/cli.md).
+	if (run_status != PLUME_OK && run_status != PLUME_ERROR_NUMERIC) {
 		*err = *failure;
 		return run_status;
 	}
@@ -336,10 +342,12 @@ int cli_simulate(int argc, char **argv)
 	    {"fields", no_argument, NULL, 'F'},
 	    {"glb-feather", no_argument, NULL, 'G'},
 	    {"help", no_argument, NULL, 'h'},
+	    {"max-memory", required_argument, NULL, 'M'},
 	    {NULL, 0, NULL, 0},
 	};
 	const char *output_dir = NULL;
 	plume_spec_options spec_options = {0};
+	uint64_t max_bytes = PLUME_DEFAULT_MAX_MEMORY;
 	run_state run = {0};
 	run.view = plume_shell_view_default_def();
 	int spp = 4;
@@ -380,6 +388,10 @@ int cli_simulate(int argc, char **argv)
 			spp = (int)value;
 			break;
 		}
+		case 'M':
+			if (!cli_parse_memory("simulate", optarg, &max_bytes))
+				return CLI_EXIT_USAGE;
+			break;
 		case 'h': cli_help_simulate(); return CLI_EXIT_OK;
 		case ':': return cli_usage_error("simulate", "option '%s' needs a value", argv[optind - 1]);
 		default: return cli_usage_error("simulate", "unknown option '%s'", argv[optind - 1]);
@@ -395,6 +407,19 @@ int cli_simulate(int argc, char **argv)
 		return cli_fail(&err);
 	run.scene = scene;
 	run.total_steps = (int)ceil(scene->duration / scene->sim.time_step - 1e-9);
+	// The frames' bytes before the run: an OBJ line is at most about 80 bytes
+	// (three %.17g coordinates), a PNG at most its raw pixels.
+	double frame_count = (double)run.total_steps / scene->frame_every + 2.0;
+	double frame_bytes = 80.0 * (scene->mesh->vertex_count + scene->mesh->face_count) +
+	                     ((run.png ? 1 : 0) + (run.render ? 1 : 0)) * 4.0 * run.view.width * run.view.height;
+	if (frame_count * frame_bytes > (double)max_bytes) {
+		fprintf(stderr,
+		        "plume: %s: $.duration: %.0f frames of up to %.3g MB each would write %.3g GB; the limit is %.3g GB "
+		        "(raise it with --max-memory, or raise $.frame_every or $.time_step)\n",
+		        argv[optind], frame_count, frame_bytes / 1e6, frame_count * frame_bytes / 1e9, (double)max_bytes / 1e9);
+		plume_scene_destroy(scene);
+		return CLI_EXIT_LIMIT;
+	}
 	run.progress = isatty(STDERR_FILENO);
 	// Handles keep the feather in place: one framing for the whole sequence. A free
 	// feather (falling) is followed frame by frame.
@@ -427,12 +452,12 @@ int cli_simulate(int argc, char **argv)
 	status = cli_output_begin(&output, output_dir, &err);
 	if (status == PLUME_OK) {
 		plume_status run_status = simulate(scene, &output, &run, &summary, &failure, &err);
-		bool keep = run_status == PLUME_OK || (run_status == PLUME_ERROR_NUMERIC && summary.steps > 0);
+		bool keep = run_status == PLUME_OK || run_status == PLUME_ERROR_NUMERIC;
 		status = keep ? cli_output_commit(&output, &err) : (cli_output_abort(&output), run_status);
 		if (status == PLUME_OK)
 			status = run_status;
 	}
-	if (status == PLUME_OK || summary.steps > 0)
+	if (status == PLUME_OK || status == PLUME_ERROR_NUMERIC)
 		printf("%d steps, %d Newton iterations (%.2f a step), %.2f s wall; largest barb strain %.3g; "
 		       "rachis tip deflection %.6g m; %d frames in %s\n",
 		       summary.steps, summary.newton_iterations,

@@ -1,5 +1,7 @@
 // Bézier curves: closed forms, elevation, splitting, arc length.
+#define _POSIX_C_SOURCE 200809L
 #include <math.h>
+#include <unistd.h>
 
 #include "support.h"
 
@@ -140,6 +142,24 @@ static void test_degenerate_point_curve(void **state)
 		assert_true(t[k] > t[k - 1]);
 }
 
+// Issue 17: a Franco-Walter shaft point of [1e308, 1e308] hung `generate`; the
+// speed overflows to inf, no tolerance is ever met, and the recursion went to
+// depth 30 everywhere (2^30 quadratures per interval). The subdivision budget
+// bounds the work whatever the values; alarm() turns a hang into a failure.
+static void test_huge_control_points_finish(void **state)
+{
+	(void)state;
+	alarm(60);
+	plume_vec3 p[4] = {{0, 0, 0}, {0.0015, 0.07, 0}, {0.005, 0.14, 0}, {1e308, 1e308, 0}};
+	double t[100];
+	plume_bezier_sample_by_length(p, 4, 100, t);
+	assert_true(t[0] == 0.0 && t[99] == 1.0);
+	for (int k = 1; k < 100; ++k)
+		assert_true(t[k] >= 0.0 && t[k] <= 1.0);
+	assert_false(isfinite(plume_bezier_length(p, 4, 0, 1)));
+	alarm(0);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -151,6 +171,7 @@ int main(void)
 	    cmocka_unit_test(test_length_of_line_and_quarter_circle),
 	    cmocka_unit_test(test_sampling_by_arc_length_is_equal),
 	    cmocka_unit_test(test_degenerate_point_curve),
+	    cmocka_unit_test(test_huge_control_points_finish),
 	};
 	return cmocka_run_group_tests_name("bezier", tests, NULL, NULL);
 }

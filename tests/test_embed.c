@@ -199,6 +199,17 @@ static void test_bad_shells(void **state)
 	assert_null(moved);
 	free(positions);
 	plume_embedding_destroy(embedding);
+	embedding = NULL;
+
+	// Issue 17: a barb point Embree's float query cannot place (NaN, or a
+	// feather.json coordinate of 1e308) is on no face; it read frames[-1].
+	feather->points[feather->point_count / 2].x = NAN;
+	assert_int_equal(plume_embedding_create(feather, mesh, &embedding, &err), PLUME_ERROR_SPEC);
+	assert_non_null(strstr(err.message, "lies on no face of the shell"));
+	assert_null(embedding);
+	feather->points[feather->point_count / 2].x = 1e308;
+	assert_int_equal(plume_embedding_create(feather, mesh, &embedding, &err), PLUME_ERROR_SPEC);
+	assert_null(embedding);
 	plume_mesh_destroy(mesh);
 	plume_feather_destroy(feather);
 	assert_int_equal(plume_bytes_in_use(), bytes_before);

@@ -43,6 +43,7 @@ typedef enum plume_status {
 	PLUME_ERROR_MEMORY = 4,      ///< an allocation failed
 	PLUME_ERROR_NUMERIC = 5,     ///< a computation did not converge or produced NaN
 	PLUME_ERROR_UNSUPPORTED = 6, ///< a format or feature that this build does not have
+	PLUME_ERROR_LIMIT = 7,       ///< the work would pass a resource limit (see plume_spec_options.max_memory)
 } plume_status;
 
 /// Human-readable message for a failed call. Filled by the callee, never
@@ -51,6 +52,12 @@ typedef struct plume_error {
 	plume_status status;
 	char message[1024];
 } plume_error;
+
+/// Set by the *_default_def() functions in a definition's `cookie` field, and
+/// asserted by the functions that take the definition: a definition struct that
+/// was declared but never initialised from its default is a programmer error
+/// caught in debug builds (Box2D's b2_secret_cookie).
+#define PLUME_DEF_COOKIE 0x706c756du
 
 /// Short stable name of a status ("io", "syntax", "spec", ...).
 const char *plume_status_name(plume_status status);

@@ -70,6 +70,8 @@ typedef struct plume_mesh_def {
 	double rachis_width_tip;
 	/// Keep the bare calamus below the vane as rachis faces. Default true.
 	bool include_calamus;
+	/// PLUME_DEF_COOKIE, set by plume_mesh_default_def; do not change.
+	uint32_t cookie;
 } plume_mesh_def;
 
 plume_mesh_def plume_mesh_default_def(void);

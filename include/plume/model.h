@@ -74,6 +74,8 @@ typedef struct plume_fw_def {
 	/// Barb width at its root and at its tip, m, > 0. Defaults 1.5e-4 and 3e-5.
 	double barb_width_base;
 	double barb_width_tip;
+	/// PLUME_DEF_COOKIE, set by plume_fw_default_def; do not change.
+	uint32_t cookie;
 } plume_fw_def;
 
 /// A 0.2 m contour feather close to the paper's hawk feather (Table 2).
@@ -110,7 +112,13 @@ typedef struct plume_spec_options {
 	plume_stage_kind stage_kind;
 	/// Stage in [0, 1] for PLUME_STAGE_GROWTH and PLUME_STAGE_UNFURL.
 	double stage;
+	/// Bytes the model may build (estimated before the work; PLUME_ERROR_LIMIT past it). 0 means
+	/// PLUME_DEFAULT_MAX_MEMORY, so that a zero-initialised options struct keeps working.
+	uint64_t max_memory;
 } plume_spec_options;
+
+/// The default of plume_spec_options.max_memory and of the CLI's --max-memory: 4 GiB.
+#define PLUME_DEFAULT_MAX_MEMORY (4ull << 30)
 
 /// Reads a feather spec from path and generates it. Syntax errors read
 /// "path:line:column: ..."; value errors "path: $.key.path: ...".

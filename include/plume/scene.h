@@ -51,6 +51,9 @@ typedef struct plume_scene_force {
 	plume_vec3 force;
 } plume_scene_force;
 
+/// The most steps one scene may take (duration / time_step): the count is an int.
+#define PLUME_SCENE_MAX_STEPS 10000000
+
 typedef struct plume_scene {
 	/// The generated feather (NULL when the scene gives explicit guides).
 	plume_feather *feather;
@@ -61,7 +64,7 @@ typedef struct plume_scene {
 	plume_scene_handle *handles;
 	int force_count;
 	plume_scene_force *forces;
-	/// Simulated time, s, > 0.
+	/// Simulated time, s, > 0; duration / sim.time_step at most PLUME_SCENE_MAX_STEPS.
 	double duration;
 	/// Write every n-th step as a frame, >= 1. Default 1.
 	int frame_every;

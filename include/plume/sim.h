@@ -90,6 +90,8 @@ typedef struct plume_sim_def {
 	/// Fix every vertex's z: in-plane problems (the lab's samples). Default false.
 	bool planar;
 	plume_solver_def solver;
+	/// PLUME_DEF_COOKIE, set by plume_sim_default_def; do not change.
+	uint32_t cookie;
 } plume_sim_def;
 
 plume_sim_def plume_sim_default_def(void);

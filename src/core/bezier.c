@@ -110,15 +110,22 @@ static double gauss8(const plume_vec3 *hodograph, int count, double a, double b)
 	return sum * half;
 }
 
+// Subdivisions one length may spend. A smooth curve converges in a few dozen;
+// the budget bounds the work independently of the values, so control points
+// near DBL_MAX (whose speed overflows to inf and never meets a tolerance) cost
+// a few milliseconds instead of 2^30 quadratures.
+enum { ADAPTIVE_BUDGET = 4096 };
+
 static double adaptive_length(const plume_vec3 *hodograph, int count, double a, double b, double whole,
-                              double tolerance, int depth)
+                              double tolerance, int depth, int *budget)
 {
 	double mid = 0.5 * (a + b);
 	double left = gauss8(hodograph, count, a, mid), right = gauss8(hodograph, count, mid, b);
-	if (depth >= 30 || fabs(left + right - whole) <= tolerance)
+	if (depth >= 30 || *budget <= 0 || !isfinite(left + right) || fabs(left + right - whole) <= tolerance)
 		return left + right;
-	return adaptive_length(hodograph, count, a, mid, left, 0.5 * tolerance, depth + 1) +
-	       adaptive_length(hodograph, count, mid, b, right, 0.5 * tolerance, depth + 1);
+	--*budget;
+	return adaptive_length(hodograph, count, a, mid, left, 0.5 * tolerance, depth + 1, budget) +
+	       adaptive_length(hodograph, count, mid, b, right, 0.5 * tolerance, depth + 1, budget);
 }
 
 /// Writes the hodograph (a single zero point for a point curve); returns its count.
@@ -145,7 +152,8 @@ static double curve_length(const plume_vec3 *hodograph, int count, double scale,
 {
 	// The control polygon bounds the length from above: it sets the absolute tolerance.
 	double tolerance = 1e-13 * (scale > 0.0 ? scale : 1.0);
-	return adaptive_length(hodograph, count, t0, t1, gauss8(hodograph, count, t0, t1), tolerance, 0);
+	int budget = ADAPTIVE_BUDGET;
+	return adaptive_length(hodograph, count, t0, t1, gauss8(hodograph, count, t0, t1), tolerance, 0, &budget);
 }
 
 double plume_bezier_length(const plume_vec3 *points, int count, double t0, double t1)

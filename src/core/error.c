@@ -16,6 +16,7 @@ const char *plume_status_name(plume_status status)
 	case PLUME_ERROR_MEMORY: return "memory";
 	case PLUME_ERROR_NUMERIC: return "numeric";
 	case PLUME_ERROR_UNSUPPORTED: return "unsupported";
+	case PLUME_ERROR_LIMIT: return "limit";
 	}
 	return "unknown";
 }

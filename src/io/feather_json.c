@@ -13,6 +13,7 @@
 // bad input gives a message with its JSON path and never a crash.
 #define _POSIX_C_SOURCE 200809L
 #include "export.h"
+#include "spec.h"
 
 #include <errno.h>
 #include <limits.h>
@@ -589,6 +590,11 @@ plume_status plume_read_json(const char *path, plume_feather **out, plume_error 
 		return plume_error_set(err, PLUME_ERROR_SYNTAX, "%s:%d:%d: %s", path, error.line, error.column, error.text);
 	}
 
+	plume_status checked = plume_spec_check_numbers(path, root, err);
+	if (checked != PLUME_OK) {
+		json_decref(root);
+		return checked;
+	}
 	reader r = {.file = path, .err = err, .path = "$", .length = 1};
 	plume_feather *feather = plume_feather_create_empty();
 	plume_status status = feather != NULL ? read_feather(&r, root, feather, true) : out_of_memory(&r);

@@ -2,6 +2,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "spec.h"
 
+#include <assert.h>
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
@@ -19,9 +20,56 @@ json_t *plume_spec_load(const char *path, plume_error *err)
 	json_error_t error;
 	json_t *root = json_loadf(file, JSON_REJECT_DUPLICATES, &error);
 	fclose(file);
-	if (root == NULL)
+	if (root == NULL) {
 		plume_error_set(err, PLUME_ERROR_SYNTAX, "%s:%d:%d: %s", path, error.line, error.column, error.text);
+		return NULL;
+	}
+	if (plume_spec_check_numbers(path, root, err) != PLUME_OK) {
+		json_decref(root);
+		return NULL;
+	}
 	return root;
+}
+
+/// Depth-first over the tree; path holds the JSON path of value (truncated
+/// when longer than the buffer). jansson's parser bounds the depth (2048).
+static bool numbers_in_range(plume_spec_reader *reader, const json_t *value, char *path, size_t size)
+{
+	size_t length = strlen(path);
+	if (json_is_number(value)) {
+		double x = json_number_value(value);
+		if (!(fabs(x) <= PLUME_SPEC_MAX_MAGNITUDE)) {
+			plume_spec_fail(reader, path, "%g is outside the range of any value plume reads, [-1e12, 1e12]", x);
+			return false;
+		}
+	} else if (json_is_object(value)) {
+		const char *key;
+		json_t *child;
+		json_object_foreach ((json_t *)value, key, child) {
+			snprintf(path + length, size - length, ".%s", key);
+			bool ok = numbers_in_range(reader, child, path, size);
+			path[length] = '\0';
+			if (!ok)
+				return false;
+		}
+	} else if (json_is_array(value)) {
+		for (size_t i = 0; i < json_array_size(value); ++i) {
+			snprintf(path + length, size - length, "[%zu]", i);
+			bool ok = numbers_in_range(reader, json_array_get(value, i), path, size);
+			path[length] = '\0';
+			if (!ok)
+				return false;
+		}
+	}
+	return true;
+}
+
+plume_status plume_spec_check_numbers(const char *file, const json_t *root, plume_error *err)
+{
+	plume_spec_reader reader = plume_spec_reader_begin(file, err);
+	char path[512] = "$";
+	numbers_in_range(&reader, root, path, sizeof path);
+	return reader.status;
 }
 
 json_t *plume_spec_load_model(const char *path, plume_status *status, plume_error *err)
@@ -253,7 +301,8 @@ bool plume_spec_points2(plume_spec_reader *reader, const json_t *object, const c
 		return false;
 	}
 	plume_vec2 points[64];
-	for (int i = 0; i < count && i < 64; ++i) {
+	assert(count >= 0 && count <= 64 && "plume_spec_points2 reads at most 64 points");
+	for (int i = 0; i < count; ++i) {
 		const json_t *point = json_array_get(value, (size_t)i);
 		char item[540];
 		plume_spec_index_path(item, sizeof item, child, (size_t)i);

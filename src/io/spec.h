@@ -31,6 +31,18 @@ json_t *plume_spec_load(const char *path, plume_error *err);
 /// is not an object. *status receives the outcome; NULL on failure.
 json_t *plume_spec_load_model(const char *path, plume_status *status, plume_error *err);
 
+/// The largest magnitude of any number plume reads from JSON (specs, scenes,
+/// lab files, cameras, feather dumps). Every key has its own, narrower range;
+/// this one holds before any reader runs, so no value near DBL_MAX can reach
+/// a product, a loop bound or an output file (1e12 leaves moduli in Pa and
+/// any length in metres far inside it, and its square far from overflow).
+#define PLUME_SPEC_MAX_MAGNITUDE 1e12
+
+/// Fails (PLUME_ERROR_SPEC, "file: $.path: ...") on the first number of the
+/// tree whose magnitude exceeds PLUME_SPEC_MAX_MAGNITUDE. plume_spec_load
+/// already calls it; readers of JSON from elsewhere call it themselves.
+plume_status plume_spec_check_numbers(const char *file, const json_t *root, plume_error *err);
+
 plume_spec_reader plume_spec_reader_begin(const char *file, plume_error *err);
 
 /// Records an error at path ("file: path: message").

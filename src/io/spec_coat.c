@@ -328,6 +328,7 @@ plume_status plume_coat_spec_generate(const char *path, const plume_spec_options
 	read_lod(&reader, root, &def.lod);
 	if (options != NULL && options->seed_given)
 		def.seed = options->seed;
+	def.max_memory = options != NULL && options->max_memory > 0 ? options->max_memory : PLUME_DEFAULT_MAX_MEMORY;
 	plume_status status = reader.status;
 	if (status == PLUME_OK) {
 		status = coat_build(&def, out, err);

@@ -391,6 +391,11 @@ plume_status plume_scene_parse(const char *text, const char *name, const plume_s
 	json_t *root = json_loads(text, JSON_REJECT_DUPLICATES, &error);
 	if (root == NULL)
 		return plume_error_set(err, PLUME_ERROR_SYNTAX, "%s:%d:%d: %s", name, error.line, error.column, error.text);
+	plume_status status = plume_spec_check_numbers(name, root, err);
+	if (status != PLUME_OK) {
+		json_decref(root);
+		return status;
+	}
 	return scene_from_json(name, root, options, out, err);
 }
 
@@ -432,6 +437,14 @@ static plume_status scene_from_json(const char *path, json_t *root, const plume_
 		status = plume_sim_def_validate(&scene->sim, 0, err);
 		if (status != PLUME_OK)
 			plume_error_prefix(err, path);
+	}
+	// The step count is an int in the run loop and in summary.json: a tiny step over a long
+	// duration overflowed it (1e9 s in steps of 1e-9 s ran 0 steps and reported success).
+	if (status == PLUME_OK && !(scene->duration / scene->sim.time_step <= PLUME_SCENE_MAX_STEPS)) {
+		plume_spec_fail(&reader, "$.duration",
+		                "%g s in steps of %g s ($.time_step) is %.3g steps; allowed at most %.0e", scene->duration,
+		                scene->sim.time_step, scene->duration / scene->sim.time_step, (double)PLUME_SCENE_MAX_STEPS);
+		status = reader.status;
 	}
 	if (status == PLUME_OK)
 		status = build_mesh(path, root, &feather_options, scene, err);

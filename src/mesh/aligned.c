@@ -941,6 +941,8 @@ static plume_status mesh_run(const mesh_input *input, const plume_mesh_def *def,
 plume_status plume_mesh_from_feather(const plume_feather *feather, const plume_mesh_def *def, plume_mesh **out,
                                      plume_mesh_report *report, plume_error *err)
 {
+	assert(feather != NULL && def != NULL && out != NULL);
+	assert(def->cookie == PLUME_DEF_COOKIE && "plume_mesh_def not from plume_mesh_default_def()");
 	*out = NULL;
 	mesh_input input;
 	plume_status status = mesh_input_from_feather(feather, def, &input, err);
@@ -954,6 +956,8 @@ plume_status plume_mesh_from_feather(const plume_feather *feather, const plume_m
 plume_status plume_mesh_from_guides(const plume_mesh_guides *guides, const plume_mesh_def *def, plume_mesh **out,
                                     plume_mesh_report *report, plume_error *err)
 {
+	assert(guides != NULL && def != NULL && out != NULL);
+	assert(def->cookie == PLUME_DEF_COOKIE && "plume_mesh_def not from plume_mesh_default_def()");
 	*out = NULL;
 	mesh_input input;
 	plume_status status = mesh_input_from_guides(guides, def, &input, err);

@@ -13,6 +13,7 @@ static const double pi = 3.14159265358979323846;
 plume_mesh_def plume_mesh_default_def(void)
 {
 	return (plume_mesh_def){
+	    .cookie = PLUME_DEF_COOKIE,
 	    .edge_length = 5e-3,
 	    .rachis_width_base = 0.0,
 	    .rachis_width_tip = 0.0,

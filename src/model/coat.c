@@ -1,6 +1,7 @@
 // Feather coats (Streit & Heidrich 4.4): follicles on a surface, key feathers,
 // interpolated feathers placed by normal, direction field and lift, in drawing
 // order from the bottom feather to the top one.
+#include <assert.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -29,11 +30,16 @@ const plume_feather *plume_coat_feather(const plume_coat *coat, int index)
 
 void plume_coat_follicle(const plume_coat *coat, int index, plume_vec3 *position, plume_vec3 *normal)
 {
+	assert(coat != NULL && index >= 0 && index < coat->count);
 	*position = coat->roots[index];
 	*normal = coat->normals[index];
 }
 
-bool plume_coat_is_key(const plume_coat *coat, int index) { return coat->is_key[index]; }
+bool plume_coat_is_key(const plume_coat *coat, int index)
+{
+	assert(coat != NULL && index >= 0 && index < coat->count);
+	return coat->is_key[index];
+}
 
 const plume_mesh *plume_coat_surface(const plume_coat *coat) { return coat->surface; }
 
@@ -145,6 +151,26 @@ static int add_follicle(follicles *f, plume_vec3 position, plume_vec3 normal)
 	f->normals[f->count] = normal;
 	f->count++;
 	return 0;
+}
+
+// Resource bounds. A feather of the coarsest level of detail still holds a
+// shaft and a few barbs: 4 KiB is a floor, far below the example coats' 30-200 KiB.
+#define COAT_MIN_FEATHER_BYTES 4096
+#define COAT_MAX_FOLLICLES 1e8 // also keeps every count far inside an int
+
+/// Upper estimate of the follicle count, from the layout's own geometry.
+static double estimated_follicles(const coat_def *def, double area)
+{
+	double s = def->spacing;
+	if (def->layout == COAT_LAYOUT_POISSON) {
+		// Disks of diameter s packed no denser than the hexagonal lattice: area / (sqrt(3)/2 s^2).
+		double smallest = s * fmin(1.0, def->spacing_factor);
+		return area / (0.8660254037844386 * smallest * smallest) + 16.0;
+	}
+	if (def->surface == COAT_SURFACE_PLANE)
+		return (def->plane_size[0] / s + 2.0) * (def->plane_size[1] / (0.8660254037844386 * s) + 2.0);
+	double n = fmax(1.0, floor(1.1071487177940904 * def->sphere_radius / s + 0.5));
+	return 10.0 * n * n + 2.0;
 }
 
 /// Regular hexagonal lattice on the plane: rows spacing sqrt(3)/2 apart, every other row shifted by half.
@@ -378,6 +404,29 @@ plume_status coat_follicles(const coat_def *def, const plume_mesh *surface, plum
 		sampler.area = def->plane_size[0] * def->plane_size[1];
 	} else {
 		sampler.area = 4.0 * PI * def->sphere_radius * def->sphere_radius;
+	}
+	if (status == 0 && !(isfinite(sampler.area) && sampler.area > 0.0)) {
+		plume_free((void *)sampler.vertex_normals);
+		plume_free(sampler.cumulative_area);
+		return plume_error_set(err, PLUME_ERROR_SPEC,
+		                       "$.surface: the surface's area is %g m^2; it needs a finite, "
+		                       "positive area to hold follicles",
+		                       sampler.area);
+	}
+	if (status == 0) {
+		// Refuse before the layout grows: every follicle costs at least its
+		// position, its normal and a feather of COAT_MIN_FEATHER_BYTES.
+		double estimate = estimated_follicles(def, sampler.area);
+		double bytes = estimate * (double)COAT_MIN_FEATHER_BYTES;
+		if (!(estimate <= COAT_MAX_FOLLICLES && bytes <= (double)def->max_memory)) {
+			plume_free((void *)sampler.vertex_normals);
+			plume_free(sampler.cumulative_area);
+			return plume_error_set(err, PLUME_ERROR_LIMIT,
+			                       "$.follicles.spacing: %g m on %.3g m^2 of surface makes about %.3g follicles, at "
+			                       "least %.3g GB of feathers; the limit is %.3g GB (raise it with --max-memory, or "
+			                       "widen the spacing)",
+			                       def->spacing, sampler.area, estimate, bytes / 1e9, (double)def->max_memory / 1e9);
+		}
 	}
 	if (status == 0) {
 		if (def->layout == COAT_LAYOUT_POISSON)

@@ -54,7 +54,8 @@ typedef struct coat_def {
 
 	plume_sh_lod lod;
 	uint64_t seed;
-	double stage; ///< growth stage of every feather, 1 finished
+	double stage;        ///< growth stage of every feather, 1 finished
+	uint64_t max_memory; ///< bytes the coat may take (estimated before the layout and before the feathers)
 } coat_def;
 
 /// Builds the coat; takes the mesh out of def (def->mesh is NULL afterwards). key_defs stay with def.

@@ -26,6 +26,7 @@ plume_fw_def plume_fw_default_def(void)
 	// A 0.2 m hawk contour feather: Table 2's "Hawk Feather" rows, with a gently
 	// curved shaft and a vane widest below its middle, the outer (left) vane narrower.
 	return (plume_fw_def){
+	    .cookie = PLUME_DEF_COOKIE,
 	    .shaft = {{0.0, 0.0}, {0.0015, 0.07}, {0.005, 0.14}, {0.004, 0.2}},
 	    .left_outline = {{-0.003, 0.045}, {-0.024, 0.06}, {-0.03, 0.15}, {-0.022, 0.21}, {0.004, 0.205}},
 	    .right_outline = {{0.003, 0.045}, {0.03, 0.06}, {0.04, 0.15}, {0.03, 0.215}, {0.004, 0.205}},
@@ -84,6 +85,7 @@ static plume_status check_points(const plume_vec2 *points, int count, const char
 
 plume_status plume_fw_def_validate(const plume_fw_def *def, plume_error *err)
 {
+	assert(def != NULL && def->cookie == PLUME_DEF_COOKIE && "plume_fw_def not from plume_fw_default_def()");
 	plume_status status;
 	if ((status = check_points(def->shaft, 4, "shaft", err)) != PLUME_OK ||
 	    (status = check_points(def->left_outline, 5, "left_outline", err)) != PLUME_OK ||

@@ -95,6 +95,12 @@ plume_status plume_sh_scan_barb_lengths(const char *image_path, const plume_sh_s
 	if (file == NULL)
 		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot read: %s", image_path, strerror(errno));
 	int width = 0, height = 0, channels = 0;
+	// The header's size first: scans are at most 16384 x 16384 pixels (a crafted header asks for gigabytes).
+	if (stbi_info_from_file(file, &width, &height, &channels) && (width > 16384 || height > 16384)) {
+		fclose(file);
+		return plume_error_set(err, PLUME_ERROR_SPEC, "%s: a %d x %d image; scans are at most 16384 x 16384 pixels",
+		                       image_path, width, height);
+	}
 	unsigned char *pixels = stbi_load_from_file(file, &width, &height, &channels, 4);
 	fclose(file);
 	if (pixels == NULL) {

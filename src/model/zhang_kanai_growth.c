@@ -292,6 +292,19 @@ plume_status zk_grow(const plume_zk_def *def, const zk_collar *collar, uint64_t 
 	vane_setup(runs + PLUME_SIDE_LEFT, def, collar, &ve, &vb, PLUME_SIDE_LEFT, plume_rng_split(&rng));
 	vane_setup(runs + PLUME_SIDE_RIGHT, def, collar, &ve, &vb, PLUME_SIDE_RIGHT, plume_rng_split(&rng));
 
+	// Barb i leaves the ridge after the emitter moved (i + 1) d: a ridge wider
+	// than the emitter's whole path from I_A to I_P emits every barb at the
+	// clamp, at times that overflow (1e308 gave a feather with no barbs).
+	for (int side = 0; side < 2; ++side) {
+		const zk_vane *v = &runs[side].vane;
+		double path = v->length * fabs(v->s_posterior - v->s_anterior);
+		if (!(def->ridge_width <= path))
+			return plume_error_set(err, PLUME_ERROR_SPEC,
+			                       "$.ridge_width is %g m, longer than the %s emitter's path along the collar from "
+			                       "I_A to I_P (%g m); allowed (0, %g]",
+			                       def->ridge_width, side == PLUME_SIDE_LEFT ? "left" : "right", path, path);
+	}
+
 	plume_status status = PLUME_OK;
 	// Termination: barbs mature in emission order, so N mature barbs on a vane
 	// means its barb N - 1 is mature.

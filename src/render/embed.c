@@ -270,6 +270,20 @@ plume_status plume_embedding_create(const plume_feather *feather, const plume_me
 		for (int i = 0; i < f->point_count; ++i)
 			e->anchors[point + i] = embed_point(scene, mesh, frames, f->points[i]);
 		point += f->point_count;
+		// A point with no nearest face (a coordinate Embree's float query cannot
+		// hold, or NaN) has no frame to carry it: refuse rather than index frames[-1].
+		for (int i = first_point; i < point; ++i) {
+			if (e->anchors[i].face < 0) {
+				rtcReleaseScene(scene);
+				rtcReleaseDevice(device);
+				plume_free(frames);
+				plume_embedding_destroy(e);
+				return plume_error_set(err, PLUME_ERROR_SPEC,
+				                       "embedding: point %d of the feather lies on no face of the shell "
+				                       "(a coordinate not finite in single precision)",
+				                       i);
+			}
+		}
 		for (int i = 0; i < f->shaft_count; ++i) {
 			const triangle_frame *fr = frames + e->anchors[first_point + i].face;
 			e->directions[direction++] = to_frame(fr, f->shaft[i].tangent);

@@ -113,6 +113,13 @@ plume_status plume_texture_load(const char *path, plume_texture **out, plume_err
 	if (status != PLUME_OK)
 		return status;
 	int width = 0, height = 0, channels = 0;
+	// The header's size before the pixels: a crafted 60000 x 60000 PNG of a few
+	// bytes would otherwise ask stb for 14 GB. 16384 is the CLI's largest --size.
+	if (stbi_info_from_memory(data, (int)size, &width, &height, &channels) && (width > 16384 || height > 16384)) {
+		plume_free(data);
+		return plume_error_set(err, PLUME_ERROR_SPEC, "%s: a %d x %d image; textures are at most 16384 x 16384 pixels",
+		                       path, width, height);
+	}
 	// stb's own allocations use malloc; the pixels are copied into plume memory
 	// at once so that the texture is counted like every other libplume object.
 	stbi_uc *pixels = stbi_load_from_memory(data, (int)size, &width, &height, &channels, 4);

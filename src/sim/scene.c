@@ -106,7 +106,17 @@ plume_status plume_scene_run(const plume_scene *scene, plume_scene_step_fn *on_s
 		status = on_step(user, 0, 0, sim, NULL, omp_get_wtime() - start, err);
 
 	double dt = scene->sim.time_step;
-	int steps = (int)ceil(scene->duration / dt - 1e-9);
+	double step_count = ceil(scene->duration / dt - 1e-9);
+	int steps = 0;
+	if (!(step_count >= 0.0 && step_count <= PLUME_SCENE_MAX_STEPS)) {
+		if (status == PLUME_OK)
+			status = plume_error_set(err, PLUME_ERROR_SPEC,
+			                         "scene: duration %g s in steps of %g s is %.3g steps; "
+			                         "allowed at most %d",
+			                         scene->duration, dt, step_count, PLUME_SCENE_MAX_STEPS);
+	} else {
+		steps = (int)step_count;
+	}
 	for (int n = 1; n <= steps && status == PLUME_OK; ++n) {
 		double t = n * dt;
 		pose_handles(scene, sim, ids, t);

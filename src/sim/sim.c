@@ -1,5 +1,6 @@
 // The simulation object: definitions, set-up from a mesh, handles, statics and
 // implicit-Euler steps with substep retries, and measurements.
+#include <assert.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -23,6 +24,7 @@ plume_sim_def plume_sim_default_def(void)
 	def.solver.tolerance = 1e-7;
 	def.solver.max_iterations = 50;
 	def.solver.max_substep_halvings = 4;
+	def.cookie = PLUME_DEF_COOKIE;
 	return def;
 }
 
@@ -316,6 +318,8 @@ static double bounding_diagonal(const plume_mesh *mesh)
 
 plume_status plume_sim_create(const plume_mesh *mesh, const plume_sim_def *def, plume_sim **out, plume_error *err)
 {
+	assert(mesh != NULL && def != NULL && out != NULL);
+	assert(def->cookie == PLUME_DEF_COOKIE && "plume_sim_def not from plume_sim_default_def()");
 	*out = NULL;
 	if (mesh->vertex_count < 3 || mesh->face_count < 1)
 		return plume_error_set(err, PLUME_ERROR_SPEC, "the mesh has no faces to simulate");
@@ -448,6 +452,7 @@ static const plume_vertex_group *find_group(const plume_sim *sim, const char *na
 
 int plume_sim_add_handle(plume_sim *sim, const char *group_name, plume_error *err)
 {
+	assert(sim != NULL && group_name != NULL);
 	const plume_vertex_group *group = find_group(sim, group_name);
 	if (group == NULL) {
 		char known[512] = "";
@@ -493,6 +498,7 @@ int plume_sim_add_handle(plume_sim *sim, const char *group_name, plume_error *er
 
 plume_status plume_sim_set_group_load(plume_sim *sim, const char *group_name, plume_vec3 force, plume_error *err)
 {
+	assert(sim != NULL && group_name != NULL);
 	const plume_vertex_group *group = find_group(sim, group_name);
 	if (group == NULL || group->count == 0)
 		return plume_error_set(err, PLUME_ERROR_SPEC, "no vertices in group \"%s\" to load", group_name);
@@ -504,6 +510,8 @@ plume_status plume_sim_set_group_load(plume_sim *sim, const char *group_name, pl
 
 void plume_sim_set_handle(plume_sim *sim, int index, plume_vec3 translation, plume_mat3 rotation, plume_vec3 pivot)
 {
+	assert(sim != NULL && index >= 0 && index < sim->handle_count && "handle index from plume_sim_add_handle");
+	assert(isfinite(translation.x) && isfinite(translation.y) && isfinite(translation.z));
 	sim_handle *handle = sim->handles + index;
 	for (int i = 0; i < handle->count; ++i) {
 		plume_vec3 arm = plume_m3_apply(rotation, plume_v3_sub(handle->anchor[i], pivot));
@@ -513,6 +521,7 @@ void plume_sim_set_handle(plume_sim *sim, int index, plume_vec3 translation, plu
 
 void plume_sim_place_handles(plume_sim *sim, double s)
 {
+	assert(sim != NULL && s >= 0.0 && s <= 1.0);
 	for (int h = 0; h < sim->handle_count; ++h) {
 		const sim_handle *handle = sim->handles + h;
 		for (int i = 0; i < handle->count; ++i)
@@ -542,6 +551,7 @@ static void add_report(plume_solve_report *total, const plume_solve_report *part
 
 plume_status plume_sim_solve_static(plume_sim *sim, plume_solve_report *report, plume_error *err)
 {
+	assert(sim != NULL);
 	plume_solve_report total = {0};
 	static const sim_problem statics = {false, 0, NULL, NULL, NULL};
 	size_t bytes = sizeof(plume_vec3) * (size_t)sim->vertex_count;
@@ -561,7 +571,9 @@ plume_status plume_sim_solve_static(plume_sim *sim, plume_solve_report *report, 
 			if (status != PLUME_OK)
 				break;
 		}
-		if (status == PLUME_OK)
+		// Substeps help a step that did not converge, not one that ran out of memory:
+		// a retry that then succeeded would make the result depend on the allocator.
+		if (status != PLUME_ERROR_NUMERIC)
 			break;
 	}
 	total.max_barb_strain = plume_sim_max_barb_strain(sim, sim->x);
@@ -587,6 +599,7 @@ static void vertex_normals(const plume_sim *sim, const plume_vec3 *x, plume_vec3
 
 plume_status plume_sim_step(plume_sim *sim, plume_solve_report *report, plume_error *err)
 {
+	assert(sim != NULL);
 	plume_solve_report total = {0};
 	size_t bytes = sizeof(plume_vec3) * (size_t)sim->vertex_count;
 	memcpy(sim->saved_x, sim->x, bytes);
@@ -617,7 +630,9 @@ plume_status plume_sim_step(plume_sim *sim, plume_solve_report *report, plume_er
 			for (int i = 0; i < sim->vertex_count; ++i)
 				sim->v[i] = plume_v3_scale(plume_v3_sub(sim->x[i], sim->previous[i]), 1 / h);
 		}
-		if (status == PLUME_OK)
+		// Substeps help a step that did not converge, not one that ran out of memory:
+		// a retry that then succeeded would make the result depend on the allocator.
+		if (status != PLUME_ERROR_NUMERIC)
 			break;
 	}
 	if (status != PLUME_OK) {

@@ -7,12 +7,13 @@
 // process's locale (see ../io/export.h).
 #define _POSIX_C_SOURCE 200809L
 #include <ctype.h>
+#include <math.h>
 #include <errno.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "../core/alloc.h"
-#include "../io/export.h"
+#include "export.h"
 #include "plume/mesh.h"
 
 /// Group names the writer gives each material; the reader maps them back.
@@ -93,7 +94,13 @@ static plume_status obj_fail(obj_reader *reader, plume_status status, const char
 	return plume_error_set(reader->err, status, "%s:%ld: %s", reader->path, reader->line, what);
 }
 
-/// Reads up to max numbers after the keyword; returns how many, or -1 on garbage.
+/// The largest coordinate an OBJ may hold, m: the bound every JSON number has
+/// (PLUME_SPEC_MAX_MAGNITUDE), so "nan", "inf" and 1e308 stop here instead of
+/// reaching a layout loop (a nan vertex made the coat's follicle search endless).
+#define OBJ_MAX_MAGNITUDE 1e12
+
+/// Reads up to max numbers after the keyword; returns how many, -1 on garbage,
+/// -2 on a value that is not finite or past OBJ_MAX_MAGNITUDE.
 static int read_numbers(const char *text, double *out, int max)
 {
 	int n = 0;
@@ -108,6 +115,8 @@ static int read_numbers(const char *text, double *out, int max)
 		out[n] = strtod(text, &end);
 		if (end == text || !(isspace((unsigned char)*end) || *end == '\0'))
 			return -1;
+		if (!(fabs(out[n]) <= OBJ_MAX_MAGNITUDE))
+			return -2;
 		++n;
 		text = end;
 	}
@@ -188,13 +197,18 @@ static plume_status read_line(obj_reader *reader, char *line)
 		++line;
 	double values[3];
 	if (line[0] == 'v' && isspace((unsigned char)line[1])) {
-		if (read_numbers(line + 2, values, 3) != 3)
+		int n = read_numbers(line + 2, values, 3);
+		if (n == -2)
+			return obj_fail(reader, PLUME_ERROR_SYNTAX, "\"v\": a coordinate is not finite or is beyond 1e12 m");
+		if (n != 3)
 			return obj_fail(reader, PLUME_ERROR_SYNTAX, "\"v\" needs three numbers");
 		if (PLUME_GROW(reader->v, reader->v_capacity, reader->v_count + 1) != 0)
 			return obj_fail(reader, PLUME_ERROR_MEMORY, "out of memory");
 		reader->v[reader->v_count++] = plume_v3(values[0], values[1], values[2]);
 	} else if (line[0] == 'v' && line[1] == 't' && isspace((unsigned char)line[2])) {
 		int n = read_numbers(line + 3, values, 2);
+		if (n == -2)
+			return obj_fail(reader, PLUME_ERROR_SYNTAX, "\"vt\": a coordinate is not finite or is beyond 1e12");
 		if (n < 1)
 			return obj_fail(reader, PLUME_ERROR_SYNTAX, "\"vt\" needs one or two numbers");
 		if (PLUME_GROW(reader->vt, reader->vt_capacity, reader->vt_count + 1) != 0)

@@ -1,14 +1,13 @@
 // A coat's geometry out: OBJ polylines and USD BasisCurves, one object per
-// feather in drawing order, and a 2D picture seen from +z.
+// feather in drawing order (the picture is render/coat_draw.c).
 #define _POSIX_C_SOURCE 200809L
-#include "../io/export.h"
+#include "export.h"
 
 #include <math.h>
 #include <stdlib.h>
 
 #include "../core/alloc.h"
 #include "plume/coat.h"
-#include "plume/render.h"
 
 /// Calls visit for the feather's shaft, each barb and barbule, then its afterfeather's, as polylines with
 /// widths and uv (the shaft's uv is (0, t)).
@@ -259,49 +258,4 @@ plume_status plume_coat_write_usda(const plume_coat *coat, const char *path, plu
 	fputs("        }\n    }\n}\n", s);
 	scratch_free(&scratch);
 	return plume_text_close(&text, PLUME_OK, err);
-}
-
-// ---------------------------------------------------------------------------
-// Picture
-
-typedef struct depth_entry {
-	double depth;
-	int index;
-} depth_entry;
-
-static int compare_depth(const void *a, const void *b)
-{
-	const depth_entry *x = a, *y = b;
-	if (x->depth != y->depth)
-		return x->depth < y->depth ? -1 : 1;
-	return (x->index > y->index) - (x->index < y->index);
-}
-
-plume_status plume_coat_render2d(const plume_coat *coat, const plume_render2d_def *def, plume_image_format format,
-                                 const char *path, plume_error *err)
-{
-	// Seen from +z: feathers on the far side of the surface (normal away from the camera) are hidden by it;
-	// the others are painted from the farthest root to the nearest, and in the coat's own bottom-to-top
-	// order where roots are equally far (a plane facing the camera).
-	int count = plume_coat_feather_count(coat), shown = 0;
-	const plume_feather **feathers = plume_alloc((size_t)(count > 0 ? count : 1) * sizeof *feathers);
-	depth_entry *order = plume_alloc((size_t)(count > 0 ? count : 1) * sizeof *order);
-	if (feathers == NULL || order == NULL) {
-		plume_free(feathers);
-		plume_free(order);
-		return plume_error_set(err, PLUME_ERROR_MEMORY, "%s: out of memory", path);
-	}
-	for (int i = 0; i < count; ++i) {
-		plume_vec3 position, normal;
-		plume_coat_follicle(coat, i, &position, &normal);
-		if (normal.z > -0.05)
-			order[shown++] = (depth_entry){position.z, i};
-	}
-	qsort(order, (size_t)shown, sizeof *order, compare_depth);
-	for (int i = 0; i < shown; ++i)
-		feathers[i] = plume_coat_feather(coat, order[i].index);
-	plume_status status = plume_render2d_feathers(feathers, shown, def, format, path, err);
-	plume_free(feathers);
-	plume_free(order);
-	return status;
 }

@@ -1,0 +1,166 @@
+#!/usr/bin/env bash
+# Regression tests of issue 17 (hardening): each input that crashed, hung,
+# grew without bound or gave a silently wrong result now fails with a message
+# naming the file and the JSON path, a documented exit code, nothing written
+# and no staging folder left. Every command runs under `timeout` so that a
+# hang is a failure, not a stuck suite.
+# Usage: hardening.sh PLUME_BINARY SOURCE_DIR
+source "$(dirname "$0")/../cli_support.sh" "$@"
+examples=$source_dir/examples
+bad=$scratch/bad
+mkdir -p "$bad"
+T="timeout 60"
+
+# edit IN OUT PYTHON: OUT is IN (JSON) with the Python statement applied to d.
+edit() {
+	/usr/bin/python3 -c "import json,sys; d=json.load(open(sys.argv[1])); $3; json.dump(d, open(sys.argv[2], 'w'))" "$1" "$2"
+}
+
+# --- Franco-Walter shaft point [1e308, 1e308]: hung in the arc-length recursion -------
+edit "$examples/franco-walter/hawk.json" "$bad/fw-shaft.json" "d['shaft'][3] = [1e308, 1e308]"
+expect_no_output "FW shaft 1e308" 3 'fw-shaft.json: $.shaft[3][0]: 1e+308 is outside the range' "$scratch/o1" \
+	$T "$plume" generate "$bad/fw-shaft.json" -o "$scratch/o1"
+
+# --- rachis (shaft) width 1e308: wrote inf into feather.usda -------------------------------
+edit "$examples/franco-walter/hawk.json" "$bad/fw-width.json" "d['shaft_width_base'] = 1e308"
+expect_no_output "FW shaft width 1e308" 3 'fw-width.json: $.shaft_width_base: 1e+308' "$scratch/o2" \
+	$T "$plume" generate "$bad/fw-width.json" -o "$scratch/o2" --format usda
+edit "$examples/scenes/falling.json" "$bad/scene-width.json" \
+	"d['feather'] = '$examples/franco-walter/hawk.json'; d['mesh']['rachis_width_base'] = 1e308"
+expect_no_output "scene rachis width 1e308" 3 'scene-width.json: $.mesh.rachis_width_base: 1e+308' "$scratch/o3" \
+	$T "$plume" simulate "$bad/scene-width.json" -o "$scratch/o3"
+
+# --- Zhang-Kanai ridge_width 1e308: 0 barbs and exit 0 -----------------------------------
+edit "$examples/zhang-kanai/figure8-contour.json" "$bad/zk-huge.json" "d['ridge_width'] = 1e308"
+expect_no_output "ZK ridge_width 1e308" 3 'zk-huge.json: $.ridge_width: 1e+308' "$scratch/o4" \
+	$T "$plume" generate "$bad/zk-huge.json" -o "$scratch/o4"
+edit "$examples/zhang-kanai/figure8-contour.json" "$bad/zk-wide.json" "d['ridge_width'] = 0.5"
+expect_no_output "ZK ridge_width past the collar" 3 \
+	"zk-wide.json: \$.ridge_width is 0.5 m, longer than the left emitter's path" "$scratch/o5" \
+	$T "$plume" generate "$bad/zk-wide.json" -o "$scratch/o5"
+
+# --- coats without bound: spacing 1e-6 m, a sphere of radius 1000 m ----------------------------
+cp "$examples"/coats/key-*.json "$bad/"
+edit "$examples/coats/sphere.json" "$bad/coat-fine.json" "d['follicles']['spacing'] = 1e-6"
+expect_no_output "coat spacing 1e-6" 5 '$.follicles.spacing: 1e-06 m on' "$scratch/o6" \
+	$T "$plume" coat "$bad/coat-fine.json" -o "$scratch/o6"
+check "coat limit names --max-memory" grep -qF 'raise it with --max-memory' "$scratch/err.txt"
+edit "$examples/coats/sphere.json" "$bad/coat-big.json" "d['surface']['radius'] = 1000"
+expect_no_output "coat sphere radius 1000 m" 5 'about 1.92e+11 follicles' "$scratch/o7" \
+	$T "$plume" coat "$bad/coat-big.json" -o "$scratch/o7"
+expect_no_output "coat --max-memory 2T is still too little" 5 'the limit is 2.2e+03 GB' "$scratch/o8" \
+	$T "$plume" coat "$bad/coat-big.json" -o "$scratch/o8" --max-memory 2T
+expect_no_output "coat --max-memory garbage" 2 "--max-memory 'lots'" "$scratch/o9" \
+	$T "$plume" coat "$examples/coats/sphere.json" -o "$scratch/o9" --max-memory lots
+# The limit is real: the example sphere (about 400 follicles) fits in 1G, not in 1M.
+expect_no_output "coat --max-memory 1M refuses the example" 5 'the limit is 0.00105 GB' "$scratch/o10" \
+	$T "$plume" coat "$examples/coats/sphere.json" -o "$scratch/o10" --max-memory 1M
+$T "$plume" coat "$examples/coats/sphere.json" -o "$scratch/sphere" --max-memory 1G --format obj 2>"$scratch/err.txt"
+check "coat --max-memory 1G builds the example ($(cat "$scratch/err.txt"))" test -s "$scratch/sphere/coat.obj"
+
+# --- a coat on an OBJ with a nan vertex: looped forever choosing follicles -----------------------
+printf 'v 0 0 0\nv 0.1 0 0\nv nan 0.1 0\nv 0 0.1 0\nf 1 2 3\nf 1 3 4\n' >"$bad/nan.obj"
+printf '{"model": "coat", "surface": {"type": "mesh", "obj": "nan.obj"}, "follicles": {"layout": "poisson", "spacing": 0.01}, "key_feathers": [{"at": [0, 0, 0], "feather": "key-plume.json"}]}' >"$bad/coat-nan.json"
+expect_no_output "coat on a nan vertex" 3 'nan.obj:3: "v": a coordinate is not finite' "$scratch/o11" \
+	$T "$plume" coat "$bad/coat-nan.json" -o "$scratch/o11"
+printf 'v 0 0 0\nv 0.1 0 0\nv 1e300 0.1 0\nf 1 2 3\n' >"$bad/huge.obj"
+sed 's/nan.obj/huge.obj/' "$bad/coat-nan.json" >"$bad/coat-huge.json"
+expect_no_output "coat on a 1e300 vertex" 3 'huge.obj:3: "v": a coordinate is not finite or is beyond 1e12 m' \
+	"$scratch/o12" $T "$plume" coat "$bad/coat-huge.json" -o "$scratch/o12"
+
+# --- time_step 1e-9 over duration 1e9: overflowed the step count, exit 0 with 0 steps -----------
+edit "$examples/scenes/falling.json" "$bad/scene-steps.json" \
+	"d['feather'] = '$examples/franco-walter/hawk.json'; d['time_step'] = 1e-9; d['duration'] = 1e9"
+expect_no_output "step count overflow" 3 'scene-steps.json: $.duration: 1e+09 s in steps of 1e-09 s' "$scratch/o13" \
+	$T "$plume" simulate "$bad/scene-steps.json" -o "$scratch/o13"
+
+# --- the first simulation step fails: frame 0 and a summary that says where and why --------
+edit "$examples/scenes/falling.json" "$bad/scene-fail.json" \
+	"d['feather'] = '$examples/franco-walter/hawk.json'; d['mesh']['edge_length'] = 0.02; d['duration'] = 0.05; d['solver'] = {'max_iterations': 1, 'max_substep_halvings': 0}"
+expect_failure "first step fails" 1 'Newton did not converge in 1 iterations' \
+	$T "$plume" simulate "$bad/scene-fail.json" -o "$scratch/fail"
+check "first step fails: frame 0 kept" test -s "$scratch/fail/frames/0000.obj"
+check "first step fails: only frame 0" test "$(ls "$scratch/fail/frames" | wc -l)" -eq 1
+check "first step fails: summary says not completed" grep -q '"completed": false' "$scratch/fail/summary.json"
+check "first step fails: summary names the step" grep -q '"failed_step": 1,' "$scratch/fail/summary.json"
+check "first step fails: summary has the reason" grep -q '"error": "simulation: step at' "$scratch/fail/summary.json"
+check "first step fails: no staging left" test -z "$(ls -A "$scratch" | grep plume-staging)"
+
+# --- render of a simulation folder whose feather.json holds 1e308: segfaulted -------------
+sim=$scratch/sim
+edit "$examples/scenes/falling.json" "$bad/scene-short.json" \
+	"d['feather'] = '$examples/franco-walter/filoplume.json'; d['mesh']['edge_length'] = 0.02; d['duration'] = 0.011"
+$T "$plume" simulate "$bad/scene-short.json" -o "$sim" >/dev/null 2>"$scratch/err.txt"
+check "short simulation for render ($(cat "$scratch/err.txt"))" test -s "$sim/feather.json"
+/usr/bin/python3 - "$sim/feather.json" <<'EOF'
+import re, sys
+path = sys.argv[1]
+text = open(path).read()
+# the shaft's first coordinate becomes 1e308
+text = re.sub(r'("position":\s*\[)[-0-9.eE+]+', r'\g<1>1e308', text, count=1)
+open(path, 'w').write(text)
+EOF
+check "feather.json edited" grep -q '1e308' "$sim/feather.json"
+expect_no_output "render feather.json 1e308" 3 'feather.json: $.' "$scratch/o14" \
+	$T "$plume" render "$sim" -o "$scratch/o14" --spp 1 --size 32x32
+check "render 1e308: names the range" grep -qF 'is outside the range of any value plume reads' "$scratch/err.txt"
+
+# --- a simulation whose frames would pass --max-memory: refused before the run -----------
+edit "$bad/scene-short.json" "$bad/scene-long.json" "d['duration'] = 1e4; d['time_step'] = 0.001; d['frame_every'] = 1"
+expect_no_output "frames past the limit" 5 'frames of up to' "$scratch/o15" \
+	$T "$plume" simulate "$bad/scene-long.json" -o "$scratch/o15"
+check "frames limit names --max-memory" grep -qF 'raise it with --max-memory' "$scratch/err.txt"
+expect_no_output "PNG frames past a 1M limit" 5 'the limit is 0.00105 GB' "$scratch/o16" \
+	$T "$plume" simulate "$bad/scene-short.json" -o "$scratch/o16" --png --max-memory 1M
+$T "$plume" simulate "$bad/scene-short.json" -o "$scratch/o17" --max-memory 64M >/dev/null 2>&1
+check "a short run fits in 64M" test -s "$scratch/o17/summary.json"
+
+# --- all or nothing over an earlier run (cli/output.c) -----------------------------------
+edit "$bad/scene-short.json" "$bad/scene-three.json" "d['duration'] = 0.033"
+run=$scratch/run
+$T "$plume" simulate "$bad/scene-three.json" -o "$run" >/dev/null 2>&1
+check "earlier run: three frames" test "$(ls "$run/frames" | wc -l)" -eq 3
+echo mine >"$run/notes.txt"
+echo mine >"$run/frames/my-notes.txt"
+cp "$run/summary.json" "$scratch/summary-before.json"
+# A failing run changes nothing, not even a frame.
+expect_failure "failing run over an earlier one" 3 '$.duration' \
+	$T "$plume" simulate "$bad/scene-steps.json" -o "$run"
+check "failed run: summary intact" cmp -s "$run/summary.json" "$scratch/summary-before.json"
+check "failed run: three frames kept" test "$(ls "$run/frames" | grep -c obj)" -eq 3
+# A shorter run replaces the earlier run whole: its frames go, the user's files stay.
+$T "$plume" simulate "$bad/scene-short.json" -o "$run" >/dev/null 2>&1
+check "new run: only its two frames" test "$(ls "$run/frames" | grep -c obj)" -eq 2
+check "new run: summary replaced" bash -c "! cmp -s '$run/summary.json' '$scratch/summary-before.json'"
+check "new run: the user's file in DIR kept" test "$(cat "$run/notes.txt")" = mine
+check "new run: the user's file in frames/ kept" test "$(cat "$run/frames/my-notes.txt")" = mine
+check "new run: no staging beside or inside" test -z "$(ls -A "$scratch" "$run" | grep plume-staging)"
+# Staging folders of a dead run are removed; those of a live process (this shell) are not.
+mkdir "$scratch/.run.plume-staging-999999-abcdef" "$run/.plume-staging-999998-abcdef" \
+	"$scratch/.run.plume-staging-$$-abcdef" "$scratch/.run.plume-staging-keep"
+$T "$plume" simulate "$bad/scene-short.json" -o "$run" >/dev/null 2>&1
+check "stale staging beside DIR removed" test ! -e "$scratch/.run.plume-staging-999999-abcdef"
+check "stale staging inside DIR removed" test ! -e "$run/.plume-staging-999998-abcdef"
+check "a live process's staging kept" test -d "$scratch/.run.plume-staging-$$-abcdef"
+check "a folder not of the pattern kept" test -d "$scratch/.run.plume-staging-keep"
+rmdir "$scratch/.run.plume-staging-$$-abcdef" "$scratch/.run.plume-staging-keep"
+# A folder of DIR with the name of a file of the run is not deleted: the run fails instead.
+gen=$scratch/gen
+mkdir -p "$gen/feather.obj"
+echo mine >"$gen/feather.obj/inside.txt"
+expect_failure "a folder named like an output" 4 'feather.obj: the run writes a file or folder of that name' \
+	$T "$plume" generate "$examples/franco-walter/blue.json" -o "$gen" --format obj
+check "that folder is intact" test "$(cat "$gen/feather.obj/inside.txt")" = mine
+check "no staging left after the conflict" test -z "$(ls -A "$scratch" | grep plume-staging)"
+
+# DIR a symbolic link to a folder: the folder gets the run, the link stays a link.
+mkdir -p "$scratch/real"
+echo mine >"$scratch/real/notes.txt"
+ln -s real "$scratch/link"
+$T "$plume" generate "$examples/franco-walter/blue.json" -o "$scratch/link" --format json >/dev/null 2>&1
+check "a linked DIR: still a link" test -L "$scratch/link"
+check "a linked DIR: the run is in the folder" test -s "$scratch/real/feather.json"
+check "a linked DIR: the user's file kept" test "$(cat "$scratch/real/notes.txt")" = mine
+check "a linked DIR: no staging left" test -z "$(ls -A "$scratch" "$scratch/real" | grep plume-staging)"
+
+finish
