@@ -35,10 +35,10 @@ golden() { # golden NAME FILE HASH
 	done
 }
 golden "franco-walter hawk JSON" fw/feather.json c2b283408fac4e0106498eeb161be52a7b404dc91df3c56438fe6c42ca7b3879
-golden "franco-walter hawk OBJ" fw/feather.obj a4d640484eb1936dfd2e5fc80d14adfff21b720e08e57cf82f580481e4ca031f
+golden "franco-walter hawk OBJ" fw/feather.obj af6c0263b9606144522b9c4ed4492f86a5f05ba5f2f24de0fc490ed99cbd9f66
 golden "streit-heidrich contour" sh/feather.json 47d44f0f1b197bf36bd8349ed2a449c95ca8af107fd29b996f4dfdb64845b3ed
 golden "zhang-kanai figure 8" zk/feather.json 28a3894c55f224b3205b38616b61fe020852c119ea2de1230d70ddda81472e5f
-golden "coat figure 15" coat/coat.obj 35ac1f0314e10766451bca2895cf844b044aa9b956480be63762411c9673c03c
+golden "coat figure 15" coat/coat.obj 9cbab708ee7bf2f503c2aa348907b90c3b1769f71d80df5ad831156adb4e5ddb
 
 for file in sim/mesh.obj sim/feather.json sim/frames/0000.obj sim/frames/0001.obj sim/frames/0002.obj \
 	sim/stats.csv rt/feather.png; do
