@@ -10,6 +10,10 @@
 
 static const double PI = 3.14159265358979323846;
 
+// The range of E_vw the search may use, in units of E_ww (see plume_lab_calibrate).
+static const double E_VW_RANGE_LOW = 1e-3;
+static const double E_VW_RANGE_HIGH = 1e3;
+
 plume_calibration_def plume_calibration_default_def(void)
 {
 	plume_calibration_def def;
@@ -124,12 +128,12 @@ plume_status plume_lab_calibrate(const plume_calibration_def *def, plume_calibra
 	straight.height = whole_periods(height, meso.bands.period);
 	straight.element_count = 200;
 	straight.barb_angle = 0.0;
-	status =
-	    slope_of(&meso, &straight, def->longitudinal_strain_max, def->steps, 1, result, &result->slope_longitudinal, err);
+	status = slope_of(&meso, &straight, def->longitudinal_strain_max, def->steps, 1, result,
+	                  &result->slope_longitudinal, err);
 	if (status == PLUME_OK) {
 		straight.barb_angle = 0.5 * PI;
-		status =
-		    slope_of(&meso, &straight, def->transverse_strain_max, def->steps, 1, result, &result->slope_transverse, err);
+		status = slope_of(&meso, &straight, def->transverse_strain_max, def->steps, 1, result,
+		                  &result->slope_transverse, err);
 	}
 	plume_sample_def tilted = def->sample;
 	tilted.height = height;
@@ -155,25 +159,36 @@ plume_status plume_lab_calibrate(const plume_calibration_def *def, plume_calibra
 	// bracket: the Illinois variant of false position, with a bisection step whenever it
 	// would shrink the bracket by less than half.
 	// The search starts at E_ww / 4, near where the thesis's parameters put E_vw, and
-	// widens by doubling: very stiff shear makes the tilted test hard for Newton, so the
-	// bracket should not reach further than it needs.
-	double lo = log(0.25 * macro.E_ww), hi = lo, f_lo = 0.0, f_hi = 0.0, slope = 0.0;
+	// widens by growing steps: very stiff shear makes the tilted test hard for Newton, so
+	// the bracket should not reach further than it needs. It never leaves
+	// [E_VW_RANGE_LOW, E_VW_RANGE_HIGH] E_ww (and E_vw <= E_vv): a shear modulus of the
+	// barbule web a thousand times softer than its transverse modulus leaves the tilted
+	// slope at its shear-free limit, and one stiffer than the barbs themselves is not a
+	// vane. When the target lies outside the slopes the model reaches over that range, no
+	// E_vw answers the question; the search says so with both ends instead of drifting to
+	// absurd moduli (barbs running clamp to clamp once reached 1e-74 Pa).
+	double log_min = log(E_VW_RANGE_LOW * macro.E_ww);
+	double log_max = log(fmin(E_VW_RANGE_HIGH * macro.E_ww, macro.E_vv));
+	double lo = fmin(fmax(log(0.25 * macro.E_ww), log_min), log_max), hi = lo, f_lo = 0.0, f_hi = 0.0, slope = 0.0;
 	macro.E_vw = exp(lo);
 	status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, 1, result, &slope, err);
 	f_lo = f_hi = slope - target;
 	double step = log(2.0);
-	for (int expand = 0; expand < 12 && status == PLUME_OK && (f_lo > 0.0) == (f_hi > 0.0); ++expand) {
-		double x = f_lo > 0.0 ? lo - step : hi + step;
+	while (status == PLUME_OK && (f_lo > 0.0) == (f_hi > 0.0)) {
+		bool down = f_lo > 0.0;
+		if (down ? lo <= log_min : hi >= log_max)
+			break; // the end of the range: the target is out of reach
+		double x = down ? fmax(lo - step, log_min) : fmin(hi + step, log_max);
 		macro.E_vw = exp(x);
 		status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, 1, result, &slope, err);
 		// Newton may fail on a very stiff trial: step out by half as far and try again.
 		for (int retry = 0; retry < 4 && status == PLUME_ERROR_NUMERIC; ++retry) {
 			step *= 0.5;
-			x = f_lo > 0.0 ? lo - step : hi + step;
+			x = down ? fmax(lo - step, log_min) : fmin(hi + step, log_max);
 			macro.E_vw = exp(x);
 			status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, 1, result, &slope, err);
 		}
-		if (f_lo > 0.0) {
+		if (down) {
 			hi = lo, f_hi = f_lo;
 			lo = x, f_lo = slope - target;
 		} else {
@@ -182,10 +197,37 @@ plume_status plume_lab_calibrate(const plume_calibration_def *def, plume_calibra
 		}
 		step *= 1.5;
 	}
-	if (status == PLUME_OK && (f_lo > 0.0) == (f_hi > 0.0))
-		status = plume_error_set(err, PLUME_ERROR_NUMERIC,
-		                         "no E_vw between %g and %g Pa gives the mesoscale tilted slope %g Pa", exp(lo),
-		                         exp(hi), target);
+	if (status == PLUME_OK && (f_lo > 0.0) == (f_hi > 0.0)) {
+		// Out of reach: the slopes at both ends of the range the search may use (the far
+		// end solved now if the search never went there; where Newton fails on it, the
+		// furthest modulus that converged stands for it).
+		bool below = f_lo > 0.0; // every slope tried is above the target
+		double near_x = below ? lo : hi, near_slope = (below ? f_lo : f_hi) + target;
+		double far_x = below ? log_max : log_min, far_slope = 0.0;
+		double from = below ? hi : lo;
+		plume_status far_status = PLUME_ERROR_NUMERIC;
+		for (int retry = 0; retry < 6 && far_status == PLUME_ERROR_NUMERIC; ++retry) {
+			if (retry > 0)
+				far_x = 0.5 * (far_x + from);
+			macro.E_vw = exp(far_x);
+			far_status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, 1, result, &far_slope, err);
+		}
+		if (far_status == PLUME_ERROR_NUMERIC)
+			far_x = from, far_slope = (below ? f_hi : f_lo) + target;
+		else if (far_status != PLUME_OK)
+			status = far_status;
+		if (status == PLUME_OK) {
+			double x_min = below ? near_x : far_x, x_max = below ? far_x : near_x;
+			double s_min = below ? near_slope : far_slope, s_max = below ? far_slope : near_slope;
+			status = plume_error_set(err, PLUME_ERROR_NUMERIC,
+			                         "no E_vw gives the mesoscale tilted slope %.6g Pa: the macroscale tilted slope "
+			                         "(%s barb constraint) is %.6g Pa at E_vw = %.4g Pa and %.6g Pa at E_vw = %.4g "
+			                         "Pa, the reachable range, so the target is %s it (check the aspect ratio and "
+			                         "the barb angle of the tilted test)",
+			                         target, def->barb_constraint ? "with the" : "without the", s_min, exp(x_min),
+			                         s_max, exp(x_max), below ? "below" : "above");
+		}
+	}
 	int side = 0;
 	while (status == PLUME_OK && hi - lo > log1p(def->tolerance)) {
 		double x = (lo * f_hi - hi * f_lo) / (f_hi - f_lo);
@@ -233,8 +275,8 @@ plume_status plume_lab_calibrate(const plume_calibration_def *def, plume_calibra
 	if (!(x >= lo && x <= hi))
 		x = 0.5 * (lo + hi);
 	macro.E_vw = exp(x);
-	status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, 1, result, &result->slope_tilted_macroscale,
-	                  err);
+	status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, 1, result,
+	                  &result->slope_tilted_macroscale, err);
 	if (status != PLUME_OK) {
 		plume_error_prefix(err, "calibration");
 		return status;

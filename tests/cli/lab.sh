@@ -68,6 +68,13 @@ assert abs(r['E_vv'] / 3.60e8 - 1) < 0.01 and abs(r['E_ww'] / 4.80e4 - 1) < 0.01
 assert r['solves'] > 0 and 'tilted_mesoscale' in r['slopes'] and r['phases'] == 1
 "
 
+# No answer: H/W and W/H swapped, the barbs run from clamp to clamp and the
+# mesoscale tilted slope is below anything the macroscale model reaches. The
+# search stops at the ends of its range (1e-3 to 1e3 E_ww) and names both.
+expect_failure "calibrate out of reach" 1 "no E_vw gives the mesoscale tilted slope" "$plume" lab calibrate --phi 0.14 --Eb 3.92e4 --EB 2.57e9 --elements 600 --macro-elements 300 --unconstrained --phases 1 --aspect 0.769
+check "calibrate out of reach: both ends of the range" grep -q 'is [0-9.e+]* Pa at E_vw = 48 Pa and [0-9.e+]* Pa at E_vw = 4.8e+07 Pa, the reachable range, so the target is below it' "$scratch/err.txt"
+check "calibrate out of reach: nothing on stdout" test ! -s "$scratch/out.txt"
+
 # --- study ---------------------------------------------------------------------
 expect_failure "unknown study" 2 "unknown study 'bending'" "$plume" lab study bending -o "$scratch/s"
 # The locking study at a twentieth of its size: the paper's point, unaligned meshes lock.
