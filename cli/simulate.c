@@ -19,7 +19,8 @@ void cli_help_simulate(void)
 	     "Simulates the feather a scene describes as an anisotropic elastic shell\n"
 	     "(Jouve et al. 2024) and writes:\n"
 	     "  DIR/mesh.obj          the rest shell (UVs, rachis and vane groups)\n"
-	     "  DIR/feather.json      the generated feather (barb-level geometry)\n"
+	     "  DIR/feather.json      the generated feather (barb-level geometry; its numbers\n"
+	     "                        in DIR/feather.bin, docs/feather-json.md)\n"
 	     "  DIR/frames/NNNN.obj   the shell at every written step (0000: the start)\n"
 	     "  DIR/sim.glb           all frames as one animated glTF 2.0 file (morph\n"
 	     "                        targets, animation \"simulation\"; Blender, three.js)\n"
@@ -276,7 +277,8 @@ static plume_status simulate(const plume_scene *scene, cli_output *output, run_s
 	plume_status status =
 	    plume_mesh_write_obj(scene->mesh, NULL, cli_output_path(output, "mesh.obj", path, sizeof path), err);
 	if (status == PLUME_OK && scene->feather != NULL)
-		status = plume_write_json(scene->feather, cli_output_path(output, "feather.json", path, sizeof path), err);
+		status =
+		    plume_write_json_binary(scene->feather, cli_output_path(output, "feather.json", path, sizeof path), err);
 	if (status != PLUME_OK)
 		return status;
 	snprintf(path, sizeof path, "%s/frames", output->stage);
