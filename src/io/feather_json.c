@@ -24,6 +24,7 @@
 
 #include <jansson.h>
 
+#include "../core/alloc.h"
 #include "../model/feather_internal.h"
 #include "plume/io.h"
 
@@ -317,10 +318,10 @@ static plume_status write_document(const plume_feather *feather, const char *pat
 	if (status != PLUME_OK)
 		return status;
 	if (binary) {
-		if ((bin = malloc(sizeof *bin)) == NULL)
+		if ((bin = plume_alloc(sizeof *bin)) == NULL)
 			return plume_text_close(&text, plume_error_set(err, PLUME_ERROR_MEMORY, "%s: out of memory", path), err);
 		if ((status = plume_text_open(&bin_text, bin_path, err)) != PLUME_OK) {
-			free(bin);
+			plume_free(bin);
 			return plume_text_close(&text, status, err);
 		}
 		*bin = (sidecar){.stream = bin_text.stream};
@@ -343,7 +344,7 @@ static plume_status write_document(const plume_feather *feather, const char *pat
 		sidecar_flush(bin);
 		// The sidecar is committed first: a JSON file never names a missing sidecar.
 		status = plume_text_close(&bin_text, status, err);
-		free(bin);
+		plume_free(bin);
 	}
 	return plume_text_close(&text, status, err);
 }
@@ -690,12 +691,12 @@ static plume_status load_sidecar(reader *r, json_t *buffer)
 	long length = -1;
 	if (fseek(file, 0, SEEK_END) == 0)
 		length = ftell(file);
-	unsigned char *bytes = length >= 0 ? malloc(length > 0 ? (size_t)length : 1) : NULL;
+	unsigned char *bytes = length >= 0 ? plume_alloc(length > 0 ? (size_t)length : 1) : NULL;
 	bool ok = bytes != NULL && fseek(file, 0, SEEK_SET) == 0 && fread(bytes, 1, (size_t)length, file) == (size_t)length;
 	int error = errno;
 	fclose(file);
 	if (!ok) {
-		free(bytes);
+		plume_free(bytes);
 		if (length >= 0 && bytes == NULL)
 			return out_of_memory(r);
 		return plume_error_set(r->err, PLUME_ERROR_IO, "%s: cannot read the sidecar %s: %s", r->file, path,
@@ -788,7 +789,7 @@ plume_status plume_read_json(const char *path, plume_feather **out, plume_error 
 	plume_feather *feather = plume_feather_create_empty();
 	plume_status status = feather != NULL ? read_feather(&r, root, feather, true) : out_of_memory(&r);
 	json_decref(root);
-	free((void *)r.buffer);
+	plume_free((void *)r.buffer);
 	if (status != PLUME_OK) {
 		plume_feather_destroy(feather);
 		return status;
