@@ -1,14 +1,105 @@
 // Benchmark: the paper's Figure 1 scenario (examples/scenes/figure1-anisotropic.json)
-// at the paper's resolution (e = 5 mm) and on a mesh four times finer (e = 2.5 mm),
-// with the isotropic comparison. Prints wall time, steps, Newton iterations per step,
-// the split between assembly, factorisation and solve, and the largest barb strain.
-// No files are written: this measures the simulator alone.
+// at the paper's resolution (e = 5 mm) and on finer meshes (e = 2.5, 1.75 mm), with
+// the isotropic comparison at 5 mm, and the solver's floor: per mesh size, the CPU
+// of one Newton iteration against the CPU of one numeric factorisation of the same
+// KKT matrix in the same run, their ratio, factorisations and solves per iteration,
+// CHOLMOD's GFlop/s, and the exponent k of time ~ V^k fitted over the sizes. Last,
+// the `plume simulate` command on the 5 mm scene (all its files) against the
+// library's load and run of the same scene (issue 15's target: within 20 %).
+//
+// The factorisations and solves are counted and timed by wrapping CHOLMOD's entry
+// points at link time (bench/CMakeLists.txt: --wrap=cholmod_factorize,
+// --wrap=cholmod_solve2), so the library carries no benchmark code. Times are CPU
+// times (the machine may be shared: CPU seconds are steadier than wall seconds).
+// `bench_simulate quick` runs the 5 mm sizes only.
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <cholmod.h>
 
 #include "plume/plume.h"
 
-static int run(const char *name, double edge_length)
+// ---------------------------------------------------------------------------
+// CHOLMOD, counted
+
+typedef struct counters {
+	long factorizations;
+	long solves;
+	double factor_cpu;     ///< seconds, this thread
+	double factor_cpu_min; ///< the fastest single factorisation
+	double solve_cpu;
+	double flops; ///< CHOLMOD's count (Common->fl) summed over the factorisations
+} counters;
+
+static counters counted;
+
+static double thread_cpu(void)
+{
+	struct timespec t;
+	clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+	return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static double process_cpu(void)
+{
+	struct timespec t;
+	clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+	return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+int __real_cholmod_factorize(cholmod_sparse *A, cholmod_factor *L, cholmod_common *Common);
+int __wrap_cholmod_factorize(cholmod_sparse *A, cholmod_factor *L, cholmod_common *Common);
+int __real_cholmod_solve2(int sys, cholmod_factor *L, cholmod_dense *B, cholmod_sparse *Bset, cholmod_dense **X_Handle,
+                          cholmod_sparse **Xset_Handle, cholmod_dense **Y_Handle, cholmod_dense **E_Handle,
+                          cholmod_common *Common);
+int __wrap_cholmod_solve2(int sys, cholmod_factor *L, cholmod_dense *B, cholmod_sparse *Bset, cholmod_dense **X_Handle,
+                          cholmod_sparse **Xset_Handle, cholmod_dense **Y_Handle, cholmod_dense **E_Handle,
+                          cholmod_common *Common);
+
+int __wrap_cholmod_factorize(cholmod_sparse *A, cholmod_factor *L, cholmod_common *Common)
+{
+	double start = thread_cpu();
+	int result = __real_cholmod_factorize(A, L, Common);
+	double seconds = thread_cpu() - start;
+	counted.factorizations += 1;
+	counted.factor_cpu += seconds;
+	if (counted.factorizations == 1 || seconds < counted.factor_cpu_min)
+		counted.factor_cpu_min = seconds;
+	// fl: the flop count of the factorisation, set by cholmod_analyze for this pattern.
+	counted.flops += Common->fl;
+	return result;
+}
+
+int __wrap_cholmod_solve2(int sys, cholmod_factor *L, cholmod_dense *B, cholmod_sparse *Bset, cholmod_dense **X_Handle,
+                          cholmod_sparse **Xset_Handle, cholmod_dense **Y_Handle, cholmod_dense **E_Handle,
+                          cholmod_common *Common)
+{
+	double start = thread_cpu();
+	int result = __real_cholmod_solve2(sys, L, B, Bset, X_Handle, Xset_Handle, Y_Handle, E_Handle, Common);
+	counted.solve_cpu += thread_cpu() - start;
+	counted.solves += 1;
+	return result;
+}
+
+// ---------------------------------------------------------------------------
+// Runs
+
+typedef struct result {
+	int vertices;
+	double cpu;     ///< load, mesh and run
+	double run_cpu; ///< plume_scene_run alone
+	int iterations;
+	counters c;
+} result;
+
+static int load(const char *name, double edge_length, plume_scene **out)
 {
 	char path[1024];
 	snprintf(path, sizeof path, "%s/examples/scenes/%s.json", PLUME_SOURCE_DIR, name);
@@ -18,54 +109,126 @@ static int run(const char *name, double edge_length)
 		fprintf(stderr, "%s\n", err.message);
 		return 1;
 	}
-	if (edge_length != 0.005) {
-		// Re-mesh the same feather finer.
-		plume_mesh_def def = plume_mesh_default_def();
-		def.edge_length = edge_length;
-		def.rachis_width_base = 0.008;
-		def.rachis_width_tip = 0.004;
-		plume_mesh *mesh = NULL;
-		if (plume_mesh_from_feather(scene->feather, &def, &mesh, &scene->mesh_report, &err) != PLUME_OK) {
+	*out = scene;
+	if (edge_length == 0.005)
+		return 0;
+	// Re-mesh the same feather finer.
+	plume_mesh_def def = plume_mesh_default_def();
+	def.edge_length = edge_length;
+	def.rachis_width_base = 0.008;
+	def.rachis_width_tip = 0.004;
+	plume_mesh *mesh = NULL;
+	if (plume_mesh_from_feather(scene->feather, &def, &mesh, &scene->mesh_report, &err) != PLUME_OK) {
+		fprintf(stderr, "%s\n", err.message);
+		return 1;
+	}
+	// Handles that select vertices near a point are selected again on the new mesh.
+	for (int h = 0; h < scene->handle_count; ++h) {
+		plume_scene_handle *handle = scene->handles + h;
+		if (handle->near_given && plume_mesh_add_group_near(mesh, handle->group, handle->source_group, handle->near,
+		                                                    handle->radius, &err) != PLUME_OK) {
 			fprintf(stderr, "%s\n", err.message);
-			plume_scene_destroy(scene);
+			plume_mesh_destroy(mesh);
 			return 1;
 		}
-		// Handles that select vertices near a point are selected again on the new mesh.
-		for (int h = 0; h < scene->handle_count; ++h) {
-			plume_scene_handle *handle = scene->handles + h;
-			if (handle->near_given && plume_mesh_add_group_near(mesh, handle->group, handle->source_group, handle->near,
-			                                                    handle->radius, &err) != PLUME_OK) {
-				fprintf(stderr, "%s\n", err.message);
-				plume_mesh_destroy(mesh);
-				plume_scene_destroy(scene);
-				return 1;
-			}
-		}
-		plume_mesh_destroy(scene->mesh);
-		scene->mesh = mesh;
 	}
+	plume_mesh_destroy(scene->mesh);
+	scene->mesh = mesh;
+	return 0;
+}
+
+static int run(const char *name, double edge_length, result *out)
+{
+	double start = process_cpu();
+	plume_scene *scene = NULL;
+	if (load(name, edge_length, &scene) != 0) {
+		plume_scene_destroy(scene);
+		return 1;
+	}
+	counted = (counters){0};
 	plume_scene_summary summary;
+	plume_error err = {0};
+	double run_start = process_cpu();
 	plume_status status = plume_scene_run(scene, NULL, NULL, &summary, &err);
-	printf("%-22s e = %.4f m: %5d vertices %5d faces %4d barb constraints | %s %3d steps, %5d Newton iterations "
-	       "(%.2f a step), %.2f s wall (assembly %.2f s, factorisation %.2f s, solve %.2f s), largest barb strain "
-	       "%.2e, rachis tip deflection %.4f m\n",
-	       name, edge_length, summary.vertex_count, summary.face_count, summary.constraint_count,
+	double end = process_cpu();
+	*out = (result){summary.vertex_count, end - start, end - run_start, summary.newton_iterations, counted};
+	const counters *c = &out->c;
+	double iterations = summary.newton_iterations > 0 ? summary.newton_iterations : 1;
+	double per_iteration = out->run_cpu / iterations;
+	double per_factor = c->factorizations > 0 ? c->factor_cpu / (double)c->factorizations : 0;
+	printf("%-20s e = %4.2f mm %5d vertices %5d faces %4d constraints | %s %3d steps %5d iterations (%.2f a step) "
+	       "%6.2f s CPU, strain %.1e\n",
+	       name, 1000 * edge_length, summary.vertex_count, summary.face_count, summary.constraint_count,
 	       status == PLUME_OK ? "ok    " : "FAILED", summary.steps, summary.newton_iterations,
-	       summary.steps > 0 ? (double)summary.newton_iterations / summary.steps : 0.0, summary.wall_seconds,
-	       summary.seconds_assembly, summary.seconds_factor, summary.seconds_solve, summary.max_barb_strain,
-	       summary.rachis_tip_deflection);
+	       summary.steps > 0 ? (double)summary.newton_iterations / summary.steps : 0.0, out->run_cpu,
+	       summary.max_barb_strain);
+	printf("%-20s   per iteration %7.2f ms CPU; one factorisation %6.2f ms (fastest %6.2f ms); ratio %5.2f; "
+	       "%.2f factorisations and %.2f solves an iteration; factorisation %4.1f %% of the run at %.2f GFlop/s; "
+	       "solves %4.1f %%\n",
+	       "", 1e3 * per_iteration, 1e3 * per_factor, 1e3 * c->factor_cpu_min,
+	       per_factor > 0 ? per_iteration / per_factor : 0.0, (double)c->factorizations / iterations,
+	       (double)c->solves / iterations, 100 * c->factor_cpu / out->run_cpu,
+	       c->factor_cpu > 0 ? 1e-9 * c->flops / c->factor_cpu : 0.0, 100 * c->solve_cpu / out->run_cpu);
 	if (status != PLUME_OK)
 		printf("  %s\n", err.message);
 	plume_scene_destroy(scene);
 	return status == PLUME_OK ? 0 : 1;
 }
 
+/// Least-squares slope of log y against log x.
+static double exponent(const result *r, int count, bool factor)
+{
+	double sx = 0, sy = 0, sxx = 0, sxy = 0;
+	for (int i = 0; i < count; ++i) {
+		double x = log(r[i].vertices), y = log(factor ? r[i].c.factor_cpu : r[i].run_cpu);
+		sx += x, sy += y, sxx += x * x, sxy += x * y;
+	}
+	return (count * sxy - sx * sy) / (count * sxx - sx * sx);
+}
+
+/// CPU seconds of `plume simulate SCENE -o DIR` (a child process, all its files).
+static double command_cpu(void)
+{
+	char dir[] = "/tmp/plume-bench-XXXXXX";
+	if (mkdtemp(dir) == NULL)
+		return -1;
+	char command[2048];
+	snprintf(command, sizeof command,
+	         "'%s' simulate '%s/examples/scenes/figure1-anisotropic.json' -o '%s/out' >/dev/null 2>&1 && rm -rf '%s'",
+	         PLUME_BINARY, PLUME_SOURCE_DIR, dir, dir);
+	struct rusage before, after;
+	getrusage(RUSAGE_CHILDREN, &before);
+	int status = system(command);
+	getrusage(RUSAGE_CHILDREN, &after);
+	if (status != 0)
+		return -1;
+	double seconds = (double)(after.ru_utime.tv_sec - before.ru_utime.tv_sec) +
+	                 (double)(after.ru_stime.tv_sec - before.ru_stime.tv_sec) +
+	                 1e-6 * (double)(after.ru_utime.tv_usec - before.ru_utime.tv_usec) +
+	                 1e-6 * (double)(after.ru_stime.tv_usec - before.ru_stime.tv_usec);
+	return seconds;
+}
+
 int main(int argc, char **argv)
 {
 	bool quick = argc > 1 && argv[1][0] == 'q';
-	int failures = run("figure1-anisotropic", 0.005);
-	failures += run("figure1-isotropic", 0.005);
-	if (!quick)
-		failures += run("figure1-anisotropic", 0.0025);
+	static const double sizes[] = {0.005, 0.0025, 0.00175};
+	int size_count = quick ? 1 : 3;
+	result results[3], isotropic;
+	int failures = 0;
+	for (int i = 0; i < size_count; ++i)
+		failures += run("figure1-anisotropic", sizes[i], results + i);
+	failures += run("figure1-isotropic", 0.005, &isotropic);
+	if (size_count > 1)
+		printf("fitted exponent, time ~ V^k over %d sizes: run k = %.2f, factorisation k = %.2f\n", size_count,
+		       exponent(results, size_count, false), exponent(results, size_count, true));
+	double command = command_cpu();
+	if (command < 0) {
+		printf("plume simulate failed (%s)\n", PLUME_BINARY);
+		return 1;
+	}
+	printf("plume simulate figure1-anisotropic (all files): %.2f s CPU; library load + run %.2f s CPU; "
+	       "command / library = %.2f (target <= 1.20)\n",
+	       command, results[0].cpu, command / results[0].cpu);
 	return failures == 0 ? 0 : 1;
 }

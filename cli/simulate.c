@@ -19,7 +19,8 @@ void cli_help_simulate(void)
 	     "Simulates the feather a scene describes as an anisotropic elastic shell\n"
 	     "(Jouve et al. 2024) and writes:\n"
 	     "  DIR/mesh.obj          the rest shell (UVs, rachis and vane groups)\n"
-	     "  DIR/feather.json      the generated feather (barb-level geometry)\n"
+	     "  DIR/feather.json      the generated feather (barb-level geometry; its numbers\n"
+	     "                        in DIR/feather.bin, docs/feather-json.md)\n"
 	     "  DIR/frames/NNNN.obj   the shell at every written step (0000: the start)\n"
 	     "  DIR/sim.glb           all frames as one animated glTF 2.0 file (morph\n"
 	     "                        targets, animation \"simulation\"; Blender, three.js)\n"
@@ -105,6 +106,7 @@ typedef struct run_state {
 	bool progress;
 	double max_strain;
 	plume_mesh_animation *animation; ///< every frame, for DIR/sim.glb
+	plume_mesh_obj_writer *obj;      ///< frames/NNNN.obj, the lines shared by all frames formatted once
 	bool fields;                     ///< --fields: DIR/fields/NNNN.vtu and DIR/fields.pvd
 	bool glb_feather;                ///< --glb-feather: sim.glb also carries the feather
 	plume_barb_embedding *carried;   ///< its embedding
@@ -119,7 +121,7 @@ static plume_status write_frame(run_state *run, int frame, double time, const pl
 	char name[64], path[4352];
 	snprintf(name, sizeof name, "frames/%04d.obj", frame);
 	cli_output_path(run->output, name, path, sizeof path);
-	plume_status status = plume_mesh_write_obj(run->scene->mesh, plume_sim_positions(sim), path, err);
+	plume_status status = plume_mesh_obj_writer_write(run->obj, plume_sim_positions(sim), path, err);
 	if (status == PLUME_OK)
 		status = plume_mesh_animation_add_frame(run->animation, time, plume_sim_positions(sim), err);
 	if (status == PLUME_OK && run->fields) {
@@ -281,11 +283,14 @@ static plume_status simulate(const plume_scene *scene, cli_output *output, run_s
 	plume_status status =
 	    plume_mesh_write_obj(scene->mesh, NULL, cli_output_path(output, "mesh.obj", path, sizeof path), err);
 	if (status == PLUME_OK && scene->feather != NULL)
-		status = plume_write_json(scene->feather, cli_output_path(output, "feather.json", path, sizeof path), err);
+		status =
+		    plume_write_json_binary(scene->feather, cli_output_path(output, "feather.json", path, sizeof path), err);
 	if (status != PLUME_OK)
 		return status;
 	snprintf(path, sizeof path, "%s/frames", output->stage);
 	status = plume_mesh_animation_create(scene->mesh, NULL, &run->animation, err);
+	if (status == PLUME_OK)
+		status = plume_mesh_obj_writer_create(scene->mesh, &run->obj, err);
 	if (status == PLUME_OK && run->glb_feather) {
 		status = plume_embedding_create(scene->feather, scene->mesh, &run->carried, err);
 		if (status == PLUME_OK)
@@ -465,6 +470,7 @@ int cli_simulate(int argc, char **argv)
 		       summary.max_barb_strain, summary.rachis_tip_deflection, run.frames, output_dir);
 	plume_scene_destroy(scene);
 	plume_mesh_animation_destroy(run.animation);
+	plume_mesh_obj_writer_destroy(run.obj);
 	plume_embedding_destroy(run.carried);
 	free(run.field_times);
 	cli_barb_renderer_end(&run.renderer);

@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 
 #include "model/feather_internal.h"
 #include "support.h"
@@ -218,6 +219,66 @@ static void test_json_refuses_ungrouped_barbules(void **state)
 	assert_non_null(strstr(err.message, "grouped"));
 	assert_int_equal(test_count_entries(dir), 0);
 	plume_feather_destroy(feather);
+	test_remove_tree(dir);
+	assert_int_equal(plume_bytes_in_use(), before);
+}
+
+static long long file_size(const char *path)
+{
+	struct stat info;
+	assert_int_equal(stat(path, &info), 0);
+	return (long long)info.st_size;
+}
+
+/// Version 2 (numbers in a sidecar, simulate's feather.json): the same feather
+/// back bit for bit (-0, a subnormal, nested afterfeathers), the same bytes
+/// again, and half the size of version 1 on a full feather.
+static void test_json_binary_round_trip(void **state)
+{
+	(void)state;
+	int64_t before = plume_bytes_in_use();
+	char dir[256], path[512], sidecar[512], again[512], text[512];
+	test_make_temp_dir(dir, sizeof dir);
+	snprintf(path, sizeof path, "%s/small.json", dir);
+	snprintf(sidecar, sizeof sidecar, "%s/small.bin", dir);
+	snprintf(again, sizeof again, "%s/again.json", dir);
+	snprintf(text, sizeof text, "%s/text.json", dir);
+	plume_error err;
+
+	plume_feather *original = small_feather(2);
+	assert_int_equal(plume_write_json_binary(original, path, &err), PLUME_OK);
+	assert_true(test_file_exists(sidecar));
+	plume_feather *copy = read_ok(path);
+	assert_true(plume_feather_equal(original, copy));
+	plume_barb barb = plume_feather_barb(copy, 0);
+	assert_true(signbit(barb.curve.points[0].z) && barb.curve.points[0].z == 0.0);
+	assert_true(barb.curve.normals[0].y == 4.9e-324);
+	assert_true(plume_feather_afterfeather_t(copy) == 0.15 + 1e-16);
+	plume_feather_destroy(copy);
+	plume_feather_destroy(original);
+
+	// A full feather: equal to what version 1 gives back, the same bytes when written again.
+	original = hawk(1);
+	snprintf(path, sizeof path, "%s/hawk.json", dir);
+	snprintf(sidecar, sizeof sidecar, "%s/hawk.bin", dir);
+	assert_int_equal(plume_write_json_binary(original, path, &err), PLUME_OK);
+	write_ok(FORMAT_JSON, original, text);
+	copy = read_ok(path);
+	plume_feather *from_text = read_ok(text);
+	assert_true(plume_feather_equal(original, copy));
+	assert_true(plume_feather_equal(from_text, copy));
+	assert_int_equal(plume_write_json_binary(copy, again, &err), PLUME_OK);
+	assert_true(test_hash_file(path) != test_hash_file(again)); // it names its own sidecar, again.bin
+	char again_bin[512];
+	snprintf(again_bin, sizeof again_bin, "%s/again.bin", dir);
+	assert_true(test_hash_file(sidecar) == test_hash_file(again_bin));
+	// Every double of the points, normals, arc lengths, widths and uvs: 9 a point.
+	plume_feather_info info = plume_feather_get_info(original);
+	assert_true(file_size(sidecar) >= (long long)info.point_count * 9 * 8);
+	assert_true(file_size(path) + file_size(sidecar) < file_size(text) * 3 / 4);
+	plume_feather_destroy(from_text);
+	plume_feather_destroy(copy);
+	plume_feather_destroy(original);
 	test_remove_tree(dir);
 	assert_int_equal(plume_bytes_in_use(), before);
 }
@@ -661,7 +722,7 @@ static void test_read_json_errors(void **state)
 	static const struct {
 		const char *from, *to, *path, *what;
 	} cases[] = {
-	    {"\"version\": 1", "\"version\": 2", "$.version:", "unsupported version"},
+	    {"\"version\": 1", "\"version\": 3", "$.version:", "unsupported version"},
 	    {"\"format\": \"plume-feather\"", "\"format\": \"feather\"", "$.format:", "plume-feather"},
 	    {"\"side\": \"left\"", "\"side\": \"up\"", "$.barbs[0].side:", "\"left\" or \"right\""},
 	    {"\"segment\": 0", "\"segment\": 0.5", "$.barbs[0].segment:", "integer"},
@@ -756,12 +817,71 @@ static void test_failed_write_leaves_existing_file(void **state)
 	assert_int_equal(plume_bytes_in_use(), before);
 }
 
+/// Version 2's own errors: a missing or short sidecar, a name with a folder, a
+/// view whose count disagrees, and views in a version 1 document.
+static void test_json_binary_errors(void **state)
+{
+	(void)state;
+	int64_t before = plume_bytes_in_use();
+	char dir[256], path[512], sidecar[512], message[1024];
+	test_make_temp_dir(dir, sizeof dir);
+	snprintf(path, sizeof path, "%s/doc.json", dir);
+	snprintf(sidecar, sizeof sidecar, "%s/doc.bin", dir);
+	static const char head[] = "{\"format\": \"plume-feather\", \"version\": 2, \"buffer\": {\"uri\": \"%s\"},\n"
+	                           " \"shaft\": {\"calamus_samples\": 0, \"position\": %s, \"tangent\": [0, 1, 0],"
+	                           " \"normal\": [0, 0, 1], \"binormal\": [1, 0, 0], \"width\": [0.001], \"t\": [0]},"
+	                           " \"barbs\": [], \"afterfeather\": null}\n";
+	char document[1024];
+	// 24 bytes: one point, three doubles 1, 2, 3.
+	FILE *file = fopen(sidecar, "wb");
+	for (int i = 1; i <= 3; ++i) {
+		unsigned char bytes[8];
+		uint64_t bits;
+		double value = i;
+		memcpy(&bits, &value, 8);
+		for (int k = 0; k < 8; ++k)
+			bytes[k] = (unsigned char)(bits >> (8 * k));
+		fwrite(bytes, 1, 8, file);
+	}
+	fclose(file);
+	snprintf(document, sizeof document, head, "doc.bin", "{\"offset\": 0, \"count\": 3}");
+	test_write_file(path, document);
+	plume_feather *feather = read_ok(path);
+	const plume_shaft_sample *shaft = plume_feather_shaft(feather);
+	assert_true(shaft[0].position.x == 1 && shaft[0].position.y == 2 && shaft[0].position.z == 3);
+	plume_feather_destroy(feather);
+
+	snprintf(document, sizeof document, head, "doc.bin", "{\"offset\": 8, \"count\": 3}");
+	test_write_file(path, document);
+	snprintf(message, sizeof message, "%s: $.shaft.position: the view", path);
+	expect_read_error(path, PLUME_ERROR_SPEC, message, "runs past the sidecar's 24 bytes");
+	snprintf(document, sizeof document, head, "doc.bin", "{\"offset\": 0, \"count\": 2}");
+	test_write_file(path, document);
+	expect_read_error(path, PLUME_ERROR_SPEC, "$.shaft.position", "expected an array of 3n numbers");
+	snprintf(document, sizeof document, head, "../doc.bin", "{\"offset\": 0, \"count\": 3}");
+	test_write_file(path, document);
+	expect_read_error(path, PLUME_ERROR_SPEC, "$.buffer.uri", "a file name in the JSON file's folder");
+	snprintf(document, sizeof document, head, "none.bin", "{\"offset\": 0, \"count\": 3}");
+	test_write_file(path, document);
+	expect_read_error(path, PLUME_ERROR_IO, "cannot read the sidecar", "none.bin");
+	// Version 1 has no sidecar: neither "buffer" nor views.
+	write_variant(path, "\"version\": 1", "\"version\": 3");
+	expect_read_error(path, PLUME_ERROR_SPEC, "$.version", "reads versions 1 and 2");
+	write_variant(path, "\"segment\": 1, \"position\": [0, 0.05, 0, 0.01, 0.06, 0]",
+	              "\"segment\": 1, \"position\": {\"offset\": 0, \"count\": 6}");
+	expect_read_error(path, PLUME_ERROR_SPEC, "$.barbs[1].position", "expected an array");
+	test_remove_tree(dir);
+	assert_int_equal(plume_bytes_in_use(), before);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test(test_json_round_trip_hawk),
 	    cmocka_unit_test(test_json_round_trip_small_with_barbules_and_afterfeathers),
 	    cmocka_unit_test(test_json_refuses_ungrouped_barbules),
+	    cmocka_unit_test(test_json_binary_round_trip),
+	    cmocka_unit_test(test_json_binary_errors),
 	    cmocka_unit_test(test_same_seed_same_bytes_other_seed_other_bytes),
 	    cmocka_unit_test(test_obj_parses_back_to_the_feather),
 	    cmocka_unit_test(test_usda_counts_match),

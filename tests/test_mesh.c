@@ -580,6 +580,19 @@ static void test_obj_round_trip(void **state)
 	assert_int_equal(plume_mesh_write_obj(mesh, moved, path, &err), PLUME_OK);
 	assert_int_equal(plume_mesh_read_obj(path, &back, &err), PLUME_OK);
 	assert_true(back->rest[7].z == 0.5);
+	// The frame writer (the invariant lines formatted once) writes the same bytes, frame after
+	// frame, and a different file for different positions.
+	char framed[640];
+	snprintf(framed, sizeof framed, "%s/frame.obj", dir);
+	plume_mesh_obj_writer *writer = NULL;
+	assert_int_equal(plume_mesh_obj_writer_create(mesh, &writer, &err), PLUME_OK);
+	assert_int_equal(plume_mesh_obj_writer_write(writer, moved, framed, &err), PLUME_OK);
+	assert_true(test_hash_file(framed) == test_hash_file(path));
+	assert_int_equal(plume_mesh_obj_writer_write(writer, NULL, framed, &err), PLUME_OK);
+	assert_true(test_hash_file(framed) != test_hash_file(path));
+	assert_int_equal(plume_mesh_write_obj(mesh, NULL, path, &err), PLUME_OK);
+	assert_true(test_hash_file(framed) == test_hash_file(path));
+	plume_mesh_obj_writer_destroy(writer);
 	free(moved);
 	plume_mesh_destroy(back);
 	plume_mesh_destroy(mesh);

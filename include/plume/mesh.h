@@ -176,6 +176,16 @@ plume_status plume_mesh_read_obj(const char *path, plume_mesh **out, plume_error
 plume_status plume_mesh_write_obj(const plume_mesh *mesh, const plume_vec3 *positions, const char *path,
                                   plume_error *err);
 
+/// Writes many frames of one mesh (plume simulate's frames/NNNN.obj): the same
+/// bytes as plume_mesh_write_obj, but the lines that do not change from frame to
+/// frame (texture coordinates, groups, faces) are formatted once, at creation.
+/// The writer keeps a pointer to mesh, which must outlive it and not change.
+typedef struct plume_mesh_obj_writer plume_mesh_obj_writer;
+plume_status plume_mesh_obj_writer_create(const plume_mesh *mesh, plume_mesh_obj_writer **out, plume_error *err);
+plume_status plume_mesh_obj_writer_write(const plume_mesh_obj_writer *writer, const plume_vec3 *positions,
+                                         const char *path, plume_error *err);
+void plume_mesh_obj_writer_destroy(plume_mesh_obj_writer *writer);
+
 PLUME_API_END
 #ifdef __cplusplus
 }

@@ -320,7 +320,8 @@ class Feather:
 
     @classmethod
     def read_json(cls, path: PathLike) -> "Feather":
-        """Reads a feather JSON dump (plume generate's feather.json): the same feather bit for bit."""
+        """Reads a feather JSON dump (plume generate's feather.json, or plume simulate's with its numbers in
+        feather.bin): the same feather bit for bit."""
         out = ffi.new("plume_feather **")
         err = new_error()
         check(lib.plume_read_json(os.fspath(path).encode(), out, err), err)

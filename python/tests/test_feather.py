@@ -60,6 +60,31 @@ def test_presets_equal_the_cli_json(source, cli, tmp_path):
     assert checked == len(PRESETS)
 
 
+def test_binary_json_read_by_numpy(source, tmp_path):
+    """Version 2 (plume simulate's feather.json + feather.bin), read with json and numpy alone."""
+    from plume._lib import check, lib, new_error
+
+    feather = plume.generate(source / "examples" / "streit-heidrich" / "semiplume.json")
+    path = tmp_path / "feather.json"
+    err = new_error()
+    check(lib.plume_write_json_binary(feather.pointer, str(path).encode(), err), err)
+    dump = json.loads(path.read_text())
+    assert dump["version"] == 2 and dump["buffer"] == {"uri": "feather.bin"}
+    numbers = np.fromfile(tmp_path / "feather.bin", dtype="<f8")
+
+    def array(view):
+        start = view["offset"] // 8
+        return numbers[start : start + view["count"]]
+
+    assert np.array_equal(feather.shaft_points.ravel(), array(dump["shaft"]["position"]))
+    barbs = dump["barbs"]
+    assert np.array_equal(feather.barb_points.ravel(), np.concatenate([array(b["position"]) for b in barbs]))
+    assert np.array_equal(feather.barb_uv.ravel(), np.concatenate([array(b["uv"]) for b in barbs]))
+    assert np.array_equal(feather.afterfeather.shaft_points.ravel(),
+                          array(dump["afterfeather"]["feather"]["shaft"]["position"]))
+    assert feather.equal(plume.Feather.read_json(path))
+
+
 def test_dict_and_file_specs_give_the_same_feather(source):
     path = source / "examples" / "zhang-kanai" / "figure8-contour.json"
     spec = json.loads(path.read_text())

@@ -9,6 +9,9 @@
 #include <ctype.h>
 #include <math.h>
 #include <errno.h>
+#include <locale.h>
+#include <stdbool.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -40,19 +43,10 @@ static int material_from_name(const char *name)
 	return PLUME_MATERIAL_VANE;
 }
 
-plume_status plume_mesh_write_obj(const plume_mesh *mesh, const plume_vec3 *positions, const char *path,
-                                  plume_error *err)
+/// The lines after the positions: texture coordinates, groups and faces, which
+/// do not change from frame to frame.
+static void write_tail(FILE *stream, const plume_mesh *mesh)
 {
-	if (positions == NULL)
-		positions = mesh->rest;
-	plume_text_file text;
-	plume_status status = plume_text_open(&text, path, err);
-	if (status != PLUME_OK)
-		return status;
-	FILE *stream = text.stream;
-	fprintf(stream, "# plume mesh: %d vertices, %d triangles\n", mesh->vertex_count, mesh->face_count);
-	for (int i = 0; i < mesh->vertex_count; ++i)
-		fprintf(stream, "v %.17g %.17g %.17g\n", positions[i].x, positions[i].y, positions[i].z);
 	for (int i = 0; i < mesh->vertex_count; ++i)
 		fprintf(stream, "vt %.17g %.17g\n", mesh->uv[i].x, mesh->uv[i].y);
 	int current = -1;
@@ -66,9 +60,93 @@ plume_status plume_mesh_write_obj(const plume_mesh *mesh, const plume_vec3 *posi
 		const int *v = mesh->faces + 3 * f;
 		fprintf(stream, "f %d/%d %d/%d %d/%d\n", v[0] + 1, v[0] + 1, v[1] + 1, v[1] + 1, v[2] + 1, v[2] + 1);
 	}
+}
+
+/// The whole file; tail, when not NULL, is write_tail's text for this mesh.
+static plume_status write_obj(const plume_mesh *mesh, const plume_vec3 *positions, const char *tail, size_t tail_length,
+                              const char *path, plume_error *err)
+{
+	if (positions == NULL)
+		positions = mesh->rest;
+	plume_text_file text;
+	plume_status status = plume_text_open(&text, path, err);
+	if (status != PLUME_OK)
+		return status;
+	FILE *stream = text.stream;
+	fprintf(stream, "# plume mesh: %d vertices, %d triangles\n", mesh->vertex_count, mesh->face_count);
+	for (int i = 0; i < mesh->vertex_count; ++i)
+		fprintf(stream, "v %.17g %.17g %.17g\n", positions[i].x, positions[i].y, positions[i].z);
+	if (tail != NULL)
+		fwrite(tail, 1, tail_length, stream);
+	else
+		write_tail(stream, mesh);
 	if (ferror(stream))
 		status = plume_error_set(err, PLUME_ERROR_IO, "%s: write failed: %s", path, strerror(errno));
 	return plume_text_close(&text, status, err);
+}
+
+plume_status plume_mesh_write_obj(const plume_mesh *mesh, const plume_vec3 *positions, const char *path,
+                                  plume_error *err)
+{
+	return write_obj(mesh, positions, NULL, 0, path, err);
+}
+
+struct plume_mesh_obj_writer {
+	const plume_mesh *mesh;
+	char *tail; ///< write_tail's text, formatted once
+	size_t tail_length;
+};
+
+plume_status plume_mesh_obj_writer_create(const plume_mesh *mesh, plume_mesh_obj_writer **out, plume_error *err)
+{
+	*out = NULL;
+	plume_mesh_obj_writer *writer = plume_calloc(1, sizeof *writer);
+	if (writer == NULL)
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "OBJ writer: out of memory");
+	writer->mesh = mesh;
+	// Formatted in the "C" numeric locale, as plume_text_open does for files.
+	locale_t c_locale = newlocale(LC_NUMERIC_MASK, "C", (locale_t)0);
+	char *text = NULL;
+	size_t length = 0;
+	FILE *stream = c_locale != (locale_t)0 ? open_memstream(&text, &length) : NULL;
+	if (stream != NULL) {
+		locale_t saved = uselocale(c_locale);
+		write_tail(stream, mesh);
+		bool failed = ferror(stream) != 0;
+		uselocale(saved);
+		if (fclose(stream) != 0 || failed) {
+			free(text);
+			text = NULL;
+		}
+	}
+	if (c_locale != (locale_t)0)
+		freelocale(c_locale);
+	// open_memstream's buffer comes from malloc: copied, so that the writer's memory is counted.
+	if (text != NULL && (writer->tail = plume_alloc(length + 1)) != NULL) {
+		memcpy(writer->tail, text, length + 1);
+		writer->tail_length = length;
+	}
+	free(text);
+	if (writer->tail == NULL) {
+		plume_free(writer);
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "OBJ writer: out of memory");
+	}
+	*out = writer;
+	return PLUME_OK;
+}
+
+plume_status plume_mesh_obj_writer_write(const plume_mesh_obj_writer *writer, const plume_vec3 *positions,
+                                         const char *path, plume_error *err)
+{
+	return write_obj(writer->mesh, positions, writer->tail, writer->tail_length, path, err);
+}
+
+void plume_mesh_obj_writer_destroy(plume_mesh_obj_writer *writer)
+{
+	if (writer == NULL)
+		return;
+	plume_free(writer->tail);
+	plume_free(writer);
 }
 
 // ---------------------------------------------------------------------------

@@ -18,10 +18,11 @@ JSON
 out=$scratch/swing
 "$plume" simulate "$scratch/swing.json" -o "$out" --png --size 200x200 >"$scratch/out.txt" 2>"$scratch/err.txt"
 succeeded "simulate succeeds"
-for f in mesh.obj feather.json stats.csv summary.json frames/0000.obj frames/0001.obj frames/0002.obj frames/0003.obj \
+for f in mesh.obj feather.json feather.bin stats.csv summary.json frames/0000.obj frames/0001.obj frames/0002.obj frames/0003.obj \
 	frames/0000.png frames/0003.png; do
 	check "writes $f" test -s "$out/$f"
 done
+check "feather.json is version 2, its numbers in feather.bin" grep -q '"buffer": {"uri": "feather.bin"}' "$out/feather.json"
 check "frame 3 is the last (steps 0, 2, 4, 5)" test ! -e "$out/frames/0004.obj"
 check "stats has a header and 5 steps" test "$(wc -l <"$out/stats.csv")" -eq 6
 check "summary says completed" grep -q '"completed": true' "$out/summary.json"
