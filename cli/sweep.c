@@ -122,6 +122,7 @@ int cli_sweep(int argc, char **argv)
 		return code;
 	}
 	int rank = 0, size = 1;
+	(void)size; // read by the MPI build only
 #ifdef PLUME_WITH_MPI
 	bool mpi = sweep_mpi_launched();
 	if (mpi) {
@@ -166,7 +167,7 @@ int cli_sweep(int argc, char **argv)
 	if (rank == 0 && code == CLI_EXIT_OK && !s.keep_runs) {
 		char runs[PATH_MAX + 16];
 		snprintf(runs, sizeof runs, "%s/runs", output_dir);
-		sweep_remove_tree(runs); // and what killed attempts left of runs since done
+		cli_remove_tree(runs); // and what killed attempts left of runs since done
 	}
 	sweep_state_end(&state);
 	sweep_free(&s);

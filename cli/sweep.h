@@ -167,8 +167,6 @@ void sweep_record_timing(const sweep_state *state, int index, double seconds, in
 bool sweep_parse_row(const char *line, int field_count, int *index, char *status, size_t size);
 
 // Runs (sweep_run.c, sweep_mpi.c)
-void sweep_remove_tree(const char *path);
-double sweep_now_seconds(void);
 /// Writes the run's spec and starts plume on it; the pid, or -1 (message in failure).
 pid_t sweep_run_start(const sweep *s, const char *dir, int index, char *failure, size_t size);
 /// The CSV row of a finished run (wait_status from waitpid; pid < 0: it never started).

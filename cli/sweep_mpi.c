@@ -49,7 +49,7 @@ bool sweep_mpi_schedule(sweep_state *state, int size)
 		message[length] = '\0';
 		int source = status.MPI_SOURCE;
 		if (status.MPI_TAG == TAG_ROW) {
-			sweep_record_timing(state, assigned[source], sweep_now_seconds() - started[source], source);
+			sweep_record_timing(state, assigned[source], cli_now_seconds() - started[source], source);
 			ok = sweep_record_row(state, assigned[source], strdup(message)) && ok;
 		}
 		free(message);
@@ -58,7 +58,7 @@ bool sweep_mpi_schedule(sweep_state *state, int size)
 		int work = next < s->run_count && ok ? next++ : -1;
 		if (work >= 0) {
 			assigned[source] = work;
-			started[source] = sweep_now_seconds();
+			started[source] = cli_now_seconds();
 		} else
 			--active;
 		MPI_Send(&work, 1, MPI_INT, source, TAG_WORK, MPI_COMM_WORLD);

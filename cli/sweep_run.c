@@ -4,7 +4,6 @@
 #define _GNU_SOURCE
 #include <errno.h>
 #include <fcntl.h>
-#include <ftw.h>
 #include <limits.h>
 #include <signal.h>
 #include <stdio.h>
@@ -13,31 +12,13 @@
 #include <sys/prctl.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "sweep.h"
 
-static int remove_entry(const char *path, const struct stat *info, int flag, struct FTW *ftw)
-{
-	(void)info;
-	(void)flag;
-	(void)ftw;
-	return remove(path);
-}
-
-void sweep_remove_tree(const char *path) { nftw(path, remove_entry, 16, FTW_DEPTH | FTW_PHYS); }
-
 static void run_dir(const char *dir, int index, char *out, size_t size)
 {
 	snprintf(out, size, "%s/runs/%06d", dir, index);
-}
-
-double sweep_now_seconds(void)
-{
-	struct timespec t;
-	clock_gettime(CLOCK_MONOTONIC, &t);
-	return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
 /// Writes the run's spec and starts plume on it; the pid, or -1 (message in row).
@@ -45,7 +26,7 @@ pid_t sweep_run_start(const sweep *s, const char *dir, int index, char *failure,
 {
 	char folder[PATH_MAX], path[PATH_MAX + 32];
 	run_dir(dir, index, folder, sizeof folder);
-	sweep_remove_tree(folder); // what a killed attempt left
+	cli_remove_tree(folder); // what a killed attempt left
 	snprintf(path, sizeof path, "%s/runs", dir);
 	mkdir(path, 0777);
 	if (mkdir(folder, 0777) != 0) {
@@ -233,7 +214,7 @@ char *sweep_run_finish(const sweep *s, const char *dir, int index, pid_t pid, in
 	snprintf(row + n, capacity - n, ",%s,%s\n", row_status_names[status], quoted);
 	json_decref(result);
 	if (!s->keep_runs && pid >= 0)
-		sweep_remove_tree(folder);
+		cli_remove_tree(folder);
 	return row;
 }
 
@@ -258,7 +239,7 @@ bool sweep_run_local(sweep_state *state, int jobs)
 			if (next >= s->run_count)
 				break;
 			char failure[512] = "";
-			double start = sweep_now_seconds();
+			double start = cli_now_seconds();
 			pid_t pid = sweep_run_start(s, state->dir, next, failure, sizeof failure);
 			if (pid < 0) {
 				ok = sweep_record_row(state, next, sweep_run_finish(s, state->dir, next, -1, 0, failure));
@@ -283,7 +264,7 @@ bool sweep_run_local(sweep_state *state, int jobs)
 		}
 		for (int k = 0; k < jobs; ++k)
 			if (slots[k].pid == pid) {
-				sweep_record_timing(state, slots[k].index, sweep_now_seconds() - slots[k].start, k);
+				sweep_record_timing(state, slots[k].index, cli_now_seconds() - slots[k].start, k);
 				ok = sweep_record_row(state, slots[k].index,
 				                      sweep_run_finish(s, state->dir, slots[k].index, pid, wait_status, "")) &&
 				     ok;
