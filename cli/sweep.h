@@ -165,6 +165,10 @@ bool sweep_record_row(sweep_state *state, int index, char *row);
 void sweep_record_timing(const sweep_state *state, int index, double seconds, int worker);
 /// Splits a CSV line into its first field (the index) and its status field.
 bool sweep_parse_row(const char *line, int field_count, int *index, char *status, size_t size);
+/// Field k of a row sweep wrote (its quotes kept): start and length; false when the
+/// row has fewer fields. (Another sweep's results.csv, which may have been edited,
+/// is read by sweep_spec.c's csv_field, which also unquotes.)
+bool sweep_row_field(const char *row, int k, const char **start, size_t *length);
 
 // Runs (sweep_run.c, sweep_mpi.c)
 /// Writes the run's spec and starts plume on it; the pid, or -1 (message in failure).

@@ -99,27 +99,37 @@ bool sweep_parse_row(const char *line, int field_count, int *index, char *status
 	if (end == line || *end != ',')
 		return false;
 	*index = (int)i;
+	const char *start;
+	size_t length;
+	if (!sweep_row_field(line, field_count - 2, &start, &length) || length >= size)
+		return false;
+	memcpy(status, start, length);
+	status[length] = '\0';
+	// Exactly field_count fields.
+	return sweep_row_field(line, field_count - 1, &start, &length) &&
+	       !sweep_row_field(line, field_count, &start, &length);
+}
+
+bool sweep_row_field(const char *row, int k, const char **start, size_t *length)
+{
 	int field = 0;
 	bool quoted = false;
-	const char *start = line;
-	for (const char *c = line;; ++c) {
+	const char *begin = row;
+	for (const char *c = row;; ++c) {
 		if (*c == '"')
 			quoted = !quoted;
 		else if ((*c == ',' && !quoted) || *c == '\n' || *c == '\0') {
-			if (field == field_count - 2) {
-				size_t length = (size_t)(c - start);
-				if (length >= size)
-					return false;
-				memcpy(status, start, length);
-				status[length] = '\0';
+			if (field == k) {
+				*start = begin;
+				*length = (size_t)(c - begin);
+				return true;
 			}
 			++field;
-			start = c + 1;
+			begin = c + 1;
 			if (*c != ',')
-				break;
+				return false;
 		}
 	}
-	return field == field_count;
 }
 
 /// Creates DIR or, when it holds this same sweep, reads the rows already done.

@@ -30,28 +30,17 @@ static double percentile(const double *sorted, int n, double q)
 /// Field k of a CSV row as a number (NAN when empty or not a number).
 static double row_number(const char *row, int k)
 {
-	int field = 0;
-	bool quoted = false;
-	const char *start = row;
-	for (const char *c = row;; ++c) {
-		if (*c == '"')
-			quoted = !quoted;
-		else if ((*c == ',' && !quoted) || *c == '\n' || *c == '\0') {
-			if (field == k) {
-				char *end = NULL;
-				double x = strtod(start, &end);
-				if (end == start || end != c)
-					return NAN;
-				if (strncmp(start, "true", 4) == 0)
-					return 1;
-				return x;
-			}
-			++field;
-			start = c + 1;
-			if (*c != ',')
-				return NAN;
-		}
-	}
+	const char *start;
+	size_t length;
+	if (!sweep_row_field(row, k, &start, &length))
+		return NAN;
+	char *end = NULL;
+	double x = strtod(start, &end);
+	if (end == start || end != start + length)
+		return NAN;
+	if (strncmp(start, "true", 4) == 0)
+		return 1;
+	return x;
 }
 
 static void sanitize(const char *name, char *out, size_t size)
