@@ -79,6 +79,8 @@ plume_status cli_output_begin(cli_output *output, const char *dir, plume_error *
 const char *cli_output_path(cli_output *output, const char *name, char *buffer, size_t size);
 plume_status cli_output_commit(cli_output *output, plume_error *err);
 void cli_output_abort(cli_output *output);
+/// Removes a file or a folder and everything in it (links removed, not followed).
+void cli_remove_tree(const char *path);
 
 /// Writes <stem>.<ext> for every format in the set into the staging folder.
 plume_status cli_write_feather(cli_output *output, const plume_feather *feather, const char *stem, unsigned formats,
@@ -113,6 +115,8 @@ typedef struct cli_progress {
 void cli_progress_begin(cli_progress *progress, const char *what, int total);
 /// done items of total finished; prints a newline when done reaches total.
 void cli_progress_update(cli_progress *progress, int done);
+/// Seconds on the monotonic clock (for durations).
+double cli_now_seconds(void);
 
 /// simulate --fields (cli/fields.c): DIR/fields/NNNN.vtu for the simulator's current state.
 plume_status cli_fields_write_frame(cli_output *output, const plume_scene *scene, const plume_sim *sim, int frame,

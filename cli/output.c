@@ -187,7 +187,7 @@ bool cli_parse_memory(const char *command, const char *text, uint64_t *bytes)
 // (Ctrl-C, a kill, a crash): only folders of exactly that pattern, only when
 // that process is gone.
 
-static void remove_tree(const char *path)
+void cli_remove_tree(const char *path)
 {
 	struct stat link_info;
 	if (lstat(path, &link_info) == 0 && S_ISLNK(link_info.st_mode)) {
@@ -204,7 +204,7 @@ static void remove_tree(const char *path)
 			snprintf(child, sizeof child, "%s/%s", path, entry->d_name);
 			struct stat info;
 			if (lstat(child, &info) == 0 && S_ISDIR(info.st_mode))
-				remove_tree(child);
+				cli_remove_tree(child);
 			else
 				unlink(child);
 		}
@@ -244,7 +244,7 @@ static void remove_stale_staging(const char *parent, const char *prefix)
 		snprintf(path, sizeof path, "%s/%s", parent, entry->d_name);
 		struct stat info;
 		if (lstat(path, &info) == 0 && S_ISDIR(info.st_mode) && info.st_uid == geteuid())
-			remove_tree(path);
+			cli_remove_tree(path);
 	}
 	closedir(dir);
 }
@@ -409,7 +409,7 @@ static plume_status commit_by_moves(cli_output *output, plume_error *err)
 			if (replace_folder)
 				rename(aside, to);
 		} else if (replace_folder) {
-			remove_tree(aside);
+			cli_remove_tree(aside);
 		}
 	}
 	closedir(stage);
@@ -487,14 +487,14 @@ plume_status cli_output_commit(cli_output *output, plume_error *err)
 		cli_output_abort(output);
 		return PLUME_ERROR_IO;
 	}
-	remove_tree(output->stage); // the earlier run; the user's files live on in DIR
+	cli_remove_tree(output->stage); // the earlier run; the user's files live on in DIR
 	return PLUME_OK;
 }
 
 void cli_output_abort(cli_output *output)
 {
 	if (output->stage[0] != '\0')
-		remove_tree(output->stage);
+		cli_remove_tree(output->stage);
 }
 
 // ---------------------------------------------------------------------------

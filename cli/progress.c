@@ -9,7 +9,7 @@
 
 #include "cli.h"
 
-static double now(void)
+double cli_now_seconds(void)
 {
 	struct timespec t;
 	clock_gettime(CLOCK_MONOTONIC, &t);
@@ -31,7 +31,7 @@ void cli_progress_begin(cli_progress *progress, const char *what, int total)
 {
 	progress->what = what;
 	progress->total = total;
-	progress->start = now();
+	progress->start = cli_now_seconds();
 	progress->shown = isatty(STDERR_FILENO) != 0 && total > 0;
 }
 
@@ -39,7 +39,7 @@ void cli_progress_update(cli_progress *progress, int done)
 {
 	if (!progress->shown)
 		return;
-	double elapsed = now() - progress->start;
+	double elapsed = cli_now_seconds() - progress->start;
 	fprintf(stderr, "\r\033[Kplume %s: %d/%d (%d%%), ", progress->what, done, progress->total,
 	        (int)(100.0 * done / progress->total));
 	print_duration(elapsed);

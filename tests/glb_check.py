@@ -22,6 +22,8 @@ def load(path):
     if magic != b"glTF" or version != 2 or length != len(data):
         sys.exit(f"{path}: not a glTF 2.0 binary (magic {magic!r}, version {version}, length {length})")
     json_length, json_type = struct.unpack_from("<I4s", data, 12)
+    if json_type != b"JSON":
+        sys.exit(f"{path}: first chunk is {json_type!r}, not JSON")
     doc = json.loads(data[20:20 + json_length])
     at = 20 + json_length
     binary = b""

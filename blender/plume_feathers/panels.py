@@ -25,34 +25,31 @@ class PLUME_PT_franco_walter(_Panel, bpy.types.Panel):
         op.barbs_lower, op.barbs_upper = s.fw_barbs_lower, s.fw_barbs_upper
 
 
+def _draw_grown_model(layout, s, model, prefix):
+    """The panel of a model grown in stages: its preset and stage (the scene's PREFIX_preset
+    and PREFIX_stage), the seed, the geometry and the button that adds the feather."""
+    col = layout.column()
+    col.prop(s, prefix + "_preset")
+    col.prop(s, prefix + "_stage")
+    col.prop(s, "seed")
+    col.prop(s, "geometry")
+    op = col.operator("plume.add_feather", text="Add feather")
+    op.model, op.preset, op.seed = model, getattr(s, prefix + "_preset"), s.seed
+    op.stage, op.geometry = getattr(s, prefix + "_stage"), s.geometry
+
+
 class PLUME_PT_streit_heidrich(_Panel, bpy.types.Panel):
     bl_label = "Streit & Heidrich"
 
     def draw(self, context):
-        s = context.scene.plume
-        col = self.layout.column()
-        col.prop(s, "sh_preset")
-        col.prop(s, "sh_stage")
-        col.prop(s, "seed")
-        col.prop(s, "geometry")
-        op = col.operator("plume.add_feather", text="Add feather")
-        op.model, op.preset, op.seed, op.stage = "streit-heidrich", s.sh_preset, s.seed, s.sh_stage
-        op.geometry = s.geometry
+        _draw_grown_model(self.layout, context.scene.plume, "streit-heidrich", "sh")
 
 
 class PLUME_PT_zhang_kanai(_Panel, bpy.types.Panel):
     bl_label = "Zhang & Kanai"
 
     def draw(self, context):
-        s = context.scene.plume
-        col = self.layout.column()
-        col.prop(s, "zk_preset")
-        col.prop(s, "zk_stage")
-        col.prop(s, "seed")
-        col.prop(s, "geometry")
-        op = col.operator("plume.add_feather", text="Add feather")
-        op.model, op.preset, op.seed, op.stage = "zhang-kanai", s.zk_preset, s.seed, s.zk_stage
-        op.geometry = s.geometry
+        _draw_grown_model(self.layout, context.scene.plume, "zhang-kanai", "zk")
 
 
 class PLUME_PT_coat(_Panel, bpy.types.Panel):

@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import ctypes.util
+import json
 import os
 import pathlib
 import re
 import shutil
 import subprocess
-from typing import Any, Optional
+import tempfile
+from typing import Any, Callable, Optional, TypeVar
 
 import cffi
 import numpy as np
@@ -123,6 +125,19 @@ def check(status: int, err: Any, rename: Optional[dict[str, str]] = None) -> Non
         raise Error.from_c(err, rename)
 
 
+def check_spec(spec: Any, name: str, call: Callable[[bytes], int], err: Any) -> None:
+    """Calls call(path) on a spec file, or on a dict written as JSON to a temporary file
+    (whose messages then name it "<dict>"), and raises plume.Error when it fails."""
+    if isinstance(spec, dict):
+        with tempfile.TemporaryDirectory(prefix="plume-") as folder:
+            path = os.path.join(folder, name)
+            with open(path, "w") as f:
+                json.dump(spec, f)
+            check(call(path.encode()), err, rename={path: "<dict>"})
+    else:
+        check(call(os.fspath(spec).encode()), err)
+
+
 def view(owner: Any, pointer: Any, count: int, dtype: Any, shape: tuple[int, ...]) -> np.ndarray:
     """A NumPy array over count C items at pointer, without copying, that keeps owner alive.
 
@@ -146,3 +161,39 @@ def text(s: Any) -> str:
 def bytes_in_use() -> int:
     """Bytes libplume has allocated and not freed (its allocator's counter, all threads)."""
     return int(lib.plume_bytes_in_use())
+
+
+_Self = TypeVar("_Self", bound="Closable")
+
+
+class Closable:
+    """``with`` support for the wrappers of libplume objects: leaving the block calls close()."""
+
+    def __enter__(self: _Self) -> _Self:
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.close()
+
+    def close(self) -> None:
+        raise NotImplementedError
+
+
+class Handle(Closable):
+    """A wrapper of one libplume object: ``_ptr`` (the pointer, freed by cffi's gc when no view
+    keeps it), ``_keep`` (what views keep alive) and ``_what`` (its name in messages)."""
+
+    _what = "object"
+    _ptr: Any
+    _keep: Any
+
+    def close(self) -> None:
+        """Drops this object's reference: the object is freed now unless views of it are alive."""
+        self._ptr = None
+        self._keep = None
+
+    @property
+    def pointer(self) -> Any:
+        if self._ptr is None:
+            raise ValueError(f"the {self._what} was closed")
+        return self._ptr

@@ -2,41 +2,25 @@
 
 from __future__ import annotations
 
-import json
 import os
-import tempfile
 from typing import Any, Iterable, Optional, Union
 
 import numpy as np
 
-from ._lib import check, ffi, lib, new_error
+from ._lib import Handle, check, check_spec, ffi, lib, new_error
 from .feather import Feather, _options
 from .mesh import Mesh
 
 
-class Coat:
+class Coat(Handle):
     """A groomed coat: ``feathers`` (placed, world coordinates, drawing order bottom to top),
     ``follicles`` and ``follicle_normals`` (K x 3), ``is_key`` (K,), the ``surface`` mesh."""
+
+    _what = "coat"
 
     def __init__(self, pointer: Any):
         self._ptr = ffi.gc(pointer, lib.plume_coat_destroy)
         self._keep = self._ptr
-
-    def __enter__(self) -> "Coat":
-        return self
-
-    def __exit__(self, *exc: Any) -> None:
-        self.close()
-
-    def close(self) -> None:
-        self._ptr = None
-        self._keep = None
-
-    @property
-    def pointer(self) -> Any:
-        if self._ptr is None:
-            raise ValueError("the coat was closed")
-        return self._ptr
 
     def __len__(self) -> int:
         return int(lib.plume_coat_feather_count(self.pointer))
@@ -105,13 +89,5 @@ def coat(spec: Union[dict, str, "os.PathLike[str]"], *, seed: Optional[int] = No
     options = _options(seed, stage, "growth")
     out = ffi.new("plume_coat **")
     err = new_error()
-    if isinstance(spec, dict):
-        with tempfile.TemporaryDirectory(prefix="plume-coat-") as folder:
-            path = os.path.join(folder, "coat.json")
-            with open(path, "w") as f:
-                json.dump(spec, f)
-            status = lib.plume_coat_spec_generate(path.encode(), options, out, err)
-            check(status, err, rename={path: "<dict>"})
-    else:
-        check(lib.plume_coat_spec_generate(os.fspath(spec).encode(), options, out, err), err)
+    check_spec(spec, "coat.json", lambda path: lib.plume_coat_spec_generate(path, options, out, err), err)
     return Coat(out[0])

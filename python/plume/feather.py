@@ -8,7 +8,7 @@ from typing import Any, Iterable, Optional, Union
 
 import numpy as np
 
-from ._lib import Error, check, ffi, lib, new_error, text, view
+from ._lib import Error, Handle, check, ffi, lib, new_error, text, view
 
 PathLike = Union[str, "os.PathLike[str]"]
 Spec = Union[dict, PathLike]
@@ -35,7 +35,7 @@ def _options(seed: Optional[int], stage: Optional[float], stage_kind: str) -> An
     return options
 
 
-class Feather:
+class Feather(Handle):
     """A generated feather (libplume's plume_feather).
 
     Arrays are read-only NumPy views into the feather's memory (no copy); each keeps
@@ -50,6 +50,8 @@ class Feather:
     back in the pool, a gathered copy when barbules sit between them.
     """
 
+    _what = "feather"
+
     def __init__(self, pointer: Any, owner: Any = None, destroy: bool = True):
         self._ptr = ffi.gc(pointer, lib.plume_feather_destroy) if destroy else pointer
         # What views keep alive: the pointer (which frees the feather when collected) and
@@ -60,23 +62,10 @@ class Feather:
         self._pool: Optional[dict[str, np.ndarray]] = None
 
     # -- lifetime -------------------------------------------------------------------
-    def __enter__(self) -> "Feather":
-        return self
-
-    def __exit__(self, *exc: Any) -> None:
-        self.close()
-
     def close(self) -> None:
         """Drops this object's reference: the feather is freed now unless views of it are alive."""
         self._pool = None
-        self._ptr = None
-        self._keep = None
-
-    @property
-    def pointer(self) -> Any:
-        if self._ptr is None:
-            raise ValueError("the feather was closed")
-        return self._ptr
+        super().close()
 
     # -- counts ---------------------------------------------------------------------
     @property

@@ -9,20 +9,13 @@ from typing import Any, Optional, Union
 
 import numpy as np
 
-from ._lib import check, ffi, lib, new_error
+from ._lib import check, check_spec, ffi, lib, new_error
 
 
 def _load_spec(spec: Union[dict, str, "os.PathLike[str]"]) -> Any:
     s = ffi.new("plume_lab_spec *")
     err = new_error()
-    if isinstance(spec, dict):
-        with tempfile.TemporaryDirectory(prefix="plume-lab-") as folder:
-            path = os.path.join(folder, "lab.json")
-            with open(path, "w") as f:
-                json.dump(spec, f)
-            check(lib.plume_lab_spec_load(path.encode(), s, err), err, rename={path: "<dict>"})
-    else:
-        check(lib.plume_lab_spec_load(os.fspath(spec).encode(), s, err), err)
+    check_spec(spec, "lab.json", lambda path: lib.plume_lab_spec_load(path, s, err), err)
     return s
 
 

@@ -7,36 +7,22 @@ from typing import Any, Optional, Union
 
 import numpy as np
 
-from ._lib import check, ffi, lib, new_error, text, view
+from ._lib import Handle, check, ffi, lib, new_error, text, view
 from .feather import Feather
 
 
-class Mesh:
+class Mesh(Handle):
     """A triangle shell: ``vertices`` (rest, N x 3), ``reference`` (N x 2, the flat material
     coordinates), ``uv``, ``triangles`` (F x 3), ``barb_angles`` (F, radians from +x in the
     reference plane), ``materials`` (F; 0 vane, 1 rachis), ``barb_edges`` (E x 2) and
     ``groups`` (name -> vertex indices). Arrays are read-only views kept valid by the mesh."""
 
+    _what = "mesh"
+
     def __init__(self, pointer: Any, report: Optional[dict] = None, owner: Any = None, destroy: bool = True):
         self._ptr = ffi.gc(pointer, lib.plume_mesh_destroy) if destroy else pointer
         self._keep = (self._ptr, getattr(owner, "_keep", owner))  # what views keep alive (not self)
         self.report = report or {}
-
-    def __enter__(self) -> "Mesh":
-        return self
-
-    def __exit__(self, *exc: Any) -> None:
-        self.close()
-
-    def close(self) -> None:
-        self._ptr = None
-        self._keep = None
-
-    @property
-    def pointer(self) -> Any:
-        if self._ptr is None:
-            raise ValueError("the mesh was closed")
-        return self._ptr
 
     @property
     def vertex_count(self) -> int:

@@ -9,7 +9,7 @@ from typing import Any, Optional, Sequence, Union
 
 import numpy as np
 
-from ._lib import Error, check, ffi, lib, new_error, text, view
+from ._lib import Closable, Error, check, ffi, lib, new_error, text, view
 from .feather import Feather, _options
 from .mesh import Mesh, _report
 
@@ -35,7 +35,7 @@ def _vec(v: Vec3) -> Any:
     return ffi.new("plume_vec3 *", (x, y, z))[0]
 
 
-class Simulation:
+class Simulation(Closable):
     """A scene (a dict or a scene file) and its running simulation.
 
     ``step()`` advances one time step with the scene's handles posed at the end of the step
@@ -75,12 +75,6 @@ class Simulation:
         self.feather = None if s.feather == ffi.NULL else Feather(s.feather, owner=self, destroy=False)
 
     # -- lifetime -------------------------------------------------------------------
-    def __enter__(self) -> "Simulation":
-        return self
-
-    def __exit__(self, *exc: Any) -> None:
-        self.close()
-
     def close(self) -> None:
         """Frees the simulation and its scene (views of positions keep them until dropped)."""
         self._sim = None

@@ -20,13 +20,14 @@ import json
 import os
 import re
 import shutil
-import struct
 import subprocess
 import sys
 import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SOURCE = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, os.path.join(SOURCE, "tests"))
+import glb_check  # noqa: E402  (the .glb reader of tests/cli/gltf.sh: struct + json only)
 failures = 0
 # simulate --fields: per face strain, stress, barb angle, material, energy densities; per vertex velocity, handles.
 FACE_FIELDS = ("green_strain_barb", "pk2_stress_barb", "barb_angle", "material", "membrane_energy_density",
@@ -72,18 +73,9 @@ def feather_curves(feather_json):
     return {"curves": len(lengths), "points": sum(lengths), "segments": sum(n - 1 for n in lengths)}
 
 
-def glb_json(path):
-    with open(path, "rb") as f:
-        magic, version, _ = struct.unpack("<4sII", f.read(12))
-        length, kind = struct.unpack("<I4s", f.read(8))
-        if magic != b"glTF" or version != 2 or kind != b"JSON":
-            raise ValueError(path + ": not a glTF 2.0 binary")
-        return json.loads(f.read(length))
-
-
 def glb_counts(path):
     """Counts a glTF importer should reproduce, from the file's own accessors."""
-    g = glb_json(path)
+    g, _ = glb_check.load(path)
     accessors = g.get("accessors", [])
     per_mesh = []
     for mesh in g.get("meshes", []):
