@@ -27,19 +27,22 @@ static double percentile(const double *sorted, int n, double q)
 	return sorted[i] + (h - i) * (sorted[i + 1] - sorted[i]);
 }
 
-/// Field k of a CSV row as a number (NAN when empty or not a number).
+/// Field k of a CSV row as a number (NAN when empty or not a number or boolean).
 static double row_number(const char *row, int k)
 {
 	const char *start;
 	size_t length;
 	if (!sweep_row_field(row, k, &start, &length))
 		return NAN;
+	// A true/false output (such as completed) counts as 1/0; strtod takes neither.
+	if (length == 4 && strncmp(start, "true", 4) == 0)
+		return 1;
+	if (length == 5 && strncmp(start, "false", 5) == 0)
+		return 0;
 	char *end = NULL;
 	double x = strtod(start, &end);
 	if (end == start || end != start + length)
 		return NAN;
-	if (strncmp(start, "true", 4) == 0)
-		return 1;
 	return x;
 }
 

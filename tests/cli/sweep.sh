@@ -78,6 +78,20 @@ check "failing run: the sweep completes" test $? -eq 0
 check "failing run: recorded with its message" grep -q '^0,1,,failed,exit 1: spec.json: traction step 1 of 3 .*Newton did not converge' "$scratch/fail/results.csv"
 check "failing run: the next run is ok" grep -q '^1,50,[0-9.e+]*,ok,$' "$scratch/fail/results.csv"
 
+# --- a true/false output counts as 1/0 in stats.json ----------------------------
+cat >"$scratch/bool.json" <<EOF
+{"command": "simulate",
+ "spec": {"feather": "$source_dir/examples/franco-walter/blue.json", "mesh": {"edge_length": 0.012},
+          "handles": [{"group": "rachis_clamp"}], "gravity": [0, 0, -9.81], "duration": 0.011},
+ "parameters": [{"path": "\$.duration", "values": [0.011, 0.022]}],
+ "outputs": ["completed", "steps"]}
+EOF
+"$plume" sweep "$scratch/bool.json" -o "$scratch/bool" >"$scratch/out.txt" 2>"$scratch/err.txt"
+succeeded "boolean output: the sweep succeeds"
+check "boolean output: completed counted as 1 in stats.json" /usr/bin/python3 -c \
+	'import json, sys; c = json.load(open(sys.argv[1]))["outputs"]["completed"]; sys.exit(not (c["count"] == 2 and c["mean"] == 1))' \
+	"$scratch/bool/stats.json"
+
 # --- kill and resume ----------------------------------------------------------
 cat >"$scratch/slow.json" <<'EOF'
 {"command": "lab traction",
