@@ -110,6 +110,9 @@ typedef struct plume_spec_options {
 	plume_stage_kind stage_kind;
 	/// Stage in [0, 1] for PLUME_STAGE_GROWTH and PLUME_STAGE_UNFURL.
 	double stage;
+	/// Coats (plume_coat_spec_generate): called after each feather is built. Default NULL (none).
+	plume_progress_fn *progress;
+	void *progress_user;
 } plume_spec_options;
 
 /// Reads a feather spec from path and generates it. Syntax errors read

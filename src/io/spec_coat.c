@@ -328,6 +328,10 @@ plume_status plume_coat_spec_generate(const char *path, const plume_spec_options
 	read_lod(&reader, root, &def.lod);
 	if (options != NULL && options->seed_given)
 		def.seed = options->seed;
+	if (options != NULL) {
+		def.progress = options->progress;
+		def.progress_user = options->progress_user;
+	}
 	plume_status status = reader.status;
 	if (status == PLUME_OK) {
 		status = coat_build(&def, out, err);
