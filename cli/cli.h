@@ -111,12 +111,21 @@ typedef struct cli_progress {
 	int total;
 	double start;
 	bool shown;
+	bool open;      ///< a line is shown and not finished
+	double printed; ///< when the last line was printed, < 0 before the first
 } cli_progress;
 void cli_progress_begin(cli_progress *progress, const char *what, int total);
 /// done items of total finished; prints a newline when done reaches total.
 void cli_progress_update(cli_progress *progress, int done);
 /// Seconds on the monotonic clock (for durations).
 double cli_now_seconds(void);
+/// The same with ", note" after the estimate (e.g. the simulated time).
+void cli_progress_update_note(cli_progress *progress, int done, const char *note);
+/// A plume_progress_fn for the library's loops (coats, calibrations, studies); user is a
+/// cli_progress begun with any total > 0, which each call replaces.
+void cli_progress_callback(void *user, int done, int total);
+/// Ends an unfinished line (a failed run) so that the error message starts on its own line.
+void cli_progress_end(cli_progress *progress);
 
 /// simulate --fields (cli/fields.c): DIR/fields/NNNN.vtu for the simulator's current state.
 plume_status cli_fields_write_frame(cli_output *output, const plume_scene *scene, const plume_sim *sim, int frame,

@@ -145,7 +145,12 @@ int cli_coat(int argc, char **argv)
 	plume_error err = {0};
 	plume_coat *coat = NULL;
 	cli_output output;
+	cli_progress progress;
+	cli_progress_begin(&progress, "coat", 1);
+	spec_options.progress = cli_progress_callback;
+	spec_options.progress_user = &progress;
 	plume_status status = plume_coat_spec_generate(argv[optind], &spec_options, &coat, &err);
+	cli_progress_end(&progress);
 	if (status == PLUME_OK && (status = cli_output_begin(&output, output_dir, &err)) == PLUME_OK) {
 		status = write_coat(&output, coat, formats, &image, &err);
 		if (status == PLUME_OK)

@@ -42,7 +42,7 @@ void cli_help_generate(void)
 	     "                         (default: all but glb)\n"
 	     "      --size WxH         image size in pixels (default: 1200 tall, width to fit)\n"
 	     "  -t, --texture IMAGE    colour the barbs from IMAGE (Franco & Walter 4.4) instead\n"
-	     "                         of the line style\n"
+	     "                         of the line style; feather.glb embeds IMAGE\n"
 	     "  -h, --help             this help\n"
 	     "\n"
 	     "Specs are described in docs/spec-franco-walter.md and docs/spec-zhang-kanai.md;\n"

@@ -38,8 +38,10 @@ void cli_help_lab(void)
 	     "  --phases K             band phases the tilted slope is averaged over (default 4)\n"
 	     "  --macro-elements N     macroscale tilted mesh size (default 2000)\n"
 	     "  --unconstrained        fit E_vw without the barb constraint\n"
-	     "  -o DIR                 also write DIR/calibration.json (the printed JSON) and\n"
-	     "                         DIR/slopes.csv (each matched slope, Pa)\n"
+	     "  -o DIR                 also write DIR/calibration.json (the printed JSON),\n"
+	     "                         DIR/slopes.csv (each matched slope, Pa), DIR/curves.csv\n"
+	     "                         (the stress-strain curves matched) and their plots\n"
+	     "                         DIR/curves_longitudinal.png/.svg, DIR/curves_tilted.png/.svg\n"
 	     "\n"
 	     "study: writes DIR/<study>.csv, .png and .svg and prints a JSON summary.\n"
 	     "  --scale S              element counts times S (default 1; e.g. 0.25 for a quick look)\n"
@@ -202,7 +204,56 @@ static void print_calibration(FILE *out, const plume_calibration_def *d, const p
 	    def.barb_constraint ? "true" : "false", r.traction_count, r.solve_count, r.bisection_iterations);
 }
 
-/// -o DIR: DIR/calibration.json (what stdout shows) and DIR/slopes.csv, together or not at all.
+/// DIR/curves.csv and the plots of the curves the calibration matched (r holds them).
+static plume_status write_curves(cli_output *output, const plume_calibration_result *r, plume_error *err)
+{
+	char path[4352], svg[4352];
+	const double *columns[8] = {r->curve_strain[0], r->curve_stress[0], r->curve_strain[1], r->curve_stress[1],
+	                            r->curve_strain[2], r->curve_stress[2], r->curve_strain[3], r->curve_stress[3]};
+	plume_status status = plume_lab_write_csv(
+	    cli_output_path(output, "curves.csv", path, sizeof path),
+	    "longitudinal_strain,longitudinal_stress_pa,transverse_strain,transverse_stress_pa,tilted_strain,"
+	    "tilted_mesoscale_stress_pa,tilted_macroscale_strain,tilted_macroscale_stress_pa",
+	    columns, 8, r->curve_samples, err);
+	if (status != PLUME_OK)
+		return status;
+	int n = r->curve_samples;
+	// The longitudinal test is a hundred times stiffer and forty times shorter: a plot of its own.
+	double line_x[2] = {0.0, r->curve_strain[0][n - 1]};
+	double line_y[2] = {0.0, r->slope_longitudinal * r->curve_strain[0][n - 1]};
+	char fit[64];
+	snprintf(fit, sizeof fit, "slope E#dvv#u = %.4g Pa", r->slope_longitudinal);
+	plume_plot_series longitudinal[2] = {
+	    {"mesoscale", r->curve_strain[0], r->curve_stress[0], n, true, false},
+	    {fit, line_x, line_y, 2, false, true},
+	};
+	plume_plot plot = {
+	    .title = "Calibration: longitudinal test",
+	    .x_label = "measured strain #fi#ge#fn",
+	    .y_label = "measured stress #fi#gs#fn [Pa]",
+	    .series_count = 2,
+	    .series = longitudinal,
+	};
+	status = plume_lab_plot(&plot, cli_output_path(output, "curves_longitudinal.png", path, sizeof path),
+	                        cli_output_path(output, "curves_longitudinal.svg", svg, sizeof svg), err);
+	if (status != PLUME_OK)
+		return status;
+	plume_plot_series tilted[3] = {
+	    {"transverse, mesoscale", r->curve_strain[1], r->curve_stress[1], n, true, false},
+	    {"tilted, barbs at 45 deg, mesoscale (mean over phases)", r->curve_strain[2], r->curve_stress[2], n, true,
+	     false},
+	    {"tilted, barbs at 45 deg, macroscale at the fitted E#dvw#u", r->curve_strain[3], r->curve_stress[3], n, false,
+	     true},
+	};
+	plot.title = "Calibration: transverse and tilted tests";
+	plot.series_count = 3;
+	plot.series = tilted;
+	return plume_lab_plot(&plot, cli_output_path(output, "curves_tilted.png", path, sizeof path),
+	                      cli_output_path(output, "curves_tilted.svg", svg, sizeof svg), err);
+}
+
+/// -o DIR: DIR/calibration.json (what stdout shows), DIR/slopes.csv, DIR/curves.csv and the
+/// curves' plots, together or not at all.
 static int write_calibration(const char *dir, const plume_calibration_def *def, const plume_calibration_result *r)
 {
 	plume_error err = {0};
@@ -234,6 +285,8 @@ static int write_calibration(const char *dir, const plume_calibration_def *def, 
 		if (ferror(csv) != 0 || fclose(csv) != 0)
 			status = plume_error_set(&err, PLUME_ERROR_IO, "%s: cannot write", path);
 	}
+	if (status == PLUME_OK && r->curve_samples > 0)
+		status = write_curves(&output, r, &err);
 	if (status == PLUME_OK)
 		status = cli_output_commit(&output, &err);
 	else
@@ -304,13 +357,19 @@ static int run_calibrate(int argc, char **argv)
 		return CLI_EXIT_INPUT;
 	}
 	plume_calibration_result r;
+	cli_progress progress;
+	cli_progress_begin(&progress, "lab calibrate", 1);
+	def.progress = cli_progress_callback;
+	def.progress_user = &progress;
+	def.keep_curves = output_dir != NULL;
 	plume_status status = plume_lab_calibrate(&def, &r, &err);
+	cli_progress_end(&progress);
 	if (status != PLUME_OK)
 		return cli_fail(&err);
 	print_calibration(stdout, &def, &r);
-	if (output_dir != NULL)
-		return write_calibration(output_dir, &def, &r);
-	return CLI_EXIT_OK;
+	int code = output_dir != NULL ? write_calibration(output_dir, &def, &r) : CLI_EXIT_OK;
+	plume_calibration_result_free(&r);
+	return code;
 }
 
 // ---------------------------------------------------------------------------
@@ -367,7 +426,12 @@ static int run_study(int argc, char **argv)
 	snprintf(file, sizeof file, "%s.svg", name);
 	cli_output_path(&output, file, stage_svg, sizeof stage_svg);
 	char summary[1024];
+	cli_progress progress;
+	cli_progress_begin(&progress, "lab study", 1);
+	def.progress = cli_progress_callback;
+	def.progress_user = &progress;
 	status = plume_lab_study(&def, stage_csv, stage_png, stage_svg, summary, sizeof summary, &err);
+	cli_progress_end(&progress);
 	if (status == PLUME_OK)
 		status = cli_output_commit(&output, &err);
 	else

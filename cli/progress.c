@@ -33,13 +33,21 @@ void cli_progress_begin(cli_progress *progress, const char *what, int total)
 	progress->total = total;
 	progress->start = cli_now_seconds();
 	progress->shown = isatty(STDERR_FILENO) != 0 && total > 0;
+	progress->open = false;
+	progress->printed = -1.0;
 }
 
-void cli_progress_update(cli_progress *progress, int done)
+void cli_progress_update(cli_progress *progress, int done) { cli_progress_update_note(progress, done, NULL); }
+
+void cli_progress_update_note(cli_progress *progress, int done, const char *note)
 {
 	if (!progress->shown)
 		return;
-	double elapsed = cli_now_seconds() - progress->start;
+	// At most ten lines a second (a coat builds thousands of feathers a second); the last always.
+	double t = cli_now_seconds(), elapsed = t - progress->start;
+	if (done < progress->total && progress->printed >= 0.0 && t - progress->printed < 0.1)
+		return;
+	progress->printed = t;
 	fprintf(stderr, "\r\033[Kplume %s: %d/%d (%d%%), ", progress->what, done, progress->total,
 	        (int)(100.0 * done / progress->total));
 	print_duration(elapsed);
@@ -49,7 +57,26 @@ void cli_progress_update(cli_progress *progress, int done)
 		print_duration(elapsed / done * (progress->total - done));
 		fputs(" left", stderr);
 	}
+	if (note != NULL)
+		fprintf(stderr, ", %s", note);
+	progress->open = done < progress->total;
 	if (done >= progress->total)
 		fputc('\n', stderr);
 	fflush(stderr);
+}
+
+void cli_progress_callback(void *user, int done, int total)
+{
+	cli_progress *progress = user;
+	progress->total = total;
+	cli_progress_update(progress, done);
+}
+
+void cli_progress_end(cli_progress *progress)
+{
+	if (progress->shown && progress->open) {
+		fputc('\n', stderr);
+		fflush(stderr);
+	}
+	progress->open = false;
 }

@@ -104,6 +104,7 @@ typedef struct run_state {
 	int frames;
 	int total_steps;
 	bool progress;
+	cli_progress bar; ///< the progress line (cli/progress.c)
 	double max_strain;
 	plume_mesh_animation *animation; ///< every frame, for DIR/sim.glb
 	plume_mesh_obj_writer *obj;      ///< frames/NNNN.obj, the lines shared by all frames formatted once
@@ -167,16 +168,11 @@ static void write_handle_columns(run_state *run, double time, const plume_sim *s
 	}
 }
 
-static void show_progress(const run_state *run, int step, double time)
+static void show_progress(run_state *run, int step, double time)
 {
-	int width = 30, done = run->total_steps > 0 ? step * width / run->total_steps : width;
-	fprintf(stderr, "\rsimulate [");
-	for (int i = 0; i < width; ++i)
-		fputc(i < done ? '#' : '.', stderr);
-	fprintf(stderr, "] step %d/%d  t = %.3f s", step, run->total_steps, time);
-	if (step == run->total_steps)
-		fputc('\n', stderr);
-	fflush(stderr);
+	char note[64];
+	snprintf(note, sizeof note, "t = %.3f s", time);
+	cli_progress_update_note(&run->bar, step, note);
 }
 
 static plume_status on_step(void *user, int step, double time, const plume_sim *sim, const plume_solve_report *report,
@@ -312,6 +308,7 @@ static plume_status simulate(const plume_scene *scene, cli_output *output, run_s
 		        h);
 	fputc('\n', run->stats);
 	plume_status run_status = plume_scene_run(scene, on_step, run, summary, failure);
+	cli_progress_end(&run->bar);
 	if (fclose(run->stats) != 0)
 		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write", path);
 	// A run that failed part way keeps what it wrote; input and I/O errors keep nothing.
@@ -425,7 +422,8 @@ int cli_simulate(int argc, char **argv)
 		plume_scene_destroy(scene);
 		return CLI_EXIT_LIMIT;
 	}
-	run.progress = isatty(STDERR_FILENO);
+	cli_progress_begin(&run.bar, "simulate", run.total_steps);
+	run.progress = run.bar.shown;
 	// Handles keep the feather in place: one framing for the whole sequence. A free
 	// feather (falling) is followed frame by frame.
 	plume_vec3 lo, hi;

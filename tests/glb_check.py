@@ -3,6 +3,11 @@
 
   glb_check.py frames SIM.glb FRAMES_DIR   each frame (base + morph target k) equals
                                            FRAMES_DIR/kkkk.obj's vertices to 1e-6 m
+  glb_check.py texture FILE.glb IMAGE.png  the embedded image has IMAGE's pixels (decoded by
+                                           matplotlib), both curve materials read it through
+                                           TEXCOORD_1, and TEXCOORD_1 is Franco & Walter's
+                                           image position of TEXCOORD_0 (s, t): u = (1 -/+ s) / 2
+                                           on the left/right vane, v = 1 - t
   glb_check.py counts FILE.glb             prints JSON: nodes, meshes, primitives,
                                            vertices (per-primitive, summed), triangles,
                                            lines, morph targets, animation keys
@@ -99,7 +104,44 @@ def counts(glb_path):
     print(json.dumps(result))
 
 
+def texture(glb_path, image_path):
+    import io
+    import matplotlib.image
+    import numpy as np
+    doc, binary = load(glb_path)
+    (image,) = doc["images"]
+    view = doc["bufferViews"][image["bufferView"]]
+    assert image["mimeType"] == "image/png", image
+    start = view.get("byteOffset", 0)
+    def rgba(pixels):  # Cairo writes an opaque image as RGB
+        return pixels if pixels.shape[2] == 4 else np.dstack([pixels, np.ones(pixels.shape[:2], pixels.dtype)])
+    embedded = rgba(matplotlib.image.imread(io.BytesIO(binary[start:start + view["byteLength"]]), format="png"))
+    original = rgba(matplotlib.image.imread(image_path))
+    assert embedded.shape == original.shape and np.array_equal(embedded, original), "embedded image differs"
+    assert doc["textures"] == [{"sampler": 0, "source": 0}], doc["textures"]
+    for material in doc["materials"]:
+        assert material["pbrMetallicRoughness"]["baseColorTexture"] == {"index": 0, "texCoord": 1}, material
+    checked = 0
+    for node in doc["nodes"]:
+        if "mesh" not in node or node["name"] not in ("shaft", "left_vane", "right_vane"):
+            continue
+        for primitive in doc["meshes"][node["mesh"]]["primitives"]:
+            attributes = primitive["attributes"]
+            assert "COLOR_0" not in attributes  # glTF would multiply it into the texture's colour
+            st = accessor(doc, binary, attributes["TEXCOORD_0"])
+            uv = accessor(doc, binary, attributes["TEXCOORD_1"])
+            for (s_, t_), (u, v) in zip(st, uv):
+                expected = 0.5 * (1 + s_) if node["name"] == "right_vane" else 0.5 * (1 - s_)
+                assert abs(u - expected) < 1e-6 and abs(v - (1 - t_)) < 1e-6, (node["name"], u, v, s_, t_)
+                checked += 1
+    assert checked > 0
+    print(f"{checked} texture coordinates checked")
+
+
 if __name__ == "__main__":
+    if len(sys.argv) == 4 and sys.argv[1] == "texture":
+        texture(sys.argv[2], sys.argv[3])
+        sys.exit(0)
     if len(sys.argv) == 4 and sys.argv[1] == "frames":
         frames(sys.argv[2], sys.argv[3])
     elif len(sys.argv) == 3 and sys.argv[1] == "counts":

@@ -375,6 +375,44 @@ static void test_bad_coats(void **state)
 	assert_int_equal(plume_bytes_in_use(), before);
 }
 
+// Progress calls as a plume_progress_fn records them.
+typedef struct progress_log {
+	int calls;
+	int last_done;
+	int last_total;
+	bool monotone;
+} progress_log;
+
+static void record_progress(void *user, int done, int total)
+{
+	progress_log *log = user;
+	log->monotone = log->monotone && done == log->last_done + 1 && done <= total;
+	log->calls += 1;
+	log->last_done = done;
+	log->last_total = total;
+}
+
+static void test_progress(void **state)
+{
+	(void)state;
+	// One call a feather, counting up to the feather count, from whichever thread built it; the
+	// coat is the same with or without the callback.
+	progress_log log = {.monotone = true};
+	plume_spec_options options = {.progress = record_progress, .progress_user = &log};
+	plume_coat *coat = NULL, *plain = build(figure15, 0, false);
+	plume_error err = {0};
+	if (plume_coat_spec_generate(figure15, &options, &coat, &err) != PLUME_OK)
+		fail_msg("%s", err.message);
+	assert_int_equal(log.calls, 64);
+	assert_int_equal(log.last_done, 64);
+	assert_int_equal(log.last_total, 64);
+	assert_true(log.monotone);
+	for (int i = 0; i < 64; ++i)
+		assert_true(plume_feather_equal(plume_coat_feather(coat, i), plume_coat_feather(plain, i)));
+	plume_coat_destroy(coat);
+	plume_coat_destroy(plain);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -386,6 +424,7 @@ int main(void)
 	    cmocka_unit_test(test_mesh_surface),
 	    cmocka_unit_test(test_exports_and_strip_rendering),
 	    cmocka_unit_test(test_bad_coats),
+	    cmocka_unit_test(test_progress),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);
 }

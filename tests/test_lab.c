@@ -516,8 +516,8 @@ static void test_mesoscale_tilted_converges(void **state)
 		slopes[k] = run_slope(&material, &sample, 0.4, 10, NULL);
 	}
 	double first = slopes[0] - slopes[1], second = slopes[1] - slopes[2];
-	print_message("mesoscale tilted slope at 500, 1000, 2000 elements: %.6g %.6g %.6g E_b\n",
-	              slopes[0] / material.E_b, slopes[1] / material.E_b, slopes[2] / material.E_b);
+	print_message("mesoscale tilted slope at 500, 1000, 2000 elements: %.6g %.6g %.6g E_b\n", slopes[0] / material.E_b,
+	              slopes[1] / material.E_b, slopes[2] / material.E_b);
 	assert_true(first > 0.0 && second > 0.0);
 	assert_true(first > 2.0 * second);
 	assert_true(second < 0.02 * slopes[2]);
@@ -597,6 +597,22 @@ static void test_mean_slope_over_phases(void **state)
 // ---------------------------------------------------------------------------
 // Calibration, locking, outputs, bad input
 
+typedef struct calibration_progress {
+	int calls;
+	int last_done;
+	int last_total;
+	bool monotone;
+} calibration_progress;
+
+static void record_calibration_progress(void *user, int done, int total)
+{
+	calibration_progress *log = user;
+	log->monotone = log->monotone && done == log->last_done + 1 && done <= total;
+	log->calls += 1;
+	log->last_done = done;
+	log->last_total = total;
+}
+
 static void test_calibration_table_5_1(void **state)
 {
 	(void)state;
@@ -609,10 +625,33 @@ static void test_calibration_table_5_1(void **state)
 	// On so coarse a mesoscale mesh the tilted target is stiff, where Newton struggles with
 	// inextensible barbs: fit the unconstrained model (E_vv = the longitudinal slope).
 	def.barb_constraint = false;
+	// The curves matched and the progress, counted in traction tests (one per band phase).
+	calibration_progress log = {.monotone = true};
+	def.keep_curves = true;
+	def.progress = record_calibration_progress;
+	def.progress_user = &log;
+	int64_t before = plume_bytes_in_use();
 	plume_calibration_result result;
 	plume_error err = {0};
 	if (plume_lab_calibrate(&def, &result, &err) != PLUME_OK)
 		fail_msg("%s", err.message);
+	assert_true(log.monotone);
+	assert_int_equal(log.calls, result.traction_count);
+	assert_int_equal(log.last_done, log.last_total);
+	assert_int_equal(result.curve_samples, def.steps + 1);
+	// Each curve's slope is the slope matched (the tilted mesoscale one averaged over the phases,
+	// which the slope, linear in the stresses, commutes with).
+	const double slopes[4] = {result.slope_longitudinal, result.slope_transverse, result.slope_tilted,
+	                          result.slope_tilted_macroscale};
+	const double strain_max[4] = {def.longitudinal_strain_max, def.transverse_strain_max, def.transverse_strain_max,
+	                              def.transverse_strain_max};
+	for (int c = 0; c < 4; ++c) {
+		assert_close(plume_lab_slope(result.curve_strain[c], result.curve_stress[c], result.curve_samples) / slopes[c],
+		             1.0, 1e-12);
+		assert_close(result.curve_strain[c][0], 0.0, 1e-12);
+		assert_close(result.curve_stress[c][0], 0.0, 1e-6 * slopes[c]);
+		assert_close(result.curve_strain[c][def.steps] / strain_max[c], 1.0, 0.05);
+	}
 	assert_close(result.E_vv / 3.60e8, 1.0, 0.01);
 	assert_close(result.E_ww / 4.80e4, 1.0, 0.01);
 	assert_close(result.E_vv / plume_lab_longitudinal_modulus(0.14, 2.57e9, 3.92e4), 1.0, 1e-6);
@@ -621,6 +660,9 @@ static void test_calibration_table_5_1(void **state)
 	assert_true(result.E_vw > 0.0);
 	assert_close(result.slope_tilted_macroscale / result.slope_tilted, 1.0, 0.02);
 	assert_true(result.traction_count >= 5);
+	plume_calibration_result_free(&result);
+	assert_null(result.curve_strain[0]);
+	assert_int_equal(plume_bytes_in_use(), before);
 }
 
 static double tilted_stress(plume_sample_mesh_kind mesh, int elements)

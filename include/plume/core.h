@@ -73,6 +73,16 @@ plume_status plume_error_set(plume_error *err, plume_status status, const char *
 void plume_error_prefix(plume_error *err, const char *prefix);
 
 // ---------------------------------------------------------------------------
+// Progress of long loops
+
+/// Called by a long library loop (a coat's feathers, a calibration's traction tests, a study's
+/// runs) after each item: done of total finished so far. total is an estimate where the
+/// loop's length is not known in advance (a calibration's search) and may grow between calls;
+/// done never exceeds it. Calls come one at a time, from any thread (parallel loops serialise
+/// them). The library never prints: the caller (the CLI) shows the progress.
+typedef void plume_progress_fn(void *user, int done, int total);
+
+// ---------------------------------------------------------------------------
 // Memory
 
 typedef void *plume_alloc_fn(size_t size);

@@ -267,6 +267,13 @@ typedef struct plume_calibration_def {
 	/// Band phases (k / phase_count, k = 0 .. phase_count - 1) the mesoscale tilted slope is
 	/// averaged over, [1, 64]. Default 4.
 	int phase_count;
+	/// Called after each traction test (a mesoscale mean counts one per phase); total is an
+	/// estimate while E_vw is searched. Default NULL (none).
+	plume_progress_fn *progress;
+	void *progress_user;
+	/// Keep the stress-strain curves matched in the result (curve_*); free them with
+	/// plume_calibration_result_free. Default false.
+	bool keep_curves;
 } plume_calibration_def;
 
 plume_calibration_def plume_calibration_default_def(void);
@@ -287,9 +294,19 @@ typedef struct plume_calibration_result {
 	int solve_count;
 	/// Bisection iterations on E_vw.
 	int bisection_iterations;
+	/// With def->keep_curves: the curves matched, curve_samples = steps + 1 samples each (the
+	/// first at rest), strain and stress (Pa): [0] mesoscale longitudinal, [1] mesoscale
+	/// transverse, [2] mesoscale tilted (the stress averaged over the band phases), [3] macroscale
+	/// tilted at the fitted E_vw. NULL and 0 otherwise.
+	int curve_samples;
+	double *curve_strain[4];
+	double *curve_stress[4];
 } plume_calibration_result;
 
 plume_status plume_lab_calibrate(const plume_calibration_def *def, plume_calibration_result *result, plume_error *err);
+
+/// Frees the curves of a calibration result (a no-op without them) and zeroes them.
+void plume_calibration_result_free(plume_calibration_result *result);
 
 // ---------------------------------------------------------------------------
 // Studies (docs/lab.md)
@@ -313,6 +330,9 @@ typedef struct plume_study_def {
 	plume_study_kind kind;
 	/// Multiplies every element count, > 0. Default 1.
 	double scale;
+	/// Called after each run of the study (a traction test or a calibration). Default NULL (none).
+	plume_progress_fn *progress;
+	void *progress_user;
 } plume_study_def;
 
 plume_study_def plume_study_default_def(plume_study_kind kind);

@@ -115,6 +115,9 @@ typedef struct plume_spec_options {
 	/// Bytes the model may build (estimated before the work; PLUME_ERROR_LIMIT past it). 0 means
 	/// PLUME_DEFAULT_MAX_MEMORY, so that a zero-initialised options struct keeps working.
 	uint64_t max_memory;
+	/// Coats (plume_coat_spec_generate): called after each feather is built. Default NULL (none).
+	plume_progress_fn *progress;
+	void *progress_user;
 } plume_spec_options;
 
 /// The default of plume_spec_options.max_memory and of the CLI's --max-memory: 4 GiB.

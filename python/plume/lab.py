@@ -63,7 +63,8 @@ def calibrate(*, barb_fraction: Optional[float] = None, E_B: Optional[float] = N
 
     Keywords override plume_calibration_default_def(): barb_fraction is Phi_B, E_B and E_b the
     barb and barbule moduli (Pa), period the band period T (m), width/thickness the tilted sample's
-    (m), element_count the mesoscale sample's target triangles. Returns the result's fields."""
+    (m), element_count the mesoscale sample's target triangles. Returns the result's fields and
+    "curves": the four stress-strain curves matched, name -> (strain, stress Pa) arrays."""
     d = ffi.new("plume_calibration_def *", lib.plume_calibration_default_def())
     if barb_fraction is not None:
         d.mesoscale.bands.barb_fraction = barb_fraction
@@ -84,12 +85,22 @@ def calibrate(*, barb_fraction: Optional[float] = None, E_B: Optional[float] = N
                         ("phase_count", phase_count)):
         if value is not None:
             setattr(d, name, value)
+    d.keep_curves = True
     r = ffi.new("plume_calibration_result *")
     err = new_error()
     check(lib.plume_lab_calibrate(d, r, err), err)
-    return {name: getattr(r, name) for name in (
+    result = {name: getattr(r, name) for name in (
         "E_vv", "E_ww", "E_vw", "slope_longitudinal", "slope_transverse", "slope_tilted",
         "slope_tilted_macroscale", "traction_count", "solve_count", "bisection_iterations")}
+    # The stress-strain curves matched (plume lab calibrate -o's curves.csv), copied out of the
+    # result before it is freed: name -> (strain, stress in Pa).
+    n = r.curve_samples
+    result["curves"] = {
+        name: (np.frombuffer(ffi.buffer(r.curve_strain[c], n * 8), dtype=np.float64).copy(),
+               np.frombuffer(ffi.buffer(r.curve_stress[c], n * 8), dtype=np.float64).copy())
+        for c, name in enumerate(("longitudinal", "transverse", "tilted_mesoscale", "tilted_macroscale"))}
+    lib.plume_calibration_result_free(r)
+    return result
 
 
 def study(kind: str, *, scale: float = 1.0, csv: Optional[str] = None, png: Optional[str] = None,

@@ -68,9 +68,9 @@ def test_traction_is_the_cli_traction(source, cli, tmp_path):
     assert e.value.path == "$.material.E_vw" and e.value.file == "<dict>"
 
 
-def test_calibrate_is_the_cli_calibration(cli):
+def test_calibrate_is_the_cli_calibration(cli, tmp_path):
     done = cli("lab", "calibrate", "--phi", 0.14, "--Eb", 3.92e4, "--EB", 2.57e9, "--elements", 300,
-               "--macro-elements", 200, "--phases", 1)
+               "--macro-elements", 200, "--phases", 1, "-o", tmp_path / "cal")
     expected = json.loads(done.stdout)
     result = plume.calibrate(barb_fraction=0.14, E_b=3.92e4, E_B=2.57e9, element_count=300, macroscale_elements=200,
                              phase_count=1)
@@ -78,6 +78,12 @@ def test_calibrate_is_the_cli_calibration(cli):
         assert f"{result[key]:.6g}" == f"{expected[key]:.6g}", key
     assert result["slope_tilted"] == pytest.approx(expected["slopes"]["tilted_mesoscale"], rel=1e-7)
     assert result["solve_count"] == expected["solves"]
+    # The curves are the CLI's curves.csv, column by column (written with %.17g).
+    table = np.loadtxt(tmp_path / "cal" / "curves.csv", delimiter=",", skiprows=1)
+    for c, name in enumerate(("longitudinal", "transverse", "tilted_mesoscale", "tilted_macroscale")):
+        strain, stress = result["curves"][name]
+        assert len(strain) == 11 and np.array_equal(strain, table[:, 2 * c]), name
+        assert np.array_equal(stress, table[:, 2 * c + 1]), name
     with pytest.raises(plume.Error):
         plume.calibrate(barb_fraction=1.5)
 

@@ -167,6 +167,30 @@ int plume_glb_material(plume_glb *glb, const char *name, const double factor[4])
 	return plume_glb_append(glb, glb->materials, material);
 }
 
+int plume_glb_png_texture(plume_glb *glb, const unsigned char *png, size_t size)
+{
+	int view = add_view(glb, png, size, GLB_NO_TARGET);
+	json_t *images = json_object_get(glb->root, "images"), *samplers = json_object_get(glb->root, "samplers");
+	json_t *textures = json_object_get(glb->root, "textures");
+	images = images != NULL ? images : set_array(glb, "images");
+	samplers = samplers != NULL ? samplers : set_array(glb, "samplers");
+	textures = textures != NULL ? textures : set_array(glb, "textures");
+	int image = plume_glb_append(glb, images, json_pack("{s:i, s:s}", "bufferView", view, "mimeType", "image/png"));
+	// Linear filtering; clamped at the borders as plume_texture_sample_vane clamps its indices.
+	int sampler = plume_glb_append(
+	    glb, samplers,
+	    json_pack("{s:i, s:i, s:i, s:i}", "magFilter", 9729, "minFilter", 9729, "wrapS", 33071, "wrapT", 33071));
+	return plume_glb_append(glb, textures, json_pack("{s:i, s:i}", "sampler", sampler, "source", image));
+}
+
+void plume_glb_material_texture(plume_glb *glb, int material, int texture, int texcoord)
+{
+	json_t *pbr = json_object_get(json_array_get(glb->materials, (size_t)material), "pbrMetallicRoughness");
+	json_t *info = json_pack("{s:i, s:i}", "index", texture, "texCoord", texcoord);
+	if (pbr == NULL || info == NULL || json_object_set_new(pbr, "baseColorTexture", info) != 0)
+		glb->failed = true;
+}
+
 double plume_glb_linear(double srgb)
 {
 	// IEC 61966-2-1.

@@ -66,6 +66,12 @@ void plume_glb_scene_root(plume_glb *glb, int node);
 int plume_glb_material(plume_glb *glb, const char *name, const double factor[4]);
 
 /// Writes the container to path atomically.
+/// An embedded PNG image (size bytes) as image, sampler and texture; returns the texture's index.
+int plume_glb_png_texture(plume_glb *glb, const unsigned char *png, size_t size);
+
+/// Gives material a base colour texture read through TEXCOORD_texcoord.
+void plume_glb_material_texture(plume_glb *glb, int material, int texture, int texcoord);
+
 plume_status plume_glb_write(plume_glb *glb, const char *path, plume_error *err);
 
 /// sRGB component to linear (glTF's COLOR_0 and baseColorFactor are linear).

@@ -13,6 +13,7 @@
 
 #include "../core/alloc.h"
 #include "glb.h"
+#include "render/texture_png.h"
 #include "plume/embed.h"
 #include "plume/gltf.h"
 
@@ -32,6 +33,7 @@ plume_gltf_def plume_gltf_default_def(void)
 /// One primitive's arrays, grown as curves are added.
 typedef struct part {
 	double *position, *normal, *uv, *color; // 3, 3, 2, 4 per vertex
+	double *image_uv;                       // 2 per vertex: where the texture's image is read (TEXCOORD_1)
 	int vertices, vertex_capacity;
 	uint32_t *indices;
 	int64_t index_count, index_capacity;
@@ -44,6 +46,7 @@ static void part_free(part *p)
 	plume_free(p->normal);
 	plume_free(p->uv);
 	plume_free(p->color);
+	plume_free(p->image_uv);
 	plume_free(p->indices);
 	memset(p, 0, sizeof *p);
 }
@@ -56,9 +59,9 @@ static bool part_reserve(part *p, int vertices, int64_t indices)
 		int capacity = p->vertex_capacity > 0 ? p->vertex_capacity : 1024;
 		while (capacity < p->vertices + vertices)
 			capacity *= 2;
-		double *arrays[4] = {p->position, p->normal, p->uv, p->color};
-		static const int widths[4] = {3, 3, 2, 4};
-		for (int k = 0; k < 4; ++k) {
+		double *arrays[5] = {p->position, p->normal, p->uv, p->color, p->image_uv};
+		static const int widths[5] = {3, 3, 2, 4, 2};
+		for (int k = 0; k < 5; ++k) {
 			double *grown = plume_realloc(arrays[k], (size_t)capacity * (size_t)widths[k] * sizeof(double));
 			if (grown == NULL) {
 				p->failed = true;
@@ -70,6 +73,7 @@ static bool part_reserve(part *p, int vertices, int64_t indices)
 		p->normal = arrays[1];
 		p->uv = arrays[2];
 		p->color = arrays[3];
+		p->image_uv = arrays[4];
 		p->vertex_capacity = capacity;
 	}
 	if (p->index_count + indices > p->index_capacity) {
@@ -87,9 +91,12 @@ static bool part_reserve(part *p, int vertices, int64_t indices)
 	return true;
 }
 
-static void part_vertex(part *p, plume_vec3 position, plume_vec3 normal, plume_vec2 uv, plume_color color)
+static void part_vertex(part *p, plume_vec3 position, plume_vec3 normal, plume_vec2 uv, plume_color color,
+                        plume_vec2 image_uv)
 {
 	int v = p->vertices++;
+	p->image_uv[2 * v] = image_uv.x;
+	p->image_uv[2 * v + 1] = image_uv.y;
 	double *x = p->position + 3 * v, *n = p->normal + 3 * v, *t = p->uv + 2 * v, *c = p->color + 4 * v;
 	x[0] = position.x;
 	x[1] = position.y;
@@ -126,7 +133,8 @@ typedef struct curve_in {
 	const plume_vec3 *across;  ///< NULL: n x t
 	const double *widths;
 	const plume_vec2 *uv;
-	plume_vec3 origin; ///< subtracted from every point
+	plume_vec3 origin;          ///< subtracted from every point
+	const plume_vec2 *image_uv; ///< per point, where the texture's image is read
 } curve_in;
 
 static void add_curve(part *p, const curve_in *c, plume_gltf_curves mode, const plume_color *colors)
@@ -140,7 +148,7 @@ static void add_curve(part *p, const curve_in *c, plume_gltf_curves mode, const 
 		uint32_t base = (uint32_t)p->vertices;
 		for (int j = 0; j < n; ++j) {
 			plume_vec3 normal = c->normals != NULL ? c->normals[j] : plume_v3(0, 0, 1);
-			part_vertex(p, plume_v3_sub(c->points[j], c->origin), normal, c->uv[j], colors[j]);
+			part_vertex(p, plume_v3_sub(c->points[j], c->origin), normal, c->uv[j], colors[j], c->image_uv[j]);
 		}
 		for (int j = 0; j + 1 < n; ++j) {
 			p->indices[p->index_count++] = base + (uint32_t)j;
@@ -166,8 +174,8 @@ static void add_curve(part *p, const curve_in *c, plume_gltf_curves mode, const 
 		}
 		double half = 0.5 * c->widths[j];
 		plume_vec3 centre = plume_v3_sub(c->points[j], c->origin);
-		part_vertex(p, plume_v3_mad(centre, -half, side), normal, c->uv[j], colors[j]);
-		part_vertex(p, plume_v3_mad(centre, half, side), normal, c->uv[j], colors[j]);
+		part_vertex(p, plume_v3_mad(centre, -half, side), normal, c->uv[j], colors[j], c->image_uv[j]);
+		part_vertex(p, plume_v3_mad(centre, half, side), normal, c->uv[j], colors[j], c->image_uv[j]);
 	}
 	for (int j = 0; j + 1 < n; ++j) {
 		uint32_t a0 = base + 2 * (uint32_t)j, b0 = a0 + 1, a1 = a0 + 2, b1 = a0 + 3;
@@ -177,20 +185,42 @@ static void add_curve(part *p, const curve_in *c, plume_gltf_curves mode, const 
 	}
 }
 
-/// Per-point colours of a curve: the texture's at (s, t) on the given side, or a constant.
-static bool curve_colors(plume_color **buffer, int *capacity, int count, const plume_gltf_def *def,
-                         const plume_vec2 *uv, plume_side side, plume_color constant)
+/// Where plume_texture_sample_vane reads the image for (s, t) on a side, as glTF texture
+/// coordinates (origin at the image's top left): Franco & Walter 4.4's columns (the rachis in
+/// the middle, each vane's edge at a border) and rows (t = 0 at the bottom).
+static plume_vec2 image_uv(plume_side side, plume_vec2 uv)
 {
-	if (count > *capacity) {
-		plume_color *grown = plume_realloc(*buffer, (size_t)count * sizeof(plume_color));
-		if (grown == NULL)
+	double u = side == PLUME_SIDE_LEFT ? 0.5 * (1.0 - uv.x) : 0.5 * (1.0 + uv.x);
+	return (plume_vec2){u, 1.0 - uv.y};
+}
+
+/// Per-point colours of a curve: the texture's at (s, t) on the given side, or a constant;
+/// and the points' image coordinates.
+typedef struct curve_buffers {
+	plume_color *colors;
+	plume_vec2 *image_uv;
+	int capacity;
+} curve_buffers;
+
+static bool curve_colors(curve_buffers *b, int count, const plume_gltf_def *def, const plume_vec2 *uv, plume_side side,
+                         plume_color constant)
+{
+	if (count > b->capacity) {
+		plume_color *grown = plume_realloc(b->colors, (size_t)count * sizeof(plume_color));
+		if (grown != NULL)
+			b->colors = grown;
+		plume_vec2 *grown_uv = plume_realloc(b->image_uv, (size_t)count * sizeof(plume_vec2));
+		if (grown_uv != NULL)
+			b->image_uv = grown_uv;
+		if (grown == NULL || grown_uv == NULL)
 			return false;
-		*buffer = grown;
-		*capacity = count;
+		b->capacity = count;
 	}
-	for (int j = 0; j < count; ++j)
-		(*buffer)[j] =
+	for (int j = 0; j < count; ++j) {
+		b->colors[j] =
 		    linear(def->texture != NULL ? plume_texture_sample_vane(def->texture, side, uv[j].x, uv[j].y) : constant);
+		b->image_uv[j] = image_uv(side, uv[j]);
+	}
 	return true;
 }
 
@@ -201,8 +231,7 @@ static const char *const part_names[PART_COUNT] = {"shaft", "left_vane", "right_
 static bool build_parts(const plume_feather *feather, const plume_gltf_def *def, plume_vec3 origin,
                         part parts[PART_COUNT])
 {
-	plume_color *colors = NULL;
-	int capacity = 0;
+	curve_buffers buffers = {0};
 	bool ok = true;
 	plume_feather_info info = plume_feather_get_info(feather);
 	const plume_shaft_sample *shaft = plume_feather_shaft(feather);
@@ -222,10 +251,10 @@ static bool build_parts(const plume_feather *feather, const plume_gltf_def *def,
 				uv[i] = (plume_vec2){0.0, shaft[i].t};
 			}
 			// The shaft's colour is the texture's at the rachis (s = 0) of the left vane.
-			ok = curve_colors(&colors, &capacity, n, def, uv, PLUME_SIDE_LEFT, def->shaft_color);
-			curve_in c = {n, points, normals, across, widths, uv, origin};
+			ok = curve_colors(&buffers, n, def, uv, PLUME_SIDE_LEFT, def->shaft_color);
+			curve_in c = {n, points, normals, across, widths, uv, origin, buffers.image_uv};
 			if (ok)
-				add_curve(&parts[PART_SHAFT], &c, def->curves, colors);
+				add_curve(&parts[PART_SHAFT], &c, def->curves, buffers.colors);
 		}
 		plume_free(points);
 		plume_free(widths);
@@ -235,11 +264,11 @@ static bool build_parts(const plume_feather *feather, const plume_gltf_def *def,
 		plume_barb barb = plume_feather_barb(feather, i);
 		if (barb.curve.count < 2)
 			continue;
-		ok = curve_colors(&colors, &capacity, barb.curve.count, def, barb.curve.uv, barb.side, def->barb_color);
-		curve_in c = {
-		    barb.curve.count, barb.curve.points, barb.curve.normals, NULL, barb.curve.widths, barb.curve.uv, origin};
+		ok = curve_colors(&buffers, barb.curve.count, def, barb.curve.uv, barb.side, def->barb_color);
+		curve_in c = {barb.curve.count, barb.curve.points, barb.curve.normals, NULL, barb.curve.widths, barb.curve.uv,
+		              origin,           buffers.image_uv};
 		if (ok)
-			add_curve(&parts[barb.side == PLUME_SIDE_LEFT ? PART_LEFT : PART_RIGHT], &c, def->curves, colors);
+			add_curve(&parts[barb.side == PLUME_SIDE_LEFT ? PART_LEFT : PART_RIGHT], &c, def->curves, buffers.colors);
 	}
 	for (int i = 0; ok && def->barbules && i < info.barbule_count; ++i) {
 		plume_barbule barbule = plume_feather_barbule(feather, i);
@@ -249,48 +278,77 @@ static bool build_parts(const plume_feather *feather, const plume_gltf_def *def,
 		// A barbule takes its barb's colour where it attaches (its own uv is along the barbule).
 		plume_barb barb = plume_feather_barb(feather, barbule.barb);
 		plume_vec2 at = {barbule.barb_s, barb.curve.count > 0 ? barb.curve.uv[0].y : 0.0};
-		ok = curve_colors(&colors, &capacity, 1, def, &at, side, def->barb_color);
+		ok = curve_colors(&buffers, 1, def, &at, side, def->barb_color);
 		if (!ok)
 			break;
-		plume_color one = colors[0];
-		ok = curve_colors(&colors, &capacity, barbule.curve.count, def, barbule.curve.uv, side, def->barb_color);
-		for (int j = 0; ok && j < barbule.curve.count; ++j)
-			colors[j] = one;
+		plume_color one = buffers.colors[0];
+		plume_vec2 one_uv = buffers.image_uv[0];
+		ok = curve_colors(&buffers, barbule.curve.count, def, barbule.curve.uv, side, def->barb_color);
+		for (int j = 0; ok && j < barbule.curve.count; ++j) {
+			buffers.colors[j] = one;
+			buffers.image_uv[j] = one_uv;
+		}
 		curve_in c = {barbule.curve.count,
 		              barbule.curve.points,
 		              barbule.curve.normals,
 		              NULL,
 		              barbule.curve.widths,
 		              barbule.curve.uv,
-		              origin};
+		              origin,
+		              buffers.image_uv};
 		if (ok)
-			add_curve(&parts[PART_BARBULES], &c, def->curves, colors);
+			add_curve(&parts[PART_BARBULES], &c, def->curves, buffers.colors);
 	}
-	plume_free(colors);
+	plume_free(buffers.colors);
+	plume_free(buffers.image_uv);
 	for (int k = 0; k < PART_COUNT; ++k)
 		ok = ok && !parts[k].failed;
 	return ok;
 }
 
 /// A glTF primitive from a part: attributes, indices, mode, material.
-static json_t *part_primitive(plume_glb *glb, const part *p, plume_gltf_curves mode, int material)
+/// textured: the texture's image is embedded, read through TEXCOORD_1; the colour is then the
+/// texture's alone (glTF multiplies COLOR_0 into the base colour, so it is left out).
+static json_t *part_primitive(plume_glb *glb, const part *p, plume_gltf_curves mode, int material, bool textured)
 {
 	int position = plume_glb_floats(glb, p->position, p->vertices, 3, GLB_ARRAY_BUFFER, true);
 	int normal = plume_glb_floats(glb, p->normal, p->vertices, 3, GLB_ARRAY_BUFFER, false);
 	int uv = plume_glb_floats(glb, p->uv, p->vertices, 2, GLB_ARRAY_BUFFER, false);
-	int color = plume_glb_floats(glb, p->color, p->vertices, 4, GLB_ARRAY_BUFFER, false);
-	int indices = plume_glb_indices(glb, p->indices, p->index_count);
-	return json_pack("{s:{s:i, s:i, s:i, s:i}, s:i, s:i, s:i}", "attributes", "POSITION", position, "NORMAL", normal,
-	                 "TEXCOORD_0", uv, "COLOR_0", color, "indices", indices, "mode", mode == PLUME_GLTF_LINES ? 1 : 4,
-	                 "material", material);
+	json_t *primitive = json_pack("{s:{s:i, s:i, s:i}, s:i, s:i}", "attributes", "POSITION", position, "NORMAL", normal,
+	                              "TEXCOORD_0", uv, "mode", mode == PLUME_GLTF_LINES ? 1 : 4, "material", material);
+	json_t *attributes = json_object_get(primitive, "attributes");
+	if (textured)
+		json_object_set_new(attributes, "TEXCOORD_1",
+		                    json_integer(plume_glb_floats(glb, p->image_uv, p->vertices, 2, GLB_ARRAY_BUFFER, false)));
+	else
+		json_object_set_new(attributes, "COLOR_0",
+		                    json_integer(plume_glb_floats(glb, p->color, p->vertices, 4, GLB_ARRAY_BUFFER, false)));
+	json_object_set_new(primitive, "indices", json_integer(plume_glb_indices(glb, p->indices, p->index_count)));
+	return primitive;
 }
 
-/// The two materials every curve file shares (colours are in COLOR_0).
-static void curve_materials(plume_glb *glb, int *shaft, int *vane)
+/// The two materials every curve file shares (colours are in COLOR_0, or with a texture in
+/// the embedded image, PNG-encoded).
+static plume_status curve_materials(plume_glb *glb, const plume_gltf_def *def, int *shaft, int *vane, plume_error *err)
 {
 	static const double white[4] = {1, 1, 1, 1};
 	*shaft = plume_glb_material(glb, "shaft", white);
 	*vane = plume_glb_material(glb, "vane", white);
+	if (def->texture == NULL)
+		return PLUME_OK;
+	size_t size = 0;
+	plume_error local = {0};
+	unsigned char *png = plume_texture_png_bytes(def->texture, &size, &local);
+	if (png == NULL) {
+		if (err != NULL)
+			*err = local;
+		return local.status;
+	}
+	int texture = plume_glb_png_texture(glb, png, size);
+	plume_free(png);
+	plume_glb_material_texture(glb, *shaft, texture, 1);
+	plume_glb_material_texture(glb, *vane, texture, 1);
+	return PLUME_OK;
 }
 
 /// Node "name" with one child node per non-empty part (and, nested, the afterfeather). Returns the node.
@@ -304,7 +362,8 @@ static int write_feather_nodes(plume_glb *glb, const plume_feather *feather, con
 	for (int k = 0; *ok && k < PART_COUNT; ++k) {
 		if (parts[k].vertices == 0)
 			continue;
-		json_t *primitive = part_primitive(glb, &parts[k], def->curves, materials[k == PART_SHAFT ? 0 : 1]);
+		json_t *primitive =
+		    part_primitive(glb, &parts[k], def->curves, materials[k == PART_SHAFT ? 0 : 1], def->texture != NULL);
 		int mesh = plume_glb_append(glb, glb->meshes,
 		                            json_pack("{s:s, s:[o]}", "name", part_names[k], "primitives", primitive));
 		int node = plume_glb_append(glb, glb->nodes, json_pack("{s:s, s:i}", "name", part_names[k], "mesh", mesh));
@@ -329,7 +388,11 @@ plume_status plume_write_glb(const plume_feather *feather, const plume_gltf_def 
 	plume_glb glb;
 	plume_glb_init(&glb, "plume " PLUME_VERSION_STRING);
 	int materials[2];
-	curve_materials(&glb, &materials[0], &materials[1]);
+	plume_status textured = curve_materials(&glb, def, &materials[0], &materials[1], err);
+	if (textured != PLUME_OK) {
+		plume_glb_free(&glb);
+		return textured;
+	}
 	bool ok = true;
 	int root = write_feather_nodes(&glb, feather, def, "feather", materials, &ok);
 	plume_glb_scene_root(&glb, root);
@@ -371,6 +434,7 @@ static bool same_parts(const part a[PART_COUNT], const part b[PART_COUNT])
 		    memcmp(a[k].normal, b[k].normal, 3 * v * sizeof(double)) != 0 ||
 		    memcmp(a[k].uv, b[k].uv, 2 * v * sizeof(double)) != 0 ||
 		    memcmp(a[k].color, b[k].color, 4 * v * sizeof(double)) != 0 ||
+		    memcmp(a[k].image_uv, b[k].image_uv, 2 * v * sizeof(double)) != 0 ||
 		    memcmp(a[k].indices, b[k].indices, (size_t)a[k].index_count * sizeof(uint32_t)) != 0)
 			return false;
 	}
@@ -397,7 +461,11 @@ plume_status plume_coat_write_glb_report(const plume_coat *coat, const plume_glt
 	plume_glb glb;
 	plume_glb_init(&glb, "plume " PLUME_VERSION_STRING);
 	int materials[2];
-	curve_materials(&glb, &materials[0], &materials[1]);
+	plume_status textured = curve_materials(&glb, def, &materials[0], &materials[1], err);
+	if (textured != PLUME_OK) {
+		plume_glb_free(&glb);
+		return textured;
+	}
 	int count = plume_coat_feather_count(coat);
 	coat_mesh *meshes = plume_calloc(count > 0 ? (size_t)count : 1, sizeof(coat_mesh));
 	json_t *children = json_array();
@@ -424,8 +492,9 @@ plume_status plume_coat_write_glb_report(const plume_coat *coat, const plume_glt
 			json_t *primitives = json_array();
 			for (int k = 0; k < PART_COUNT; ++k)
 				if (candidate->parts[k].vertices > 0)
-					json_array_append_new(primitives, part_primitive(&glb, &candidate->parts[k], def->curves,
-					                                                 materials[k == PART_SHAFT ? 0 : 1]));
+					json_array_append_new(primitives,
+					                      part_primitive(&glb, &candidate->parts[k], def->curves,
+					                                     materials[k == PART_SHAFT ? 0 : 1], def->texture != NULL));
 			char name[32];
 			snprintf(name, sizeof name, "feather_%05d", i);
 			mesh = plume_glb_append(&glb, glb.meshes, json_pack("{s:s, s:o}", "name", name, "primitives", primitives));

@@ -329,6 +329,10 @@ plume_status plume_coat_spec_generate(const char *path, const plume_spec_options
 	if (options != NULL && options->seed_given)
 		def.seed = options->seed;
 	def.max_memory = options != NULL && options->max_memory > 0 ? options->max_memory : PLUME_DEFAULT_MAX_MEMORY;
+	if (options != NULL) {
+		def.progress = options->progress;
+		def.progress_user = options->progress_user;
+	}
 	plume_status status = reader.status;
 	if (status == PLUME_OK) {
 		status = coat_build(&def, out, err);

@@ -6,6 +6,8 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "core/alloc.h"
+#include "lab/lab_internal.h"
 #include "plume/lab.h"
 
 static const double PI = 3.14159265358979323846;
@@ -71,10 +73,11 @@ static plume_status check(const plume_calibration_def *def, plume_error *err)
 }
 
 // Runs one traction test (the mean over phase_count band phases for the mesoscale model)
-// and returns its slope.
+// and returns its slope; keeps its curve as result's curve (0..3) when the result holds curves
+// and curve >= 0.
 static plume_status slope_of(const plume_lab_material *material, const plume_sample_def *sample, double strain_max,
-                             int steps, int phase_count, plume_calibration_result *result, double *slope,
-                             plume_error *err)
+                             int steps, int phase_count, plume_calibration_result *result, double *slope, int curve,
+                             plume_lab_progress *progress, plume_error *err)
 {
 	plume_traction_def traction = plume_traction_default_def();
 	traction.strain_max = strain_max;
@@ -88,7 +91,10 @@ static plume_status slope_of(const plume_lab_material *material, const plume_sam
 	// mesoscale mesh's own error.
 	traction.accept_residual = 1e-3;
 	int solves = 0;
-	plume_status status = plume_lab_mean_slope(material, sample, &traction, phase_count, slope, &solves, err);
+	bool keep = curve >= 0 && result->curve_samples > 0;
+	plume_status status = lab_mean_curve(material, sample, &traction, phase_count, slope, &solves,
+	                                     keep ? result->curve_strain[curve] : NULL,
+	                                     keep ? result->curve_stress[curve] : NULL, progress, err);
 	if (status != PLUME_OK) {
 		char context[160];
 		if (material->model == PLUME_LAB_MACROSCALE)
@@ -112,12 +118,45 @@ static double whole_periods(double size, double period)
 	return count * period;
 }
 
+// While E_vw is searched the number of tests ahead is unknown: the estimate keeps this test
+// and the final one ahead of those done.
+static plume_lab_progress *search_progress(plume_lab_progress *progress)
+{
+	if (progress->total < progress->done + 2)
+		progress->total = progress->done + 2;
+	return progress;
+}
+
+void plume_calibration_result_free(plume_calibration_result *result)
+{
+	for (int c = 0; c < 4; ++c) {
+		plume_free(result->curve_strain[c]);
+		plume_free(result->curve_stress[c]);
+		result->curve_strain[c] = result->curve_stress[c] = NULL;
+	}
+	result->curve_samples = 0;
+}
+
 plume_status plume_lab_calibrate(const plume_calibration_def *def, plume_calibration_result *result, plume_error *err)
 {
 	memset(result, 0, sizeof *result);
 	plume_status status = check(def, err);
 	if (status != PLUME_OK)
 		return status;
+	if (def->keep_curves) {
+		result->curve_samples = def->steps + 1;
+		for (int c = 0; c < 4; ++c) {
+			result->curve_strain[c] = plume_calloc((size_t)result->curve_samples, sizeof(double));
+			result->curve_stress[c] = plume_calloc((size_t)result->curve_samples, sizeof(double));
+			if (result->curve_strain[c] == NULL || result->curve_stress[c] == NULL) {
+				plume_calibration_result_free(result);
+				return plume_error_set(err, PLUME_ERROR_MEMORY, "calibration: out of memory");
+			}
+		}
+	}
+	// Tests ahead: longitudinal, transverse, the tilted phases, then a search on E_vw that
+	// typically takes about ten macroscale tests, and the final one.
+	plume_lab_progress progress = {def->progress, def->progress_user, 0, 2 + def->phase_count + 11};
 	plume_lab_material meso = def->mesoscale;
 	meso.model = PLUME_LAB_MESOSCALE;
 	double width = def->sample.width, height = def->aspect_ratio * def->sample.width;
@@ -129,11 +168,11 @@ plume_status plume_lab_calibrate(const plume_calibration_def *def, plume_calibra
 	straight.element_count = 200;
 	straight.barb_angle = 0.0;
 	status = slope_of(&meso, &straight, def->longitudinal_strain_max, def->steps, 1, result,
-	                  &result->slope_longitudinal, err);
+	                  &result->slope_longitudinal, 0, &progress, err);
 	if (status == PLUME_OK) {
 		straight.barb_angle = 0.5 * PI;
 		status = slope_of(&meso, &straight, def->transverse_strain_max, def->steps, 1, result,
-		                  &result->slope_transverse, err);
+		                  &result->slope_transverse, 1, &progress, err);
 	}
 	plume_sample_def tilted = def->sample;
 	tilted.height = height;
@@ -142,9 +181,10 @@ plume_status plume_lab_calibrate(const plume_calibration_def *def, plume_calibra
 	// corners: the target is its mean over band phases.
 	if (status == PLUME_OK)
 		status = slope_of(&meso, &tilted, def->transverse_strain_max, def->steps, def->phase_count, result,
-		                  &result->slope_tilted, err);
+		                  &result->slope_tilted, 2, &progress, err);
 	if (status != PLUME_OK) {
 		plume_error_prefix(err, "calibration");
+		plume_calibration_result_free(result);
 		return status;
 	}
 
@@ -171,7 +211,8 @@ plume_status plume_lab_calibrate(const plume_calibration_def *def, plume_calibra
 	double log_max = log(fmin(E_VW_RANGE_HIGH * macro.E_ww, macro.E_vv));
 	double lo = fmin(fmax(log(0.25 * macro.E_ww), log_min), log_max), hi = lo, f_lo = 0.0, f_hi = 0.0, slope = 0.0;
 	macro.E_vw = exp(lo);
-	status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, 1, result, &slope, err);
+	status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, 1, result, &slope, -1,
+	                  search_progress(&progress), err);
 	f_lo = f_hi = slope - target;
 	double step = log(2.0);
 	while (status == PLUME_OK && (f_lo > 0.0) == (f_hi > 0.0)) {
@@ -180,13 +221,15 @@ plume_status plume_lab_calibrate(const plume_calibration_def *def, plume_calibra
 			break; // the end of the range: the target is out of reach
 		double x = down ? fmax(lo - step, log_min) : fmin(hi + step, log_max);
 		macro.E_vw = exp(x);
-		status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, 1, result, &slope, err);
+		status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, 1, result, &slope, -1,
+		                  search_progress(&progress), err);
 		// Newton may fail on a very stiff trial: step out by half as far and try again.
 		for (int retry = 0; retry < 4 && status == PLUME_ERROR_NUMERIC; ++retry) {
 			step *= 0.5;
 			x = down ? fmax(lo - step, log_min) : fmin(hi + step, log_max);
 			macro.E_vw = exp(x);
-			status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, 1, result, &slope, err);
+			status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, 1, result, &slope, -1,
+			                  search_progress(&progress), err);
 		}
 		if (down) {
 			hi = lo, f_hi = f_lo;
@@ -235,7 +278,8 @@ plume_status plume_lab_calibrate(const plume_calibration_def *def, plume_calibra
 		if (!(x > lo && x < hi))
 			x = 0.5 * (lo + hi);
 		macro.E_vw = exp(x);
-		status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, 1, result, &slope, err);
+		status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, 1, result, &slope, -1,
+		                  search_progress(&progress), err);
 		double f = slope - target;
 		result->bisection_iterations += 1;
 		if (f == 0.0) {
@@ -257,7 +301,8 @@ plume_status plume_lab_calibrate(const plume_calibration_def *def, plume_calibra
 			// Slow progress: bisect once.
 			double mid = 0.5 * (lo + hi);
 			macro.E_vw = exp(mid);
-			status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, 1, result, &slope, err);
+			status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, 1, result, &slope, -1,
+			                  search_progress(&progress), err);
 			result->bisection_iterations += 1;
 			if ((slope - target > 0.0) == (f_hi > 0.0))
 				hi = mid, f_hi = slope - target;
@@ -268,6 +313,7 @@ plume_status plume_lab_calibrate(const plume_calibration_def *def, plume_calibra
 	}
 	if (status != PLUME_OK) {
 		plume_error_prefix(err, "calibration");
+		plume_calibration_result_free(result);
 		return status;
 	}
 	// The final modulus: the bracket's false-position point, and its slope.
@@ -275,10 +321,12 @@ plume_status plume_lab_calibrate(const plume_calibration_def *def, plume_calibra
 	if (!(x >= lo && x <= hi))
 		x = 0.5 * (lo + hi);
 	macro.E_vw = exp(x);
+	progress.total = progress.done + 1;
 	status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, 1, result,
-	                  &result->slope_tilted_macroscale, err);
+	                  &result->slope_tilted_macroscale, 3, &progress, err);
 	if (status != PLUME_OK) {
 		plume_error_prefix(err, "calibration");
+		plume_calibration_result_free(result);
 		return status;
 	}
 	result->E_vv = macro.E_vv;

@@ -64,6 +64,14 @@ static void table_free(table *t)
 		plume_free(t->columns[c]);
 }
 
+// One run of a study finished: done of total (def->progress, when set).
+static void study_progress(const plume_study_def *def, int *done, int total)
+{
+	*done += 1;
+	if (def->progress != NULL)
+		def->progress(def->progress_user, *done, total);
+}
+
 static plume_status memory_error(plume_error *err) { return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory"); }
 
 // ---------------------------------------------------------------------------
@@ -104,6 +112,7 @@ static plume_status study_locking(const plume_study_def *def, const char *csv, c
 	plume_sample_def sample = plume_sample_default_def(); // 10 x 13 mm, barbs at 45 degrees
 	double error_ratio = 0.0;
 	int unconverged = 0;
+	int done = 0, total = 3 * (1 + 2 * 5) + 5; // a reference and two meshes per alpha; the constraint at 1e4
 	for (int a = 0; a < 3 && status == PLUME_OK; ++a) {
 		plume_lab_material material = plume_lab_material_default(PLUME_LAB_MACROSCALE);
 		material.E_vv = alphas[a] * material.E_ww;
@@ -112,6 +121,7 @@ static plume_status study_locking(const plume_study_def *def, const char *csv, c
 		fine.element_count = scaled(16000, def->scale);
 		double reference;
 		status = stress_at(&material, &fine, 0.05, 5, &reference, err);
+		study_progress(def, &done, total);
 		if (status == PLUME_OK && isnan(reference))
 			status = plume_error_set(err, PLUME_ERROR_NUMERIC,
 			                         "locking study: the reference (%d aligned elements, alpha %g) did not converge",
@@ -127,6 +137,7 @@ static plume_status study_locking(const plume_study_def *def, const char *csv, c
 				m.barb_constraint = mesh == 2;
 				double stress;
 				status = stress_at(&m, &s, 0.05, 5, &stress, err);
+				study_progress(def, &done, total);
 				double row[5] = {alphas[a], mesh, s.element_count, stress, fabs(stress - reference) / fabs(reference)};
 				unconverged += isnan(stress);
 				if (status == PLUME_OK && table_add(&t, row) != 0)
@@ -251,6 +262,7 @@ static plume_status study_conditioning(const plume_study_def *def, const char *c
 		plume_lab_material m = material;
 		m.barb_constraint = k == 2;
 		status = plume_lab_traction(&m, &sample, &traction, runs + k, err);
+		study_progress(def, &(int){k}, 3);
 		if (status == PLUME_OK) {
 			variation[k] = slope_oscillation(runs[k].strain, runs[k].stress, runs[k].count);
 			total_iterations[k] = runs[k].newton_iterations;
@@ -331,6 +343,7 @@ static plume_status study_angles(const plume_study_def *def, const char *csv, co
 	double angle_deg[ANGLES], meso[3][ANGLES], macro[3][ANGLES], E_vw[3];
 	plume_status status = PLUME_OK;
 	double worst = 0.0;
+	int done = 0, total = 3 * (1 + 2 * ANGLES); // a calibration and two slopes per angle for each Phi_B
 	for (int p = 0; p < 3 && status == PLUME_OK; ++p) {
 		plume_calibration_def cal = plume_calibration_default_def();
 		cal.mesoscale.bands.barb_fraction = phis[p];
@@ -344,6 +357,7 @@ static plume_status study_angles(const plume_study_def *def, const char *csv, co
 		status = plume_lab_calibrate(&cal, &result, err);
 		if (status != PLUME_OK)
 			break;
+		study_progress(def, &done, total);
 		E_vw[p] = result.E_vw;
 		plume_lab_material meso_material = cal.mesoscale;
 		plume_lab_material macro_material = plume_lab_material_default(PLUME_LAB_MACROSCALE);
@@ -357,9 +371,11 @@ static plume_status study_angles(const plume_study_def *def, const char *csv, co
 			sample.barb_angle = angle_deg[a] * PI / 180.0;
 			sample.element_count = cal.sample.element_count;
 			status = slope_at(&meso_material, &sample, cal.steps, cal.phase_count, &meso[p][a], err);
+			study_progress(def, &done, total);
 			sample.element_count = cal.macroscale_elements;
 			if (status == PLUME_OK)
 				status = slope_at(&macro_material, &sample, cal.steps, 1, &macro[p][a], err);
+			study_progress(def, &done, total);
 			if (status == PLUME_OK) {
 				meso[p][a] /= E_b[p];
 				macro[p][a] /= E_b[p];
@@ -438,6 +454,7 @@ static plume_status study_size(const plume_study_def *def, const char *csv, cons
 		traction.solver.tolerance = 1e-6;
 		traction.accept_residual = 1e-4;
 		status = plume_lab_traction(&material, &sample, &traction, runs + k, err);
+		study_progress(def, &(int){k}, SIZES);
 		if (status == PLUME_OK) {
 			inverse_n[k] = 1.0 / barbs[k];
 			stress_at_3[k] = runs[k].stress[runs[k].count - 1] / material.E_B;

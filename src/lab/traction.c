@@ -8,6 +8,7 @@
 #include "core/alloc.h"
 #include "lab/quadratic.h"
 #include "plume/lab.h"
+#include "lab/lab_internal.h"
 
 plume_lab_material plume_lab_material_default(plume_lab_model model)
 {
@@ -278,11 +279,11 @@ plume_status plume_lab_traction(const plume_lab_material *material, const plume_
 		r.iterations[i] = step.iterations;
 		r.converged[i] = step.status == PLUME_OK;
 		r.residual[i] = step.residual;
-		bool accepted = step.status == PLUME_OK ||
-		                (step.status == PLUME_ERROR_NUMERIC && step.residual <= def->accept_residual);
+		bool accepted =
+		    step.status == PLUME_OK || (step.status == PLUME_ERROR_NUMERIC && step.residual <= def->accept_residual);
 		if (!accepted && (def->require_convergence || step.status != PLUME_ERROR_NUMERIC)) {
-			status = plume_error_set(err, step.status, "traction step %d of %d (strain %g) failed: %s", i,
-			                         def->steps, strain, step_err.message);
+			status = plume_error_set(err, step.status, "traction step %d of %d (strain %g) failed: %s", i, def->steps,
+			                         strain, step_err.message);
 			break;
 		}
 		r.strain[i] = plume_lab_measured_strain(H, d);
@@ -306,9 +307,9 @@ plume_status plume_lab_traction(const plume_lab_material *material, const plume_
 	return status;
 }
 
-plume_status plume_lab_mean_slope(const plume_lab_material *material, const plume_sample_def *sample,
-                                  const plume_traction_def *def, int phase_count, double *slope, int *solve_count,
-                                  plume_error *err)
+plume_status lab_mean_curve(const plume_lab_material *material, const plume_sample_def *sample,
+                            const plume_traction_def *def, int phase_count, double *slope, int *solve_count,
+                            double *strain, double *stress, plume_lab_progress *progress, plume_error *err)
 {
 	if (phase_count < 1)
 		return plume_error_set(err, PLUME_ERROR_SPEC, "phase count is %d, allowed >= 1", phase_count);
@@ -331,10 +332,29 @@ plume_status plume_lab_mean_slope(const plume_lab_material *material, const plum
 		}
 		sum += r.slope;
 		solves += r.solve_count;
+		// Every phase loads the clamp to the same strains: the stresses average sample by sample.
+		for (int i = 0; i < r.count && stress != NULL; ++i) {
+			if (strain != NULL)
+				strain[i] = r.strain[i];
+			stress[i] = (k == 0 ? 0.0 : stress[i]) + r.stress[i] / runs;
+		}
 		plume_traction_result_free(&r);
+		if (progress != NULL && progress->fn != NULL) {
+			progress->done += 1;
+			if (progress->total < progress->done)
+				progress->total = progress->done;
+			progress->fn(progress->user, progress->done, progress->total);
+		}
 	}
 	*slope = sum / runs;
 	if (solve_count != NULL)
 		*solve_count = solves;
 	return PLUME_OK;
+}
+
+plume_status plume_lab_mean_slope(const plume_lab_material *material, const plume_sample_def *sample,
+                                  const plume_traction_def *def, int phase_count, double *slope, int *solve_count,
+                                  plume_error *err)
+{
+	return lab_mean_curve(material, sample, def, phase_count, slope, solve_count, NULL, NULL, NULL, err);
 }

@@ -704,6 +704,7 @@ plume_status coat_build(coat_def *def, plume_coat **out, plume_error *err)
 	for (int k = 0; k < def->key_count; ++k)
 		key_pointers[k] = &def->key_defs[k];
 	int failed = count; // the first failing follicle in drawing order
+	int built = 0;      // feathers finished, for def->progress
 #pragma omp parallel for schedule(dynamic, 4)
 	for (int slot = 0; slot < count; ++slot) {
 		int i = order[slot].index;
@@ -737,6 +738,11 @@ plume_status coat_build(coat_def *def, plume_coat **out, plume_error *err)
 		coat->normals[slot] = normals[i];
 		coat->is_key[slot] = key_of[i] >= 0;
 		statuses[slot] = s;
+		if (def->progress != NULL) {
+			// One call at a time, with the count of feathers finished so far, whichever thread.
+#pragma omp critical
+			def->progress(def->progress_user, ++built, count);
+		}
 		if (s != PLUME_OK) {
 			// Unnamed: a named section's lock is a global symbol libplume.so would export.
 #pragma omp critical

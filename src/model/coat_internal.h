@@ -54,8 +54,10 @@ typedef struct coat_def {
 
 	plume_sh_lod lod;
 	uint64_t seed;
-	double stage;        ///< growth stage of every feather, 1 finished
-	uint64_t max_memory; ///< bytes the coat may take (estimated before the layout and before the feathers)
+	double stage;                ///< growth stage of every feather, 1 finished
+	uint64_t max_memory;         ///< bytes the coat may take (estimated before the layout and before the feathers)
+	plume_progress_fn *progress; ///< after each feather (plume_spec_options), may be NULL
+	void *progress_user;
 } coat_def;
 
 /// Builds the coat; takes the mesh out of def (def->mesh is NULL afterwards). key_defs stay with def.

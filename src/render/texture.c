@@ -14,6 +14,7 @@
 #include "core/alloc.h"
 #include "plume/render.h"
 #include "render/cairo_png.h"
+#include "render/texture_png.h"
 
 struct plume_texture {
 	int width;
@@ -172,9 +173,11 @@ plume_color plume_texture_sample_vane(const plume_texture *texture, plume_side s
 /// Straight 8-bit channel times alpha, rounded: Cairo's ARGB32 is premultiplied.
 static uint32_t premultiply(uint8_t channel, uint8_t alpha) { return ((uint32_t)channel * alpha + 127u) / 255u; }
 
-plume_status plume_texture_write_png(const plume_texture *texture, const char *path, plume_error *err)
+// The texture as a Cairo ARGB32 surface (premultiplied) in *out.
+static plume_status texture_surface(const plume_texture *texture, const char *path, cairo_surface_t **out,
+                                    plume_error *err)
 {
-	assert(texture != NULL && path != NULL);
+	*out = NULL;
 	cairo_surface_t *surface = cairo_image_surface_create(CAIRO_FORMAT_ARGB32, texture->width, texture->height);
 	cairo_status_t cairo_status = cairo_surface_status(surface);
 	if (cairo_status != CAIRO_STATUS_SUCCESS) {
@@ -197,7 +200,59 @@ plume_status plume_texture_write_png(const plume_texture *texture, const char *p
 		}
 	}
 	cairo_surface_mark_dirty(surface);
-	plume_status status = plume_cairo_write_png(surface, path, err);
+	*out = surface;
+	return PLUME_OK;
+}
+
+plume_status plume_texture_write_png(const plume_texture *texture, const char *path, plume_error *err)
+{
+	assert(texture != NULL && path != NULL);
+	cairo_surface_t *surface = NULL;
+	plume_status status = texture_surface(texture, path, &surface, err);
+	if (status != PLUME_OK)
+		return status;
+	status = plume_cairo_write_png(surface, path, err);
 	cairo_surface_destroy(surface);
 	return status;
+}
+
+typedef struct png_bytes {
+	unsigned char *data;
+	size_t size, capacity;
+} png_bytes;
+
+static cairo_status_t append_png(void *closure, const unsigned char *data, unsigned int length)
+{
+	png_bytes *out = closure;
+	if (out->size + length > out->capacity) {
+		size_t capacity = out->capacity > 0 ? out->capacity : 1 << 16;
+		while (capacity < out->size + length)
+			capacity *= 2;
+		unsigned char *grown = plume_realloc(out->data, capacity);
+		if (grown == NULL)
+			return CAIRO_STATUS_NO_MEMORY;
+		out->data = grown;
+		out->capacity = capacity;
+	}
+	memcpy(out->data + out->size, data, length);
+	out->size += length;
+	return CAIRO_STATUS_SUCCESS;
+}
+
+unsigned char *plume_texture_png_bytes(const plume_texture *texture, size_t *size, plume_error *err)
+{
+	*size = 0;
+	cairo_surface_t *surface = NULL;
+	if (texture_surface(texture, "texture", &surface, err) != PLUME_OK)
+		return NULL;
+	png_bytes out = {0};
+	cairo_status_t status = cairo_surface_write_to_png_stream(surface, append_png, &out);
+	cairo_surface_destroy(surface);
+	if (status != CAIRO_STATUS_SUCCESS) {
+		plume_free(out.data);
+		plume_error_set(err, PLUME_ERROR_MEMORY, "texture: cannot encode PNG: %s", cairo_status_to_string(status));
+		return NULL;
+	}
+	*size = out.size;
+	return out.data;
 }

@@ -24,6 +24,15 @@ expect_failure "unknown format" 2 "allowed: png, svg, pdf, obj, usda, json, glb"
 	"$plume" generate "$source_dir/examples/franco-walter/blue.json" -o "$scratch/bad" --format gltf
 check "unknown format: nothing written" test ! -e "$scratch/bad"
 
+# --texture: the image embedded in feather.glb, read through TEXCOORD_1 at Franco & Walter's positions.
+"$plume" generate "$source_dir/examples/franco-walter/blue.json" -o "$scratch/textured" --format glb --texture "$source_dir/examples/textures/bands.png" >/dev/null 2>"$scratch/err.txt"
+status=$?
+check "generate --texture --format glb: exit 0 ($(cat "$scratch/err.txt"))" test "$status" -eq 0
+"$py" "$checker" texture "$scratch/textured/feather.glb" "$source_dir/examples/textures/bands.png" >"$scratch/out.txt" 2>&1
+status=$?
+check "textured feather.glb: image, materials and coordinates ($(tail -1 "$scratch/out.txt"))" test "$status" -eq 0
+check "textured feather.glb: the same geometry" test "$(field "$scratch/textured/feather.glb" vertices)" -eq "$(field "$scratch/blue/feather.glb" vertices)"
+
 # A shell.
 "$plume" mesh "$source_dir/examples/franco-walter/blue.json" -o "$scratch/mesh" --format glb -e 0.01 >/dev/null 2>"$scratch/err.txt"
 status=$?

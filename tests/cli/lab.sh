@@ -61,6 +61,30 @@ status=$?
 check "calibrate succeeds ($(cat "$scratch/err.txt"))" test "$status" -eq 0
 check "calibrate -o: calibration.json is what stdout showed" cmp -s "$scratch/cal.json" "$scratch/cal/calibration.json"
 check "calibrate -o: slopes.csv has four slopes" test "$(grep -c ',mesoscale,\|,macroscale,' "$scratch/cal/slopes.csv")" -eq 4
+check "calibrate -o: curves.csv header" grep -q '^longitudinal_strain,longitudinal_stress_pa,transverse_strain,transverse_stress_pa,tilted_strain,tilted_mesoscale_stress_pa,tilted_macroscale_strain,tilted_macroscale_stress_pa$' "$scratch/cal/curves.csv"
+for file in curves_longitudinal.png curves_longitudinal.svg curves_tilted.png curves_tilted.svg; do
+	check "calibrate -o: $file written" test -s "$scratch/cal/$file"
+done
+check "calibrate -o: only the six files and calibration.json" test "$(ls -A "$scratch/cal" | wc -l)" -eq 7
+check "calibrate -o: no progress when stderr is a file" test ! -s "$scratch/err.txt"
+# The curves are the ones matched: 11 samples from rest, the slope through the origin of
+# each (eq. C.7 by Simpson's rule on the 10 intervals) is the slope in slopes.csv.
+check "calibrate -o: curves give the slopes" python3 -c "
+import csv
+rows = list(csv.DictReader(open('$scratch/cal/curves.csv')))
+slopes = [float(r['slope_pa']) for r in csv.DictReader(open('$scratch/cal/slopes.csv'))]
+assert len(rows) == 11, len(rows)
+def slope(x, y):
+    w = [1 if i in (0, len(x) - 1) else 4 if i % 2 else 2 for i in range(len(x))]
+    return sum(wi * a * b for wi, a, b in zip(w, x, y)) / sum(wi * a * a for wi, a in zip(w, x))
+col = lambda k: [float(r[k]) for r in rows]
+got = [slope(col('longitudinal_strain'), col('longitudinal_stress_pa')),
+       slope(col('transverse_strain'), col('transverse_stress_pa')),
+       slope(col('tilted_strain'), col('tilted_mesoscale_stress_pa')),
+       slope(col('tilted_macroscale_strain'), col('tilted_macroscale_stress_pa'))]
+assert all(abs(g / s - 1) < 1e-7 for g, s in zip(got, slopes)), (got, slopes)
+assert col('longitudinal_strain')[0] == 0 and abs(col('transverse_strain')[-1] / 0.4 - 1) < 0.05
+"
 check "calibrate: JSON" python3 -c "
 import json, sys
 r = json.load(open('$scratch/cal.json'))  # stdout holds the JSON and nothing else
@@ -78,8 +102,10 @@ check "calibrate out of reach: nothing on stdout" test ! -s "$scratch/out.txt"
 # --- study ---------------------------------------------------------------------
 expect_failure "unknown study" 2 "unknown study 'bending'" "$plume" lab study bending -o "$scratch/s"
 # The locking study at a twentieth of its size: the paper's point, unaligned meshes lock.
-"$plume" lab study locking -o "$scratch/locking" --scale 0.05 >"$scratch/out.txt" 2>"$scratch/err.txt"
+# On a pseudo-terminal (script(1)) for its progress line; stdout still goes to a file.
+script -qec "'$plume' lab study locking -o '$scratch/locking' --scale 0.05 >'$scratch/out.txt'" /dev/null >"$scratch/err.txt"
 succeeded "locking study succeeds"
+check "locking study: progress on a terminal" grep -q 'plume lab study: 38/38 (100%), [0-9]* s elapsed' "$scratch/err.txt"
 for file in locking.csv locking.png locking.svg; do
 	check "locking study: $file written" test -s "$scratch/locking/$file"
 done

@@ -57,6 +57,9 @@ bad "unknown key" 'did you mean "duration"' '"durations": 1'
 expect_failure "missing scene" 4 "missing.json" "$plume" simulate "$scratch/missing.json" -o "$scratch/none"
 check "missing scene: nothing written" test ! -e "$scratch/none"
 expect_failure "no output" 2 "missing -o DIR" "$plume" simulate "$scratch/swing.json"
+# The progress line on a terminal (script(1)): steps, elapsed time and the simulated time.
+script -qec "'$plume' simulate '$scratch/swing.json' -o '$scratch/tty' >/dev/null" /dev/null >"$scratch/tty.txt"
+check "progress on a terminal" grep -q 'plume simulate: \([0-9]*\)/\1 (100%), [0-9]* s elapsed, t = ' "$scratch/tty.txt"
 "$plume" help simulate | grep -q "frames/NNNN.obj"
 check "help describes the outputs" test $? -eq 0
 

@@ -77,6 +77,10 @@ check "figure 15: 64 feather objects" test "$(grep -c '^o feather_' "$scratch/fi
 check "figure 15: USD curves" grep -q 'def BasisCurves "feather_00063"' "$scratch/figure15-hexagonal/coat.usda"
 "$plume" coat "$coats/figure15-hexagonal.json" -o "$scratch/f15b" --size 300x300 2>/dev/null
 check "coat: deterministic" cmp -s "$scratch/figure15-hexagonal/coat.obj" "$scratch/f15b/coat.obj"
+# Progress only on a terminal: nothing in a file, a line with the count on a pseudo-terminal (script(1)).
+check "coat: no progress when stderr is a file" test ! -s "$scratch/err.txt"
+script -qec "'$plume' coat '$coats/figure15-hexagonal.json' -o '$scratch/f15t' --format obj >/dev/null" /dev/null >"$scratch/tty.txt"
+check "coat: progress on a terminal" grep -q 'plume coat: 64/64 (100%), [0-9]* s elapsed' "$scratch/tty.txt"
 "$plume" coat "$coats/figure15-hexagonal.json" -o "$scratch/f15s" --format png --style strips --size 200x200
 check "coat --style strips" test -s "$scratch/f15s/coat.png"
 check "help coat" bash -c "'$plume' help coat | grep -q 'COAT.json'"

@@ -37,6 +37,8 @@ JS
 set -e
 "$plume" generate examples/franco-walter/blue.json -o "$scratch/feather" --format glb >/dev/null
 "$plume" mesh examples/franco-walter/blue.json -o "$scratch/mesh" --format glb -e 0.01 >/dev/null
+# The texture embedded as a PNG image, read through TEXCOORD_1.
+"$plume" generate examples/franco-walter/blue.json -o "$scratch/textured" --format glb --texture examples/textures/bands.png >/dev/null
 "$plume" coat examples/coats/figure15-hexagonal.json -o "$scratch/coat" --format glb >/dev/null
 cat >"$scratch/swing.json" <<JSON
 {"feather": "$PWD/examples/franco-walter/blue.json", "mesh": {"edge_length": 0.01},
@@ -44,4 +46,4 @@ cat >"$scratch/swing.json" <<JSON
 JSON
 "$plume" simulate "$scratch/swing.json" -o "$scratch/sim" >/dev/null
 set +e
-(cd "$scratch" && NODE_PATH="$scratch/node_modules" node validate.js feather/feather.glb mesh/mesh.glb coat/coat.glb sim/sim.glb)
+(cd "$scratch" && NODE_PATH="$scratch/node_modules" node validate.js feather/feather.glb textured/feather.glb mesh/mesh.glb coat/coat.glb sim/sim.glb)
