@@ -532,8 +532,17 @@ static plume_status read_view(reader *r, json_t *view, int components, size_t ex
 		uint64_t bits = 0;
 		for (int j = 7; j >= 0; --j)
 			bits = bits << 8 | bytes[j];
+		double x;
+		memcpy(&x, &bits, sizeof x);
+		// The sidecar's numbers pass the same bound as the JSON's (plume_spec_check_numbers):
+		// nothing non-finite or absurd reaches the embedding or a renderer.
+		if (!(fabs(x) <= PLUME_SPEC_MAX_MAGNITUDE))
+			return fail(r,
+			            "number %zu of the view in the sidecar is %g, outside the range of any value plume reads, "
+			            "[-1e12, 1e12]",
+			            k, x);
 		size_t item = k / (size_t)components, component = k % (size_t)components;
-		memcpy((double *)((char *)base + item * stride) + component, &bits, sizeof bits);
+		((double *)((char *)base + item * stride))[component] = x;
 	}
 	return PLUME_OK;
 }

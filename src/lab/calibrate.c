@@ -253,7 +253,8 @@ plume_status plume_lab_calibrate(const plume_calibration_def *def, plume_calibra
 			if (retry > 0)
 				far_x = 0.5 * (far_x + from);
 			macro.E_vw = exp(far_x);
-			far_status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, 1, result, &far_slope, err);
+			far_status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, 1, result, &far_slope, -1,
+			                      search_progress(&progress), err);
 		}
 		if (far_status == PLUME_ERROR_NUMERIC)
 			far_x = from, far_slope = (below ? f_hi : f_lo) + target;

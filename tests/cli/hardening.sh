@@ -91,19 +91,38 @@ sim=$scratch/sim
 edit "$examples/scenes/falling.json" "$bad/scene-short.json" \
 	"d['feather'] = '$examples/franco-walter/filoplume.json'; d['mesh']['edge_length'] = 0.02; d['duration'] = 0.011"
 $T "$plume" simulate "$bad/scene-short.json" -o "$sim" >/dev/null 2>"$scratch/err.txt"
-check "short simulation for render ($(cat "$scratch/err.txt"))" test -s "$sim/feather.json"
-/usr/bin/python3 - "$sim/feather.json" <<'EOF'
-import re, sys
-path = sys.argv[1]
-text = open(path).read()
-# the shaft's first coordinate becomes 1e308
-text = re.sub(r'("position":\s*\[)[-0-9.eE+]+', r'\g<1>1e308', text, count=1)
-open(path, 'w').write(text)
+check "short simulation for render ($(cat "$scratch/err.txt"))" test -s "$sim/feather.bin"
+# Version 1 (numbers inline, as earlier plume wrote it) in a copy of the folder:
+# the views of version 2 become arrays again, the shaft's first coordinate 1e308.
+cp -r "$sim" "$sim-v1"
+/usr/bin/python3 - "$sim-v1" <<'EOF'
+import json, struct, sys
+folder = sys.argv[1]
+doc = json.load(open(folder + '/feather.json'))
+data = open(folder + '/feather.bin', 'rb').read()
+def inline(value):
+    if isinstance(value, dict) and set(value) == {'offset', 'count'}:
+        return list(struct.unpack_from('<%dd' % value['count'], data, value['offset']))
+    if isinstance(value, dict):
+        return {k: inline(v) for k, v in value.items() if k != 'buffer'}
+    if isinstance(value, list):
+        return [inline(v) for v in value]
+    return value
+doc = inline(doc)
+doc['version'] = 1
+doc['shaft']['position'][0] = 1e308
+open(folder + '/feather.json', 'w').write(json.dumps(doc))
 EOF
-check "feather.json edited" grep -q '1e308' "$sim/feather.json"
+check "feather.json edited" grep -q '1e+308' "$sim-v1/feather.json"
 expect_no_output "render feather.json 1e308" 3 'feather.json: $.' "$scratch/o14" \
-	$T "$plume" render "$sim" -o "$scratch/o14" --spp 1 --size 32x32
+	$T "$plume" render "$sim-v1" -o "$scratch/o14" --spp 1 --size 32x32
 check "render 1e308: names the range" grep -qF 'is outside the range of any value plume reads' "$scratch/err.txt"
+# Version 2: the first number of the sidecar becomes 1e308.
+/usr/bin/python3 -c 'import struct, sys; f = open(sys.argv[1], "r+b"); f.write(struct.pack("<d", 1e308))' "$sim/feather.bin"
+expect_no_output "render feather.bin 1e308" 3 'feather.json: $.' "$scratch/o14b" \
+	$T "$plume" render "$sim" -o "$scratch/o14b" --spp 1 --size 32x32
+check "render feather.bin 1e308: names the sidecar and the range" \
+	grep -qF 'in the sidecar is 1e+308, outside the range of any value plume reads' "$scratch/err.txt"
 
 # --- a simulation whose frames would pass --max-memory: refused before the run -----------
 edit "$bad/scene-short.json" "$bad/scene-long.json" "d['duration'] = 1e4; d['time_step'] = 0.001; d['frame_every'] = 1"
