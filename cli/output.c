@@ -249,6 +249,18 @@ static void remove_stale_staging(const char *parent, const char *prefix)
 	closedir(dir);
 }
 
+/// Stages inside DIR itself (mkdtemp fills in the XXXXXX), for a DIR that cannot be
+/// swapped whole: the run's files are then moved in entry by entry.
+static plume_status stage_inside_dir(cli_output *output, plume_error *err)
+{
+	output->stage_inside = true;
+	snprintf(output->stage, sizeof output->stage, "%s/.plume-staging-%ld-XXXXXX", output->dir, (long)getpid());
+	if (mkdtemp(output->stage) == NULL)
+		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write the output folder: %s", output->dir,
+		                       strerror(errno));
+	return PLUME_OK;
+}
+
 plume_status cli_output_begin(cli_output *output, const char *dir, plume_error *err)
 {
 	memset(output, 0, sizeof *output);
@@ -278,12 +290,7 @@ plume_status cli_output_begin(cli_output *output, const char *dir, plume_error *
 	// folder; stage inside the folder it names and move entry by entry instead.
 	struct stat link_info;
 	if (output->dir_existed && lstat(output->dir, &link_info) == 0 && S_ISLNK(link_info.st_mode)) {
-		output->stage_inside = true;
-		snprintf(output->stage, sizeof output->stage, "%s/.plume-staging-%ld-XXXXXX", output->dir, (long)getpid());
-		if (mkdtemp(output->stage) == NULL)
-			return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write the output folder: %s", output->dir,
-			                       strerror(errno));
-		return PLUME_OK;
+		return stage_inside_dir(output, err);
 	}
 	snprintf(output->stage, sizeof output->stage, "%.*s%s%ld-XXXXXX", parent, output->dir, prefix, (long)getpid());
 	if (mkdtemp(output->stage) != NULL)
@@ -292,12 +299,7 @@ plume_status cli_output_begin(cli_output *output, const char *dir, plume_error *
 		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write the output folder: %s", output->dir,
 		                       strerror(errno));
 	// An existing DIR in a parent we may not write: stage inside DIR, move entry by entry.
-	output->stage_inside = true;
-	snprintf(output->stage, sizeof output->stage, "%s/.plume-staging-%ld-XXXXXX", output->dir, (long)getpid());
-	if (mkdtemp(output->stage) == NULL)
-		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write the output folder: %s", output->dir,
-		                       strerror(errno));
-	return PLUME_OK;
+	return stage_inside_dir(output, err);
 }
 
 const char *cli_output_path(cli_output *output, const char *name, char *buffer, size_t size)

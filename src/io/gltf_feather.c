@@ -379,6 +379,17 @@ static int write_feather_nodes(plume_glb *glb, const plume_feather *feather, con
 	return plume_glb_append(glb, glb->nodes, json_pack("{s:s, s:o}", "name", name, "children", children));
 }
 
+/// A new container with the two curve materials (and the texture, when def has one);
+/// freed again on failure.
+static plume_status begin_curves_glb(plume_glb *glb, const plume_gltf_def *def, int materials[2], plume_error *err)
+{
+	plume_glb_init(glb, "plume " PLUME_VERSION_STRING);
+	plume_status status = curve_materials(glb, def, &materials[0], &materials[1], err);
+	if (status != PLUME_OK)
+		plume_glb_free(glb);
+	return status;
+}
+
 plume_status plume_write_glb(const plume_feather *feather, const plume_gltf_def *def, const char *path,
                              plume_error *err)
 {
@@ -386,13 +397,10 @@ plume_status plume_write_glb(const plume_feather *feather, const plume_gltf_def 
 	if (def == NULL)
 		def = &defaults;
 	plume_glb glb;
-	plume_glb_init(&glb, "plume " PLUME_VERSION_STRING);
 	int materials[2];
-	plume_status textured = curve_materials(&glb, def, &materials[0], &materials[1], err);
-	if (textured != PLUME_OK) {
-		plume_glb_free(&glb);
-		return textured;
-	}
+	plume_status begun = begin_curves_glb(&glb, def, materials, err);
+	if (begun != PLUME_OK)
+		return begun;
 	bool ok = true;
 	int root = write_feather_nodes(&glb, feather, def, "feather", materials, &ok);
 	plume_glb_scene_root(&glb, root);
@@ -459,13 +467,10 @@ plume_status plume_coat_write_glb_report(const plume_coat *coat, const plume_glt
 	if (def == NULL)
 		def = &defaults;
 	plume_glb glb;
-	plume_glb_init(&glb, "plume " PLUME_VERSION_STRING);
 	int materials[2];
-	plume_status textured = curve_materials(&glb, def, &materials[0], &materials[1], err);
-	if (textured != PLUME_OK) {
-		plume_glb_free(&glb);
-		return textured;
-	}
+	plume_status begun = begin_curves_glb(&glb, def, materials, err);
+	if (begun != PLUME_OK)
+		return begun;
 	int count = plume_coat_feather_count(coat);
 	coat_mesh *meshes = plume_calloc(count > 0 ? (size_t)count : 1, sizeof(coat_mesh));
 	json_t *children = json_array();
