@@ -118,7 +118,6 @@ void sweep_free(sweep *s);
 bool sweep_owns_dimension(const sweep_param *p, int i);
 
 // JSON paths (sweep_paths.c): "$" followed by ".key" and "[index]" parts.
-size_t sweep_edit_distance(const char *a, const char *b);
 /// The value at path in root and its parent (for replacement); NULL when absent.
 /// *settable: the path names a key the parent object lacks (a key left to its default).
 json_t *sweep_path_lookup(json_t *root, const char *path, json_t **parent, char *key, size_t key_size, size_t *index,

@@ -23,7 +23,7 @@ static bool probe_spec(const sweep *s, json_t *spec, char *message, size_t size)
 			size_t best = strcmp(name, "unconstrained") == 0 || strcmp(name, "description") == 0 ? 0 : SIZE_MAX;
 			const char *nearest = "phi";
 			for (int i = 0; i < SWEEP_CALIBRATION_KEY_COUNT && best != 0; ++i) {
-				size_t d = sweep_edit_distance(sweep_calibration_keys[i].key, name);
+				size_t d = plume_edit_distance(sweep_calibration_keys[i].key, name);
 				if (d < best) {
 					best = d;
 					nearest = sweep_calibration_keys[i].key;

@@ -8,33 +8,6 @@
 
 #include "sweep.h"
 
-size_t sweep_edit_distance(const char *a, const char *b)
-{
-	size_t n = strlen(a), m = strlen(b);
-	size_t *row = malloc((m + 1) * sizeof *row);
-	if (row == NULL)
-		return SIZE_MAX;
-	for (size_t j = 0; j <= m; ++j)
-		row[j] = j;
-	for (size_t i = 1; i <= n; ++i) {
-		size_t diagonal = row[0];
-		row[0] = i;
-		for (size_t j = 1; j <= m; ++j) {
-			size_t above = row[j];
-			size_t best = diagonal + (a[i - 1] != b[j - 1]);
-			if (above + 1 < best)
-				best = above + 1;
-			if (row[j - 1] + 1 < best)
-				best = row[j - 1] + 1;
-			row[j] = best;
-			diagonal = above;
-		}
-	}
-	size_t d = row[m];
-	free(row);
-	return d;
-}
-
 // JSON paths: "$" followed by ".key" and "[index]" parts.
 
 /// The value at path in root and its parent (for replacement); NULL when absent.
@@ -111,7 +84,7 @@ void sweep_nearest_path(const json_t *node, const char *prefix, const char *path
 			sweep_nearest_path(value, child, path, best, best_distance);
 		}
 	} else {
-		size_t d = sweep_edit_distance(prefix, path);
+		size_t d = plume_edit_distance(prefix, path);
 		if (d < *best_distance) {
 			*best_distance = d;
 			snprintf(best, 512, "%s", prefix);

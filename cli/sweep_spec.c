@@ -163,7 +163,7 @@ static bool check_keys(const sweep *s, const json_t *object, const char *where, 
 				best = 0;
 				break;
 			}
-			size_t d = sweep_edit_distance(allowed[i], key);
+			size_t d = plume_edit_distance(allowed[i], key);
 			if (d < best) {
 				best = d;
 				nearest = allowed[i];

@@ -125,6 +125,23 @@ static void test_syntax_error_names_line_and_column(void **state)
 	expect_error("", PLUME_ERROR_SYNTAX, "spec.json:");
 }
 
+// Textbook values of the Levenshtein distance, and keys longer than the old 63-byte row:
+// a misspelling at byte 70 still counts (the spec reader cut both words at 63 before).
+static void test_edit_distance(void **state)
+{
+	(void)state;
+	assert_int_equal(plume_edit_distance("kitten", "sitting"), 3);
+	assert_int_equal(plume_edit_distance("", "abc"), 3);
+	assert_int_equal(plume_edit_distance("flaw", "lawn"), 2);
+	assert_int_equal(plume_edit_distance("same", "same"), 0);
+	char a[80], b[80];
+	memset(a, 'x', 79);
+	memset(b, 'x', 79);
+	a[79] = b[79] = '\0';
+	b[70] = 'y';
+	assert_int_equal(plume_edit_distance(a, b), 1);
+}
+
 static void test_unknown_key_names_path_and_nearest(void **state)
 {
 	(void)state;
@@ -229,6 +246,7 @@ int main(void)
 	    cmocka_unit_test(test_keys_reach_the_definition),
 	    cmocka_unit_test(test_seed_option_overrides_spec),
 	    cmocka_unit_test(test_syntax_error_names_line_and_column),
+	    cmocka_unit_test(test_edit_distance),
 	    cmocka_unit_test(test_unknown_key_names_path_and_nearest),
 	    cmocka_unit_test(test_out_of_range_names_path_and_range),
 	    cmocka_unit_test(test_wrong_types_name_path),

@@ -72,6 +72,11 @@ plume_status plume_error_set(plume_error *err, plume_status status, const char *
 /// Prepends "prefix: " to an already filled message (used to add a file name).
 void plume_error_prefix(plume_error *err, const char *prefix);
 
+/// Levenshtein distance between two strings (insertions, deletions, substitutions), for
+/// the "did you mean" of an error message. Strings longer than 255 bytes count their
+/// first 255 only.
+size_t plume_edit_distance(const char *a, const char *b);
+
 // ---------------------------------------------------------------------------
 // Progress of long loops
 

@@ -50,3 +50,30 @@ void plume_error_prefix(plume_error *err, const char *prefix)
 	err->message[prefix_length - 2] = ':';
 	err->message[prefix_length - 1] = ' ';
 }
+
+// One rolling row of the dynamic programme; the row lives on the stack, so a misspelt key
+// costs no allocation (and cannot fail), and inputs are cut at EDIT_DISTANCE_MAX bytes.
+enum { EDIT_DISTANCE_MAX = 255 };
+
+size_t plume_edit_distance(const char *a, const char *b)
+{
+	size_t n = strnlen(b, EDIT_DISTANCE_MAX), m = strnlen(a, EDIT_DISTANCE_MAX);
+	size_t row[EDIT_DISTANCE_MAX + 1];
+	for (size_t j = 0; j <= n; ++j)
+		row[j] = j;
+	for (size_t i = 1; i <= m; ++i) {
+		size_t diagonal = row[0];
+		row[0] = i;
+		for (size_t j = 1; j <= n; ++j) {
+			size_t above = row[j];
+			size_t best = diagonal + (a[i - 1] != b[j - 1]);
+			if (above + 1 < best)
+				best = above + 1;
+			if (row[j - 1] + 1 < best)
+				best = row[j - 1] + 1;
+			row[j] = best;
+			diagonal = above;
+		}
+	}
+	return row[n];
+}

@@ -119,39 +119,12 @@ void plume_spec_index_path(char *out, size_t size, const char *parent, size_t in
 	snprintf(out, size, "%s[%zu]", parent, index);
 }
 
-// Levenshtein distance with one rolling row; keys are short.
-static size_t edit_distance(const char *a, const char *b)
-{
-	size_t n = strlen(b);
-	if (n > 63)
-		n = 63;
-	size_t row[64];
-	for (size_t j = 0; j <= n; ++j)
-		row[j] = j;
-	for (size_t i = 1; a[i - 1] != '\0'; ++i) {
-		size_t diagonal = row[0];
-		row[0] = i;
-		for (size_t j = 1; j <= n; ++j) {
-			size_t above = row[j];
-			size_t cost = a[i - 1] == b[j - 1] ? 0 : 1;
-			size_t best = diagonal + cost;
-			if (above + 1 < best)
-				best = above + 1;
-			if (row[j - 1] + 1 < best)
-				best = row[j - 1] + 1;
-			row[j] = best;
-			diagonal = above;
-		}
-	}
-	return row[n];
-}
-
 const char *plume_spec_nearest(const char *word, const char *const *allowed)
 {
 	const char *nearest = allowed[0];
 	size_t best = (size_t)-1;
 	for (const char *const *candidate = allowed; *candidate != NULL; ++candidate) {
-		size_t distance = edit_distance(word, *candidate);
+		size_t distance = plume_edit_distance(word, *candidate);
 		if (distance < best) {
 			best = distance;
 			nearest = *candidate;
