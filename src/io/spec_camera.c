@@ -2,6 +2,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "../core/asserts.h"
 #include "io/spec.h"
 #include "plume/raytrace.h"
 
@@ -177,6 +178,7 @@ static void read_choice(plume_spec_reader *reader, const json_t *root, const cha
 
 plume_status plume_raytrace_def_read(const char *path, plume_raytrace_def *def, plume_error *err)
 {
+	PLUME_ASSERT_DEF(def);
 	static const char *const keys[] = {
 	    "camera",      "lights",        "spp",        "seed",         "background",  "sky_color",      "sky_intensity",
 	    "ground",      "ground_normal", "ground_gap", "ground_color", "shading",     "barbules",       "barb_color",

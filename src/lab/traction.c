@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "../core/asserts.h"
 #include "core/alloc.h"
 #include "lab/quadratic.h"
 #include "plume/lab.h"
@@ -28,6 +29,7 @@ plume_lab_material plume_lab_material_default(plume_lab_model model)
 plume_traction_def plume_traction_default_def(void)
 {
 	return (plume_traction_def){
+	    .cookie = PLUME_DEF_COOKIE,
 	    .strain_max = 0.4,
 	    .steps = 20,
 	    .solver = plume_sim_default_def().solver,
@@ -67,6 +69,9 @@ static bool positive(double value) { return value > 0.0 && isfinite(value); }
 plume_status plume_lab_validate(const plume_lab_material *material, const plume_sample_def *sample,
                                 const plume_traction_def *traction, plume_error *err)
 {
+	PLUME_ASSERT(material != NULL);
+	PLUME_ASSERT_DEF(sample);
+	PLUME_ASSERT(traction == NULL || traction->cookie == PLUME_DEF_COOKIE);
 #define REQUIRE(condition, format, ...)                                                                                \
 	if (!(condition))                                                                                                  \
 		return plume_error_set(err, PLUME_ERROR_SPEC, format, __VA_ARGS__);
