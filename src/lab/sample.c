@@ -421,12 +421,15 @@ plume_status plume_sample_validate(const plume_sample_def *sample, const plume_b
 {
 	PLUME_ASSERT_DEF(sample);
 	PLUME_ASSERT(bands == NULL || bands->cookie == PLUME_DEF_COOKIE);
-	if (!(sample->width > 0.0 && isfinite(sample->width)))
-		return plume_error_set(err, PLUME_ERROR_SPEC, "sample.width is %g m, allowed > 0", sample->width);
-	if (!(sample->height > 0.0 && isfinite(sample->height)))
-		return plume_error_set(err, PLUME_ERROR_SPEC, "sample.height is %g m, allowed > 0", sample->height);
-	if (!(sample->thickness > 0.0 && isfinite(sample->thickness)))
-		return plume_error_set(err, PLUME_ERROR_SPEC, "sample.thickness is %g m, allowed > 0", sample->thickness);
+	// Sizes with a floor and a ceiling, not just > 0: a 1e-300 m sample's triangle areas
+	// underflow to 0 and its energies divide by them.
+	if (!(sample->width >= 1e-6 && sample->width <= 10.0))
+		return plume_error_set(err, PLUME_ERROR_SPEC, "sample.width is %g m, allowed [1e-06, 10]", sample->width);
+	if (!(sample->height >= 1e-6 && sample->height <= 10.0))
+		return plume_error_set(err, PLUME_ERROR_SPEC, "sample.height is %g m, allowed [1e-06, 10]", sample->height);
+	if (!(sample->thickness >= 1e-9 && sample->thickness <= 1.0))
+		return plume_error_set(err, PLUME_ERROR_SPEC, "sample.thickness is %g m, allowed [1e-09, 1]",
+		                       sample->thickness);
 	if (!(sample->barb_angle >= 0.0 && sample->barb_angle < PI))
 		return plume_error_set(err, PLUME_ERROR_SPEC, "sample.barb_angle_deg is %g, allowed in [0, 180)",
 		                       sample->barb_angle * 180.0 / PI);

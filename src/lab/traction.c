@@ -106,10 +106,10 @@ plume_status plume_lab_validate(const plume_lab_material *material, const plume_
 		        "traction.strain_max is %g in compression, allowed in (0, 0.5)", traction->strain_max);
 		REQUIRE(traction->steps >= 1 && traction->steps <= 100000, "traction.steps is %d, allowed in [1, 100000]",
 		        traction->steps);
-		REQUIRE(positive(traction->solver.tolerance), "traction.tolerance is %g, allowed > 0",
-		        traction->solver.tolerance);
-		REQUIRE(traction->solver.max_iterations >= 1, "traction.max_iterations is %d, allowed >= 1",
-		        traction->solver.max_iterations);
+		REQUIRE(traction->solver.tolerance > 0.0 && traction->solver.tolerance < 1.0,
+		        "traction.tolerance is %g, allowed (0, 1)", traction->solver.tolerance);
+		REQUIRE(traction->solver.max_iterations >= 1 && traction->solver.max_iterations <= 100000,
+		        "traction.max_iterations is %d, allowed [1, 100000]", traction->solver.max_iterations);
 		REQUIRE(traction->accept_residual >= 0.0 && traction->accept_residual < 1.0,
 		        "traction.accept_residual is %g, allowed in [0, 1)", traction->accept_residual);
 		REQUIRE(traction->solver.max_substep_halvings >= 0 && traction->solver.max_substep_halvings <= 16,

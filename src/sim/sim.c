@@ -44,7 +44,9 @@ static plume_status check_material(const plume_material *material, const char *p
 	if (!(condition))                                                                                                  \
 		return plume_error_set(err, PLUME_ERROR_SPEC, "%s.%s is %g, allowed " allowed, path, #field,                   \
 		                       (double)material->field);
-	REQUIRE(material->thickness > 0 && isfinite(material->thickness), thickness, "> 0");
+	// Floors and ceilings, not just > 0: a 1e-300 m shell or step makes the stiffness or the
+	// inertia term (mass / h^2) underflow or overflow, and Newton then works on NaN.
+	REQUIRE(material->thickness >= 1e-9 && material->thickness <= 1.0, thickness, "[1e-09, 1] m");
 	REQUIRE(material->surface_density >= 0 && isfinite(material->surface_density), surface_density, ">= 0");
 	REQUIRE(material->bending_along >= 0 && isfinite(material->bending_along), bending_along, ">= 0");
 	REQUIRE(isfinite(material->bending_across), bending_across, "finite");
@@ -82,8 +84,8 @@ plume_status plume_sim_def_validate(const plume_sim_def *def, int mesh_material_
 		if (status != PLUME_OK)
 			return status;
 	}
-	if (!(def->time_step > 0) || !isfinite(def->time_step))
-		return plume_error_set(err, PLUME_ERROR_SPEC, "$.time_step is %g, allowed > 0", def->time_step);
+	if (!(def->time_step >= 1e-9 && def->time_step <= 100.0))
+		return plume_error_set(err, PLUME_ERROR_SPEC, "$.time_step is %g, allowed [1e-09, 100] s", def->time_step);
 	if (!(def->drag >= 0) || !isfinite(def->drag))
 		return plume_error_set(err, PLUME_ERROR_SPEC, "$.drag is %g, allowed >= 0", def->drag);
 	if (!isfinite(def->gravity.x) || !isfinite(def->gravity.y) || !isfinite(def->gravity.z))
