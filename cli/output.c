@@ -372,11 +372,16 @@ static void remove_at(int at_fd, const char *name, int depth)
 	unlinkat(at_fd, name, AT_REMOVEDIR);
 }
 
+/// Another thread may still be writing a file into the folder while the handler empties it
+/// (the signal can land on any thread): a few passes, until the folder itself is gone.
 static void remove_active_stages(void)
 {
-	for (int i = 0; i < MAX_ACTIVE_STAGES; ++i)
-		if (active_used[i])
+	for (int i = 0; i < MAX_ACTIVE_STAGES; ++i) {
+		struct stat info;
+		for (int pass = 0;
+		     pass < 8 && active_used[i] && fstatat(AT_FDCWD, active_stage[i], &info, AT_SYMLINK_NOFOLLOW) == 0; ++pass)
 			remove_at(AT_FDCWD, active_stage[i], 0);
+	}
 }
 
 static void on_interrupt(int signal_number)
