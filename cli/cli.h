@@ -70,6 +70,7 @@ typedef struct cli_output {
 	char stage[4160];
 	bool dir_existed;
 	bool stage_inside; ///< staged inside DIR (its parent is not writable): committed entry by entry
+	int stage_slot; ///< 1 + its slot in output.c's list for the signal handler, 0 when none
 	char names[32][80];
 	int name_count;
 } cli_output;

@@ -183,9 +183,17 @@ bool cli_parse_memory(const char *command, const char *text, uint64_t *bytes)
 // in between where DIR is absent, but never mixed. Without hard links (vfat)
 // the run fails and DIR keeps the earlier run. When the parent folder is not
 // writable, the staging folder goes inside DIR and entries move one by one.
-// The PID in the name lets a later run remove staging folders whose run died
-// (Ctrl-C, a kill, a crash): only folders of exactly that pattern, only when
-// that process is gone.
+//
+// Interrupted runs. Each staging folder holds a marker file, STAGING_MARKER, that
+// says "plume staging", the PID and that process's start time. SIGINT and SIGTERM
+// during a run remove the run's staging folders (cli_output_begin installs the
+// handler) and then end plume by the same signal, so DIR keeps the earlier run
+// and nothing is left beside it. What no handler sees (SIGKILL, a crash, a power
+// cut) is cleaned by the next run into the same DIR: it removes a folder beside
+// DIR (or inside it, where a run staged there) only when its name has the staging
+// pattern, its marker is plume's and names this name's PID, and that process is
+// gone (or the PID now belongs to a process that started at another time). A
+// folder without a valid marker is never touched, whatever its name.
 
 void cli_remove_tree(const char *path)
 {
@@ -215,8 +223,79 @@ void cli_remove_tree(const char *path)
 	}
 }
 
-/// True for "PREFIX<pid>-XXXXXX" whose process no longer runs; *pid receives it.
-static bool stale_staging(const char *name, const char *prefix)
+// The marker file in every staging folder; its name starts like the staging
+// folders' so that a marker left in DIR by a run killed mid-commit is never
+// carried into the next run (carry_over skips the pattern).
+#define STAGING_MARKER ".plume-staging-marker"
+#define STAGING_MARKER_HEADER "plume staging folder"
+
+/// When process pid started, in clock ticks after boot (/proc/PID/stat, field 22), or 0
+/// when it cannot be read (no /proc, or no such process).
+static unsigned long long process_start(long pid)
+{
+	char path[64], text[1024];
+	snprintf(path, sizeof path, "/proc/%ld/stat", pid);
+	FILE *file = fopen(path, "r");
+	if (file == NULL)
+		return 0;
+	size_t n = fread(text, 1, sizeof text - 1, file);
+	fclose(file);
+	text[n] = '\0';
+	// The command name (field 2) is in parentheses and may hold spaces: count from the last ')'.
+	const char *at = strrchr(text, ')');
+	if (at == NULL)
+		return 0;
+	unsigned long long start = 0;
+	for (int field = 2; field < 22 && at != NULL; ++field)
+		at = strchr(at + 1, ' ');
+	if (at == NULL || sscanf(at + 1, "%llu", &start) != 1)
+		return 0;
+	return start;
+}
+
+/// Writes the marker of a new staging folder. 0 or an errno.
+static int write_marker(const char *stage)
+{
+	char path[4352];
+	snprintf(path, sizeof path, "%s/" STAGING_MARKER, stage);
+	FILE *file = fopen(path, "w");
+	if (file == NULL)
+		return errno;
+	long pid = (long)getpid();
+	fprintf(file, STAGING_MARKER_HEADER "\npid %ld\nstart %llu\n", pid, process_start(pid));
+	return fclose(file) == 0 ? 0 : errno;
+}
+
+/// Whether the staging folder path, named with pid, holds a valid marker of that
+/// pid and that run is over (the process is gone, or the PID was reused since).
+static bool marker_says_dead(const char *path, long pid)
+{
+	char marker[4672], text[256];
+	snprintf(marker, sizeof marker, "%s/" STAGING_MARKER, path);
+	struct stat info;
+	if (lstat(marker, &info) != 0 || !S_ISREG(info.st_mode) || info.st_size >= (off_t)sizeof text)
+		return false;
+	FILE *file = fopen(marker, "r");
+	if (file == NULL)
+		return false;
+	size_t n = fread(text, 1, sizeof text - 1, file);
+	fclose(file);
+	text[n] = '\0';
+	long marker_pid = 0;
+	unsigned long long start = 0;
+	int used = 0;
+	if (sscanf(text, STAGING_MARKER_HEADER "\npid %ld\nstart %llu\n%n", &marker_pid, &start, &used) != 2 ||
+	    (size_t)used != n || marker_pid != pid)
+		return false;
+	if (kill((pid_t)pid, 0) != 0)
+		return errno == ESRCH;
+	// A live process with that PID: the run is over when it started at another time.
+	unsigned long long now = process_start(pid);
+	return start != 0 && now != 0 && now != start;
+}
+
+/// True for a folder "PREFIX<pid>-XXXXXX" of ours whose run is over (marker_says_dead).
+static bool stale_staging(const char *parent, const char *name, const char *prefix)
 {
 	size_t length = strlen(prefix);
 	if (strncmp(name, prefix, length) != 0)
@@ -224,13 +303,16 @@ static bool stale_staging(const char *name, const char *prefix)
 	char *end;
 	errno = 0;
 	long pid = strtol(name + length, &end, 10);
-	if (errno != 0 || end == name + length || pid <= 0 || *end != '-' || strlen(end + 1) != 6)
+	if (errno != 0 || end == name + length || pid <= 0 || *end != '-' || strlen(end + 1) != 6 || pid == (long)getpid())
 		return false;
-	return pid != (long)getpid() && kill((pid_t)pid, 0) != 0 && errno == ESRCH;
+	char path[4608];
+	snprintf(path, sizeof path, "%s/%s", parent, name);
+	struct stat info;
+	return lstat(path, &info) == 0 && S_ISDIR(info.st_mode) && info.st_uid == geteuid() && marker_says_dead(path, pid);
 }
 
-/// Removes staging folders an earlier, dead plume left beside DIR (and, from
-/// plume versions that staged inside DIR, those in it).
+/// Removes staging folders an earlier, dead plume left beside DIR (and, where a
+/// run staged inside DIR, those in it).
 static void remove_stale_staging(const char *parent, const char *prefix)
 {
 	DIR *dir = opendir(parent);
@@ -238,15 +320,162 @@ static void remove_stale_staging(const char *parent, const char *prefix)
 		return;
 	struct dirent *entry;
 	while ((entry = readdir(dir)) != NULL) {
-		if (!stale_staging(entry->d_name, prefix))
+		if (!stale_staging(parent, entry->d_name, prefix))
 			continue;
 		char path[4608];
 		snprintf(path, sizeof path, "%s/%s", parent, entry->d_name);
-		struct stat info;
-		if (lstat(path, &info) == 0 && S_ISDIR(info.st_mode) && info.st_uid == geteuid())
-			cli_remove_tree(path);
+		cli_remove_tree(path);
 	}
 	closedir(dir);
+}
+
+// ---------------------------------------------------------------------------
+// Interruption: SIGINT and SIGTERM remove the staging folders of the runs under
+// way. The handler may run on any thread at any moment, so it uses only
+// async-signal-safe calls (openat, getdents64, unlinkat, close, signal, raise) on
+// paths copied into static storage before the handler could need them, and while
+// a commit is swapping folders it only notes the signal: the commit finishes (DIR
+// then holds one whole run) and re-raises it.
+
+enum { MAX_ACTIVE_STAGES = 4 };
+static char active_stage[MAX_ACTIVE_STAGES][sizeof((cli_output *)0)->stage];
+static _Atomic int active_used[MAX_ACTIVE_STAGES];
+static _Atomic int committing;
+static _Atomic int pending_signal;
+
+/// Removes name (a file or a folder tree) in the folder at_fd. Async-signal-safe.
+static void remove_at(int at_fd, const char *name, int depth)
+{
+	if (unlinkat(at_fd, name, 0) == 0 || (errno != EISDIR && errno != EPERM) || depth > 16)
+		return;
+	int fd = openat(at_fd, name, O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+	if (fd < 0)
+		return;
+	char buffer[4096];
+	// Read from the start again after each batch: entries are removed as they are read.
+	for (;;) {
+		lseek(fd, 0, SEEK_SET);
+		ssize_t n = getdents64(fd, buffer, sizeof buffer);
+		bool removed = false;
+		for (ssize_t at = 0; at < n;) {
+			struct dirent64 *entry = (struct dirent64 *)(buffer + at);
+			at += entry->d_reclen;
+			if (strcmp(entry->d_name, ".") == 0 || strcmp(entry->d_name, "..") == 0)
+				continue;
+			remove_at(fd, entry->d_name, depth + 1);
+			removed = true;
+		}
+		if (!removed)
+			break;
+	}
+	close(fd);
+	unlinkat(at_fd, name, AT_REMOVEDIR);
+}
+
+/// Another thread may still be writing a file into the folder while the handler empties it
+/// (the signal can land on any thread): a few passes, until the folder itself is gone.
+static void remove_active_stages(void)
+{
+	for (int i = 0; i < MAX_ACTIVE_STAGES; ++i) {
+		struct stat info;
+		for (int pass = 0;
+		     pass < 8 && active_used[i] && fstatat(AT_FDCWD, active_stage[i], &info, AT_SYMLINK_NOFOLLOW) == 0; ++pass)
+			remove_at(AT_FDCWD, active_stage[i], 0);
+	}
+}
+
+static void on_interrupt(int signal_number)
+{
+	int saved = errno;
+	if (committing) {
+		pending_signal = signal_number;
+		errno = saved;
+		return;
+	}
+	remove_active_stages();
+	signal(signal_number, SIG_DFL);
+	raise(signal_number); // delivered when the handler returns: plume ends by the signal
+	errno = saved;
+}
+
+/// Installs on_interrupt for SIGINT and SIGTERM, except where they are ignored
+/// (nohup, a background job of a shell without job control): that choice stands.
+static void install_interrupt_handler(void)
+{
+	static bool installed;
+	if (installed)
+		return;
+	installed = true;
+	int signals[] = {SIGINT, SIGTERM};
+	for (size_t i = 0; i < sizeof signals / sizeof signals[0]; ++i) {
+		struct sigaction old;
+		if (sigaction(signals[i], NULL, &old) != 0 || old.sa_handler == SIG_IGN)
+			continue;
+		struct sigaction action;
+		memset(&action, 0, sizeof action);
+		action.sa_handler = on_interrupt;
+		sigemptyset(&action.sa_mask);
+		action.sa_flags = SA_RESTART;
+		sigaction(signals[i], &action, NULL);
+	}
+}
+
+/// Remembers output's staging folder for on_interrupt (with more than
+/// MAX_ACTIVE_STAGES at once, the others are left to the next run's clean-up).
+static void track_stage(cli_output *output)
+{
+	for (int i = 0; i < MAX_ACTIVE_STAGES; ++i)
+		if (!active_used[i]) {
+			memcpy(active_stage[i], output->stage, sizeof active_stage[i]);
+			active_used[i] = 1;
+			output->stage_slot = i + 1;
+			return;
+		}
+}
+
+static void untrack_stage(cli_output *output)
+{
+	if (output->stage_slot > 0)
+		active_used[output->stage_slot - 1] = 0;
+	output->stage_slot = 0;
+}
+
+/// Brackets the part of a commit that swaps folders: a signal in it waits for its end.
+static void begin_critical(void) { committing = 1; }
+
+static void end_critical(void)
+{
+	committing = 0;
+	int signal_number = pending_signal;
+	if (signal_number != 0) {
+		remove_active_stages();
+		signal(signal_number, SIG_DFL);
+		raise(signal_number);
+	}
+}
+
+/// mkdtemp of output->stage, then its tracking and marker, with a signal held back
+/// until all three are done (so no folder is left unmarked). On failure the folder,
+/// if made (*made), is removed again.
+static plume_status make_stage(cli_output *output, bool *made, plume_error *err)
+{
+	install_interrupt_handler();
+	begin_critical();
+	int failure = 0;
+	*made = mkdtemp(output->stage) != NULL;
+	if (!*made) {
+		failure = errno;
+	} else {
+		track_stage(output);
+		failure = write_marker(output->stage);
+	}
+	end_critical();
+	if (failure == 0)
+		return PLUME_OK;
+	if (*made)
+		cli_output_abort(output);
+	return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write the output folder: %s", output->dir,
+	                       strerror(failure));
 }
 
 /// Stages inside DIR itself (mkdtemp fills in the XXXXXX), for a DIR that cannot be
@@ -255,10 +484,8 @@ static plume_status stage_inside_dir(cli_output *output, plume_error *err)
 {
 	output->stage_inside = true;
 	snprintf(output->stage, sizeof output->stage, "%s/.plume-staging-%ld-XXXXXX", output->dir, (long)getpid());
-	if (mkdtemp(output->stage) == NULL)
-		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write the output folder: %s", output->dir,
-		                       strerror(errno));
-	return PLUME_OK;
+	bool made;
+	return make_stage(output, &made, err);
 }
 
 plume_status cli_output_begin(cli_output *output, const char *dir, plume_error *err)
@@ -293,11 +520,10 @@ plume_status cli_output_begin(cli_output *output, const char *dir, plume_error *
 		return stage_inside_dir(output, err);
 	}
 	snprintf(output->stage, sizeof output->stage, "%.*s%s%ld-XXXXXX", parent, output->dir, prefix, (long)getpid());
-	if (mkdtemp(output->stage) != NULL)
-		return PLUME_OK;
-	if (!output->dir_existed)
-		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write the output folder: %s", output->dir,
-		                       strerror(errno));
+	bool made;
+	plume_status status = make_stage(output, &made, err);
+	if (status == PLUME_OK || made || !output->dir_existed)
+		return status;
 	// An existing DIR in a parent we may not write: stage inside DIR, move entry by entry.
 	return stage_inside_dir(output, err);
 }
@@ -393,8 +619,10 @@ static plume_status commit_by_moves(cli_output *output, plume_error *err)
 	}
 	struct dirent *entry;
 	plume_status status = PLUME_OK;
+	begin_critical();
 	while (status == PLUME_OK && (entry = readdir(stage)) != NULL) {
-		if (strcmp(entry->d_name, ".") == 0 || strcmp(entry->d_name, "..") == 0)
+		if (strcmp(entry->d_name, ".") == 0 || strcmp(entry->d_name, "..") == 0 ||
+		    strcmp(entry->d_name, STAGING_MARKER) == 0)
 			continue;
 		char from[4608], to[4608], aside[4608];
 		snprintf(from, sizeof from, "%s/%s", output->stage, entry->d_name);
@@ -417,9 +645,15 @@ static plume_status commit_by_moves(cli_output *output, plume_error *err)
 	closedir(stage);
 	if (status != PLUME_OK) {
 		cli_output_abort(output);
+		end_critical();
 		return status;
 	}
+	char marker[4672];
+	snprintf(marker, sizeof marker, "%s/" STAGING_MARKER, output->stage);
+	unlink(marker);
 	rmdir(output->stage);
+	untrack_stage(output);
+	end_critical();
 	return PLUME_OK;
 }
 
@@ -454,12 +688,19 @@ plume_status cli_output_commit(cli_output *output, plume_error *err)
 		mode_t mask = umask(0);
 		umask(mask);
 		chmod(output->stage, 0777 & ~mask);
+		begin_critical();
 		if (rename(output->stage, output->dir) != 0) {
 			plume_error_set(err, PLUME_ERROR_IO, "%s: cannot create the output folder: %s", output->dir,
 			                strerror(errno));
 			cli_output_abort(output);
+			end_critical();
 			return PLUME_ERROR_IO;
 		}
+		untrack_stage(output);
+		end_critical();
+		char marker[4352];
+		snprintf(marker, sizeof marker, "%s/" STAGING_MARKER, output->dir);
+		unlink(marker); // killed before this, DIR keeps a marker that the next run drops
 		return PLUME_OK;
 	}
 	char conflict[4608] = "";
@@ -480,6 +721,7 @@ plume_status cli_output_commit(cli_output *output, plume_error *err)
 		cli_output_abort(output);
 		return PLUME_ERROR_IO;
 	}
+	begin_critical();
 	if (failure == 0) {
 		chmod(output->stage, info.st_mode & 07777);
 		failure = exchange(output->stage, output->dir);
@@ -487,9 +729,18 @@ plume_status cli_output_commit(cli_output *output, plume_error *err)
 	if (failure != 0) {
 		plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write: %s", output->dir, strerror(failure));
 		cli_output_abort(output);
+		end_critical();
 		return PLUME_ERROR_IO;
 	}
+	// The earlier run now has the staging name: the marker goes with it, so that a run
+	// killed before the removal below leaves a folder the next run recognises.
+	char marker_from[4352], marker_to[4352];
+	snprintf(marker_from, sizeof marker_from, "%s/" STAGING_MARKER, output->dir);
+	snprintf(marker_to, sizeof marker_to, "%s/" STAGING_MARKER, output->stage);
+	rename(marker_from, marker_to);
+	end_critical();                 // a signal held back until now removes the earlier run too, then ends plume
 	cli_remove_tree(output->stage); // the earlier run; the user's files live on in DIR
+	untrack_stage(output);
 	return PLUME_OK;
 }
 
@@ -497,6 +748,7 @@ void cli_output_abort(cli_output *output)
 {
 	if (output->stage[0] != '\0')
 		cli_remove_tree(output->stage);
+	untrack_stage(output);
 }
 
 // ---------------------------------------------------------------------------

@@ -91,9 +91,9 @@ static void test_bad_scenes(void **state)
 	expect_error("{" FEATHER ", \"materials\": {\"vane\": {\"E_ww\": -5}}}", PLUME_ERROR_SPEC,
 	             "$.materials.vane.E_ww is -5, allowed > 0");
 	expect_error("{" FEATHER ", \"materials\": {\"rachis\": {\"thickness\": 0}}}", PLUME_ERROR_SPEC,
-	             "$.materials.rachis.thickness is 0, allowed > 0");
-	expect_error("{" FEATHER ", \"time_step\": 0}", PLUME_ERROR_SPEC, "$.time_step is 0, allowed > 0");
-	expect_error("{" FEATHER ", \"time_step\": -0.01}", PLUME_ERROR_SPEC, "$.time_step is -0.01, allowed > 0");
+	             "$.materials.rachis.thickness is 0, allowed [1e-09, 1] m");
+	expect_error("{" FEATHER ", \"time_step\": 0}", PLUME_ERROR_SPEC, "$.time_step is 0, allowed [1e-09, 100] s");
+	expect_error("{" FEATHER ", \"time_step\": -0.01}", PLUME_ERROR_SPEC, "$.time_step is -0.01, allowed [1e-09, 100] s");
 	expect_error("{" FEATHER ", \"materials\": {\"vane\": {\"model\": \"orthotropc\"}}}", PLUME_ERROR_SPEC,
 	             "did you mean \"orthotropic\"?");
 	expect_error("{" FEATHER ", \"duraton\": 1}", PLUME_ERROR_SPEC, "duration");

@@ -55,8 +55,10 @@ typedef struct plume_error {
 
 /// Set by the *_default_def() functions in a definition's `cookie` field, and
 /// asserted by the functions that take the definition: a definition struct that
-/// was declared but never initialised from its default is a programmer error
-/// caught in debug builds (Box2D's b2_secret_cookie).
+/// was declared but never initialised from its default is a programmer error, and
+/// the call aborts with the file and line (Box2D's b2_secret_cookie). Programmer-error
+/// asserts (an index out of range, a NULL or destroyed handle, such a definition) are
+/// on in every build type unless libplume is configured with -DPLUME_DISABLE_ASSERTS=ON.
 #define PLUME_DEF_COOKIE 0x706c756du
 
 /// Short stable name of a status ("io", "syntax", "spec", ...).

@@ -43,6 +43,8 @@ typedef struct plume_gltf_def {
 	/// Shell colours (sRGB) of vane and rachis faces. Defaults (0.70, 0.62, 0.50), (0.78, 0.72, 0.62).
 	plume_color vane_color;
 	plume_color rachis_color;
+	/// PLUME_DEF_COOKIE, set by plume_gltf_default_def; do not change.
+	uint32_t cookie;
 } plume_gltf_def;
 
 plume_gltf_def plume_gltf_default_def(void);

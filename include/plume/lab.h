@@ -91,6 +91,8 @@ typedef struct plume_sample_def {
 	int element_count;
 	/// Seed of the unaligned mesh's random points. Default 1.
 	uint64_t seed;
+	/// PLUME_DEF_COOKIE, set by plume_sample_default_def; do not change.
+	uint32_t cookie;
 } plume_sample_def;
 
 plume_sample_def plume_sample_default_def(void);
@@ -109,6 +111,8 @@ typedef struct plume_band_def {
 	int barb_divisions;
 	/// Element rows across each barbule band, >= 1. Default 3.
 	int barbule_divisions;
+	/// PLUME_DEF_COOKIE, set by plume_band_default_def; do not change.
+	uint32_t cookie;
 } plume_band_def;
 
 plume_band_def plume_band_default_def(void);
@@ -182,6 +186,8 @@ typedef struct plume_traction_def {
 	/// Accept a step whose Newton solve stalled (round-off on stiff problems) when its final
 	/// gradient norm is at most this fraction of the clamp force; 0 never. Default 0.
 	double accept_residual;
+	/// PLUME_DEF_COOKIE, set by plume_traction_default_def; do not change.
+	uint32_t cookie;
 } plume_traction_def;
 
 plume_traction_def plume_traction_default_def(void);
@@ -274,6 +280,8 @@ typedef struct plume_calibration_def {
 	/// Keep the stress-strain curves matched in the result (curve_*); free them with
 	/// plume_calibration_result_free. Default false.
 	bool keep_curves;
+	/// PLUME_DEF_COOKIE, set by plume_calibration_default_def; do not change.
+	uint32_t cookie;
 } plume_calibration_def;
 
 plume_calibration_def plume_calibration_default_def(void);
@@ -333,6 +341,8 @@ typedef struct plume_study_def {
 	/// Called after each run of the study (a traction test or a calibration). Default NULL (none).
 	plume_progress_fn *progress;
 	void *progress_user;
+	/// PLUME_DEF_COOKIE, set by plume_study_default_def; do not change.
+	uint32_t cookie;
 } plume_study_def;
 
 plume_study_def plume_study_default_def(plume_study_kind kind);

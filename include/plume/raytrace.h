@@ -148,6 +148,8 @@ typedef struct plume_raytrace_def {
 	bool shadows;
 	/// OpenMP threads; 0 means OpenMP's default. The image does not depend on it. Default 0.
 	int threads;
+	/// PLUME_DEF_COOKIE, set by plume_raytrace_default_def; do not change.
+	uint32_t cookie;
 } plume_raytrace_def;
 
 plume_raytrace_def plume_raytrace_default_def(void);

@@ -96,6 +96,8 @@ typedef struct plume_render2d_def {
 	/// Default: empty (0, 0) to (0, 0).
 	plume_vec2 view_min;
 	plume_vec2 view_max;
+	/// PLUME_DEF_COOKIE, set by plume_render2d_default_def; do not change.
+	uint32_t cookie;
 } plume_render2d_def;
 
 plume_render2d_def plume_render2d_default_def(void);
@@ -126,9 +128,11 @@ typedef struct plume_shell_view_def {
 	/// min > max the box is taken from the positions. Default empty.
 	plume_vec3 bounds_min;
 	plume_vec3 bounds_max;
-	plume_color background; ///< Default (0.96, 0.96, 0.95, 1).
-	plume_color vane_color; ///< Default (0.78, 0.70, 0.58, 1).
+	plume_color background;   ///< Default (0.96, 0.96, 0.95, 1).
+	plume_color vane_color;   ///< Default (0.78, 0.70, 0.58, 1).
 	plume_color rachis_color; ///< Default (0.35, 0.27, 0.20, 1).
+	/// PLUME_DEF_COOKIE, set by plume_shell_view_default_def; do not change.
+	uint32_t cookie;
 } plume_shell_view_def;
 
 plume_shell_view_def plume_shell_view_default_def(void);

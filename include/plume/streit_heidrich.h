@@ -124,6 +124,8 @@ typedef struct plume_sh_def {
 	double barb_width_tip;
 	/// Texture coordinate mode. Default PLUME_SH_TEXTURE_BARB.
 	plume_sh_texture_mode texture_mode;
+	/// PLUME_DEF_COOKIE, set by plume_sh_default_def; do not change.
+	uint32_t cookie;
 } plume_sh_def;
 
 /// A 0.1 m contour feather: pennaceous above a plumulaceous base.

@@ -159,6 +159,8 @@ typedef struct plume_zk_def {
 	double barb_width_tip;
 	/// Barbule width, m, > 0. Default 1e-5.
 	double barbule_width;
+	/// PLUME_DEF_COOKIE, set by plume_zk_default_def; do not change.
+	uint32_t cookie;
 } plume_zk_def;
 
 /// A contour feather about 0.12 m long, 100 barbs per vane, unfurled, no expansion.

@@ -6,15 +6,15 @@
 // length over a fixed partition, then solves each target length by Newton's
 // method inside its interval (safeguarded by bisection), so a table of n
 // samples costs O(n) quadratures instead of O(n) full-length integrals.
-#include <assert.h>
 #include <math.h>
 #include <string.h>
 
+#include "asserts.h"
 #include "plume/core.h"
 
 plume_vec3 plume_bezier_eval(const plume_vec3 *points, int count, double t)
 {
-	assert(count >= 1 && count <= PLUME_BEZIER_MAX_POINTS);
+	PLUME_ASSERT(count >= 1 && count <= PLUME_BEZIER_MAX_POINTS);
 	if (count == 4) {
 		// The cubic is every barb's curve: Bernstein form without the triangle.
 		double s = 1.0 - t;
@@ -40,7 +40,7 @@ plume_vec3 plume_bezier_eval(const plume_vec3 *points, int count, double t)
 
 void plume_bezier_hodograph(const plume_vec3 *points, int count, plume_vec3 *out)
 {
-	assert(count >= 2);
+	PLUME_ASSERT(count >= 2);
 	double degree = (double)(count - 1);
 	for (int i = 0; i + 1 < count; ++i)
 		out[i] = plume_v3_scale(plume_v3_sub(points[i + 1], points[i]), degree);
@@ -48,7 +48,7 @@ void plume_bezier_hodograph(const plume_vec3 *points, int count, plume_vec3 *out
 
 plume_vec3 plume_bezier_derivative(const plume_vec3 *points, int count, int order, double t)
 {
-	assert(count >= 1 && count <= PLUME_BEZIER_MAX_POINTS && order >= 0);
+	PLUME_ASSERT(count >= 1 && count <= PLUME_BEZIER_MAX_POINTS && order >= 0);
 	if (order >= count)
 		return plume_v3(0.0, 0.0, 0.0);
 	plume_vec3 work[PLUME_BEZIER_MAX_POINTS];
@@ -78,7 +78,7 @@ void plume_bezier_elevate(const plume_vec3 *points, int count, plume_vec3 *out)
 
 void plume_bezier_split(const plume_vec3 *points, int count, double t, plume_vec3 *left, plume_vec3 *right)
 {
-	assert(count >= 1 && count <= PLUME_BEZIER_MAX_POINTS);
+	PLUME_ASSERT(count >= 1 && count <= PLUME_BEZIER_MAX_POINTS);
 	plume_vec3 work[PLUME_BEZIER_MAX_POINTS];
 	memcpy(work, points, (size_t)count * sizeof *points);
 	for (int level = count - 1; level >= 0; --level) {
@@ -131,7 +131,7 @@ static double adaptive_length(const plume_vec3 *hodograph, int count, double a, 
 /// Writes the hodograph (a single zero point for a point curve); returns its count.
 static int hodograph_of(const plume_vec3 *points, int count, plume_vec3 *hodograph)
 {
-	assert(count >= 1 && count <= PLUME_BEZIER_MAX_POINTS);
+	PLUME_ASSERT(count >= 1 && count <= PLUME_BEZIER_MAX_POINTS);
 	if (count == 1) {
 		hodograph[0] = plume_v3(0.0, 0.0, 0.0);
 		return 1;
@@ -165,6 +165,8 @@ double plume_bezier_length(const plume_vec3 *points, int count, double t0, doubl
 
 void plume_bezier_arc_init(plume_bezier_arc *arc, const plume_vec3 *points, int count)
 {
+	PLUME_ASSERT(arc != NULL && points != NULL);
+	PLUME_ASSERT(count >= 1 && count <= PLUME_BEZIER_MAX_POINTS);
 	arc->hodograph_count = hodograph_of(points, count, arc->hodograph);
 	double scale = control_polygon_length(points, count);
 	const int intervals = PLUME_BEZIER_ARC_INTERVALS;
@@ -255,7 +257,7 @@ double plume_bezier_param_at_length(const plume_vec3 *points, int count, double 
 
 void plume_bezier_sample_by_length(const plume_vec3 *points, int count, int sample_count, double *params_out)
 {
-	assert(sample_count >= 2);
+	PLUME_ASSERT(sample_count >= 2);
 	plume_bezier_arc arc;
 	plume_bezier_arc_init(&arc, points, count);
 	params_out[0] = 0.0;

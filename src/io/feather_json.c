@@ -462,6 +462,18 @@ static plume_status read_number(reader *r, json_t *object, const char *key, doub
 	return PLUME_OK;
 }
 
+/// A fraction in [0, 1]: where a barb sits on the shaft (rachis_t), a barbule on its barb
+/// (barb_s), the afterfeather on the shaft (t). The generators write nothing else.
+static plume_status read_fraction(reader *r, json_t *object, const char *key, double *out)
+{
+	plume_status status = read_number(r, object, key, out);
+	if (status == PLUME_OK && !(*out >= 0.0 && *out <= 1.0)) {
+		enter(r, ".%s", key);
+		return fail(r, "is %g, allowed [0, 1]", *out);
+	}
+	return status;
+}
+
 static plume_status read_int(reader *r, json_t *object, const char *key, json_int_t lo, json_int_t hi, int *out)
 {
 	json_t *value = json_object_get(object, key);
@@ -634,7 +646,7 @@ static plume_status read_barbule(reader *r, json_t *object, plume_feather *feath
 	plume_barbule_record record = {.barb = barb};
 	int kind = 0;
 	plume_status status = check_object(r, object, "a barbule", keys, sizeof keys / sizeof keys[0]);
-	if (status != PLUME_OK || (status = read_number(r, object, "barb_s", &record.barb_s)) != PLUME_OK ||
+	if (status != PLUME_OK || (status = read_fraction(r, object, "barb_s", &record.barb_s)) != PLUME_OK ||
 	    (status = read_name(r, object, "kind", kind_names, &kind)) != PLUME_OK ||
 	    (status = read_polyline(r, object, feather, &record.curve)) != PLUME_OK)
 		return status;
@@ -650,7 +662,7 @@ static plume_status read_barb(reader *r, json_t *object, plume_feather *feather)
 	int side = 0;
 	plume_status status = check_object(r, object, "a barb", keys, sizeof keys / sizeof keys[0]);
 	if (status != PLUME_OK || (status = read_name(r, object, "side", side_names, &side)) != PLUME_OK ||
-	    (status = read_number(r, object, "rachis_t", &record.rachis_t)) != PLUME_OK ||
+	    (status = read_fraction(r, object, "rachis_t", &record.rachis_t)) != PLUME_OK ||
 	    (status = read_int(r, object, "segment", INT_MIN, INT_MAX, &record.segment)) != PLUME_OK ||
 	    (status = read_polyline(r, object, feather, &record.curve)) != PLUME_OK)
 		return status;
@@ -765,7 +777,7 @@ static plume_status read_feather(reader *r, json_t *object, plume_feather *feath
 	static const char *const after_keys[] = {"t", "feather"};
 	mark = enter(r, ".afterfeather");
 	if ((status = check_object(r, after, "the afterfeather, or null", after_keys, 2)) != PLUME_OK ||
-	    (status = read_number(r, after, "t", &feather->afterfeather_t)) != PLUME_OK)
+	    (status = read_fraction(r, after, "t", &feather->afterfeather_t)) != PLUME_OK)
 		return status;
 	// Attached before it is filled, so that destroying the parent frees it on any error.
 	if ((feather->afterfeather = plume_feather_create_empty()) == NULL)

@@ -11,6 +11,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "../core/asserts.h"
 #include "../core/alloc.h"
 #include "glb.h"
 #include "render/texture_png.h"
@@ -20,6 +21,7 @@
 plume_gltf_def plume_gltf_default_def(void)
 {
 	return (plume_gltf_def){
+	    .cookie = PLUME_DEF_COOKIE,
 	    .curves = PLUME_GLTF_RIBBONS,
 	    .barbules = true,
 	    .texture = NULL,
@@ -393,6 +395,8 @@ static plume_status begin_curves_glb(plume_glb *glb, const plume_gltf_def *def, 
 plume_status plume_write_glb(const plume_feather *feather, const plume_gltf_def *def, const char *path,
                              plume_error *err)
 {
+	PLUME_ASSERT(feather != NULL && path != NULL);
+	PLUME_ASSERT_DEF_OR_NULL(def);
 	plume_gltf_def defaults = plume_gltf_default_def();
 	if (def == NULL)
 		def = &defaults;
@@ -463,6 +467,9 @@ static bool build_coat_parts(const plume_feather *feather, const plume_gltf_def 
 plume_status plume_coat_write_glb_report(const plume_coat *coat, const plume_gltf_def *def, const char *path,
                                          plume_coat_glb_report *report, plume_error *err)
 {
+	PLUME_ASSERT(coat != NULL);
+	PLUME_ASSERT(path != NULL);
+	PLUME_ASSERT_DEF_OR_NULL(def);
 	plume_gltf_def defaults = plume_gltf_default_def();
 	if (def == NULL)
 		def = &defaults;

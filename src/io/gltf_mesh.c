@@ -15,6 +15,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "../core/asserts.h"
 #include "../core/alloc.h"
 #include "animation.h"
 #include "glb.h"
@@ -138,6 +139,8 @@ int plume_glb_shell_node(plume_glb *glb, const plume_mesh *mesh, const plume_vec
 plume_status plume_mesh_write_glb(const plume_mesh *mesh, const plume_vec3 *positions, const plume_gltf_def *def,
                                   const char *path, plume_error *err)
 {
+	PLUME_ASSERT(mesh != NULL && path != NULL);
+	PLUME_ASSERT_DEF_OR_NULL(def);
 	plume_gltf_def defaults = plume_gltf_default_def();
 	if (def == NULL)
 		def = &defaults;
@@ -155,6 +158,8 @@ plume_status plume_mesh_write_glb(const plume_mesh *mesh, const plume_vec3 *posi
 plume_status plume_mesh_animation_create(const plume_mesh *mesh, const plume_gltf_def *def, plume_mesh_animation **out,
                                          plume_error *err)
 {
+	PLUME_ASSERT(mesh != NULL && out != NULL);
+	PLUME_ASSERT_DEF_OR_NULL(def);
 	*out = NULL;
 	plume_mesh_animation *a = plume_calloc(1, sizeof *a);
 	if (a == NULL)

@@ -1,8 +1,8 @@
 // JSON spec reading with paths in every message (see spec.h).
 #define _POSIX_C_SOURCE 200809L
+#include "../core/asserts.h"
 #include "spec.h"
 
-#include <assert.h>
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
@@ -274,7 +274,7 @@ bool plume_spec_points2(plume_spec_reader *reader, const json_t *object, const c
 		return false;
 	}
 	plume_vec2 points[64];
-	assert(count >= 0 && count <= 64 && "plume_spec_points2 reads at most 64 points");
+	PLUME_ASSERT(count >= 0 && count <= 64 && "plume_spec_points2 reads at most 64 points");
 	for (int i = 0; i < count; ++i) {
 		const json_t *point = json_array_get(value, (size_t)i);
 		char item[540];

@@ -2,6 +2,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "../core/asserts.h"
 #include "io/spec.h"
 #include "plume/raytrace.h"
 
@@ -37,16 +38,23 @@ static int read_numbers(plume_spec_reader *reader, const json_t *object, const c
 	return n;
 }
 
+/// The shortest direction vector a camera or light file may hold: a shorter one (1e-300)
+/// passed "non-zero" but its squared length underflowed to 0, and normalising it gave NaN.
+#define MIN_DIRECTION_LENGTH 1e-9
+
+/// [x, y, z]; a direction (nonzero) must be at least MIN_DIRECTION_LENGTH long.
 static bool read_vec3(plume_spec_reader *reader, const json_t *object, const char *path, const char *key,
                       plume_vec3 *out, bool nonzero)
 {
 	double v[3];
 	if (read_numbers(reader, object, path, key, v, 3, 0) != 3)
 		return false;
-	if (nonzero && !(v[0] != 0.0 || v[1] != 0.0 || v[2] != 0.0)) {
+	double length = plume_v3_length(plume_v3(v[0], v[1], v[2]));
+	if (nonzero && !(length >= MIN_DIRECTION_LENGTH)) {
 		char child[256];
 		plume_spec_path(child, sizeof child, path, key);
-		plume_spec_fail(reader, child, "must be a non-zero vector");
+		plume_spec_fail(reader, child, "has length %g, allowed >= %g (a non-zero direction)", length,
+		                MIN_DIRECTION_LENGTH);
 		return false;
 	}
 	*out = plume_v3(v[0], v[1], v[2]);
@@ -102,9 +110,11 @@ static void read_camera(plume_spec_reader *reader, const json_t *object, plume_c
 	bool target = read_vec3(reader, object, path, "target", &camera->target, false);
 	if (eye || target) {
 		camera->automatic = false;
-		if (reader->status == PLUME_OK && camera->eye.x == camera->target.x && camera->eye.y == camera->target.y &&
-		    camera->eye.z == camera->target.z)
-			plume_spec_fail(reader, "$.camera.target", "must differ from the eye");
+		double distance = plume_v3_distance(camera->eye, camera->target);
+		if (reader->status == PLUME_OK && !(distance >= MIN_DIRECTION_LENGTH))
+			plume_spec_fail(reader, "$.camera.target",
+			                "is %g m from the eye, allowed >= %g m (it must differ from the eye)", distance,
+			                MIN_DIRECTION_LENGTH);
 	}
 	read_vec3(reader, object, path, "up", &camera->up, true);
 	read_vec3(reader, object, path, "view_direction", &camera->view_direction, true);
@@ -124,8 +134,10 @@ static void read_camera(plume_spec_reader *reader, const json_t *object, plume_c
 	if (plume_spec_number(reader, object, path, "margin", &camera->margin))
 		check_range(reader, path, "margin", camera->margin, 0.0, 0.45, false);
 	double turntable = camera->turntable / DEG;
-	if (plume_spec_number(reader, object, path, "turntable_deg", &turntable))
+	if (plume_spec_number(reader, object, path, "turntable_deg", &turntable)) {
+		check_range(reader, path, "turntable_deg", turntable, -360.0, 360.0, false);
 		camera->turntable = turntable * DEG;
+	}
 }
 
 static void read_lights(plume_spec_reader *reader, const json_t *array, plume_raytrace_def *def)
@@ -177,6 +189,7 @@ static void read_choice(plume_spec_reader *reader, const json_t *root, const cha
 
 plume_status plume_raytrace_def_read(const char *path, plume_raytrace_def *def, plume_error *err)
 {
+	PLUME_ASSERT_DEF(def);
 	static const char *const keys[] = {
 	    "camera",      "lights",        "spp",        "seed",         "background",  "sky_color",      "sky_intensity",
 	    "ground",      "ground_normal", "ground_gap", "ground_color", "shading",     "barbules",       "barb_color",

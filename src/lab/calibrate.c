@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "../core/asserts.h"
 #include "core/alloc.h"
 #include "lab/lab_internal.h"
 #include "plume/lab.h"
@@ -34,6 +35,7 @@ plume_calibration_def plume_calibration_default_def(void)
 	def.tolerance = 1e-4;
 	def.macroscale_elements = 2000;
 	def.phase_count = 4;
+	def.cookie = PLUME_DEF_COOKIE;
 	return def;
 }
 
@@ -139,6 +141,8 @@ void plume_calibration_result_free(plume_calibration_result *result)
 
 plume_status plume_lab_calibrate(const plume_calibration_def *def, plume_calibration_result *result, plume_error *err)
 {
+	PLUME_ASSERT_DEF(def);
+	PLUME_ASSERT(result != NULL);
 	memset(result, 0, sizeof *result);
 	plume_status status = check(def, err);
 	if (status != PLUME_OK)

@@ -10,6 +10,7 @@
 
 #include <libqhull_r/qhull_ra.h>
 
+#include "../core/asserts.h"
 #include "core/alloc.h"
 #include "plume/lab.h"
 
@@ -18,6 +19,7 @@ static const double PI = 3.14159265358979323846;
 plume_sample_def plume_sample_default_def(void)
 {
 	return (plume_sample_def){
+	    .cookie = PLUME_DEF_COOKIE,
 	    .width = 1.0e-2,
 	    .height = 1.3e-2,
 	    .thickness = 1.2e-4,
@@ -30,7 +32,11 @@ plume_sample_def plume_sample_default_def(void)
 
 plume_band_def plume_band_default_def(void)
 {
-	return (plume_band_def){.period = 4.0e-4, .barb_fraction = 0.14, .barb_divisions = 1, .barbule_divisions = 3};
+	return (plume_band_def){.cookie = PLUME_DEF_COOKIE,
+	                        .period = 4.0e-4,
+	                        .barb_fraction = 0.14,
+	                        .barb_divisions = 1,
+	                        .barbule_divisions = 3};
 }
 
 // Growing arrays of points and triangles, filled by the two meshers.
@@ -413,12 +419,17 @@ static int compare_face(const void *a, const void *b)
 
 plume_status plume_sample_validate(const plume_sample_def *sample, const plume_band_def *bands, plume_error *err)
 {
-	if (!(sample->width > 0.0 && isfinite(sample->width)))
-		return plume_error_set(err, PLUME_ERROR_SPEC, "sample.width is %g m, allowed > 0", sample->width);
-	if (!(sample->height > 0.0 && isfinite(sample->height)))
-		return plume_error_set(err, PLUME_ERROR_SPEC, "sample.height is %g m, allowed > 0", sample->height);
-	if (!(sample->thickness > 0.0 && isfinite(sample->thickness)))
-		return plume_error_set(err, PLUME_ERROR_SPEC, "sample.thickness is %g m, allowed > 0", sample->thickness);
+	PLUME_ASSERT_DEF(sample);
+	PLUME_ASSERT(bands == NULL || bands->cookie == PLUME_DEF_COOKIE);
+	// Sizes with a floor and a ceiling, not just > 0: a 1e-300 m sample's triangle areas
+	// underflow to 0 and its energies divide by them.
+	if (!(sample->width >= 1e-6 && sample->width <= 10.0))
+		return plume_error_set(err, PLUME_ERROR_SPEC, "sample.width is %g m, allowed [1e-06, 10]", sample->width);
+	if (!(sample->height >= 1e-6 && sample->height <= 10.0))
+		return plume_error_set(err, PLUME_ERROR_SPEC, "sample.height is %g m, allowed [1e-06, 10]", sample->height);
+	if (!(sample->thickness >= 1e-9 && sample->thickness <= 1.0))
+		return plume_error_set(err, PLUME_ERROR_SPEC, "sample.thickness is %g m, allowed [1e-09, 1]",
+		                       sample->thickness);
 	if (!(sample->barb_angle >= 0.0 && sample->barb_angle < PI))
 		return plume_error_set(err, PLUME_ERROR_SPEC, "sample.barb_angle_deg is %g, allowed in [0, 180)",
 		                       sample->barb_angle * 180.0 / PI);
@@ -475,6 +486,7 @@ static plume_status add_clamp_group(plume_mesh *mesh, const char *name, double y
 plume_status plume_sample_mesh(const plume_sample_def *sample, const plume_band_def *bands, plume_mesh **out,
                                plume_error *err)
 {
+	PLUME_ASSERT(out != NULL);
 	*out = NULL;
 	plume_status status = plume_sample_validate(sample, bands, err);
 	if (status != PLUME_OK)

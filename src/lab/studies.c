@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "../core/asserts.h"
 #include "core/alloc.h"
 #include "plume/lab.h"
 
@@ -13,7 +14,10 @@ static const double PI = 3.14159265358979323846;
 
 static const char *const study_names[] = {"locking", "conditioning", "angles", "size"};
 
-plume_study_def plume_study_default_def(plume_study_kind kind) { return (plume_study_def){.kind = kind, .scale = 1.0}; }
+plume_study_def plume_study_default_def(plume_study_kind kind)
+{
+	return (plume_study_def){.kind = kind, .scale = 1.0, .cookie = PLUME_DEF_COOKIE};
+}
 
 bool plume_study_kind_from_name(const char *name, plume_study_kind *kind)
 {
@@ -499,6 +503,7 @@ static plume_status study_size(const plume_study_def *def, const char *csv, cons
 plume_status plume_lab_study(const plume_study_def *def, const char *csv_path, const char *png_path,
                              const char *svg_path, char *summary, size_t summary_size, plume_error *err)
 {
+	PLUME_ASSERT_DEF(def);
 	if (!(def->scale > 0.0 && def->scale <= 16.0))
 		return plume_error_set(err, PLUME_ERROR_SPEC, "study scale is %g, allowed in (0, 16]", def->scale);
 	if (summary != NULL && summary_size > 0)

@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "../core/asserts.h"
 #include "core/alloc.h"
 #include "lab/quadratic.h"
 #include "plume/lab.h"
@@ -28,6 +29,7 @@ plume_lab_material plume_lab_material_default(plume_lab_model model)
 plume_traction_def plume_traction_default_def(void)
 {
 	return (plume_traction_def){
+	    .cookie = PLUME_DEF_COOKIE,
 	    .strain_max = 0.4,
 	    .steps = 20,
 	    .solver = plume_sim_default_def().solver,
@@ -67,6 +69,9 @@ static bool positive(double value) { return value > 0.0 && isfinite(value); }
 plume_status plume_lab_validate(const plume_lab_material *material, const plume_sample_def *sample,
                                 const plume_traction_def *traction, plume_error *err)
 {
+	PLUME_ASSERT(material != NULL);
+	PLUME_ASSERT_DEF(sample);
+	PLUME_ASSERT(traction == NULL || traction->cookie == PLUME_DEF_COOKIE);
 #define REQUIRE(condition, format, ...)                                                                                \
 	if (!(condition))                                                                                                  \
 		return plume_error_set(err, PLUME_ERROR_SPEC, format, __VA_ARGS__);
@@ -101,10 +106,10 @@ plume_status plume_lab_validate(const plume_lab_material *material, const plume_
 		        "traction.strain_max is %g in compression, allowed in (0, 0.5)", traction->strain_max);
 		REQUIRE(traction->steps >= 1 && traction->steps <= 100000, "traction.steps is %d, allowed in [1, 100000]",
 		        traction->steps);
-		REQUIRE(positive(traction->solver.tolerance), "traction.tolerance is %g, allowed > 0",
-		        traction->solver.tolerance);
-		REQUIRE(traction->solver.max_iterations >= 1, "traction.max_iterations is %d, allowed >= 1",
-		        traction->solver.max_iterations);
+		REQUIRE(traction->solver.tolerance > 0.0 && traction->solver.tolerance < 1.0,
+		        "traction.tolerance is %g, allowed (0, 1)", traction->solver.tolerance);
+		REQUIRE(traction->solver.max_iterations >= 1 && traction->solver.max_iterations <= 100000,
+		        "traction.max_iterations is %d, allowed [1, 100000]", traction->solver.max_iterations);
 		REQUIRE(traction->accept_residual >= 0.0 && traction->accept_residual < 1.0,
 		        "traction.accept_residual is %g, allowed in [0, 1)", traction->accept_residual);
 		REQUIRE(traction->solver.max_substep_halvings >= 0 && traction->solver.max_substep_halvings <= 16,

@@ -1,10 +1,10 @@
 // plume_mesh: allocation, vertex groups, barb-edge collection and quality
 // measures. The builders (aligned.c, sample.c, obj.c) fill the arrays.
-#include <assert.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/asserts.h"
 #include "../core/alloc.h"
 #include "plume/mesh.h"
 
@@ -26,7 +26,7 @@ static void *zeroed(int count, size_t size) { return plume_calloc(count > 0 ? (s
 
 plume_mesh *plume_mesh_create(int vertex_count, int face_count)
 {
-	assert(vertex_count >= 0 && face_count >= 0);
+	PLUME_ASSERT(vertex_count >= 0 && face_count >= 0);
 	plume_mesh *mesh = plume_calloc(1, sizeof *mesh);
 	if (mesh == NULL)
 		return NULL;
@@ -70,6 +70,8 @@ void plume_mesh_destroy(plume_mesh *mesh)
 
 plume_status plume_mesh_add_group(plume_mesh *mesh, const char *name, const int *vertices, int count, plume_error *err)
 {
+	PLUME_ASSERT(mesh != NULL && name != NULL);
+	PLUME_ASSERT(count >= 0 && (count == 0 || vertices != NULL));
 	size_t length = strlen(name);
 	if (length == 0 || length >= sizeof mesh->groups[0].name)
 		return plume_error_set(err, PLUME_ERROR_SPEC, "vertex group name \"%s\" must have 1 to %zu bytes", name,
@@ -128,7 +130,7 @@ plume_status plume_mesh_collect_barb_edges(plume_mesh *mesh, plume_error *err)
 		int k = mesh->barb_edge[f];
 		if (k < 0)
 			continue;
-		assert(k < 3);
+		PLUME_ASSERT(k < 3);
 		int a = mesh->faces[3 * f + k], b = mesh->faces[3 * f + (k + 1) % 3];
 		edges[2 * n] = a < b ? a : b;
 		edges[2 * n + 1] = a < b ? b : a;
@@ -188,11 +190,10 @@ plume_status plume_mesh_add_group_near(plume_mesh *mesh, const char *name, const
 		if (hypot(p.x - near.x, p.y - near.y) <= radius)
 			picked[count++] = group->vertices[i];
 	}
-	plume_status status =
-	    count == 0 ? plume_error_set(err, PLUME_ERROR_SPEC,
-	                                 "no vertex of group \"%s\" lies within radius %g m of (%g, %g)", source, radius,
-	                                 near.x, near.y)
-	               : plume_mesh_add_group(mesh, name, picked, count, err);
+	plume_status status = count == 0 ? plume_error_set(err, PLUME_ERROR_SPEC,
+	                                                   "no vertex of group \"%s\" lies within radius %g m of (%g, %g)",
+	                                                   source, radius, near.x, near.y)
+	                                 : plume_mesh_add_group(mesh, name, picked, count, err);
 	plume_free(picked);
 	return status;
 }

@@ -1,11 +1,11 @@
 // Feather coats (Streit & Heidrich 4.4): follicles on a surface, key feathers,
 // interpolated feathers placed by normal, direction field and lift, in drawing
 // order from the bottom feather to the top one.
-#include <assert.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/asserts.h"
 #include "../core/alloc.h"
 #include "coat_internal.h"
 #include "feather_internal.h"
@@ -13,6 +13,7 @@
 #define PI 3.14159265358979323846
 
 struct plume_coat {
+	uint32_t magic; ///< PLUME_HANDLE_MAGIC while alive (core/asserts.h)
 	int count;
 	plume_feather **feathers; ///< drawing order
 	plume_vec3 *roots;
@@ -21,32 +22,47 @@ struct plume_coat {
 	plume_mesh *surface;
 };
 
-int plume_coat_feather_count(const plume_coat *coat) { return coat->count; }
+int plume_coat_feather_count(const plume_coat *coat)
+{
+	PLUME_ASSERT_HANDLE(coat);
+	return coat->count;
+}
 
 const plume_feather *plume_coat_feather(const plume_coat *coat, int index)
 {
-	return index >= 0 && index < coat->count ? coat->feathers[index] : NULL;
+	PLUME_ASSERT_HANDLE(coat);
+	PLUME_ASSERT_INDEX(index, coat->count);
+	return coat->feathers[index];
 }
 
 void plume_coat_follicle(const plume_coat *coat, int index, plume_vec3 *position, plume_vec3 *normal)
 {
-	assert(coat != NULL && index >= 0 && index < coat->count);
+	PLUME_ASSERT_HANDLE(coat);
+	PLUME_ASSERT_INDEX(index, coat->count);
+	PLUME_ASSERT(position != NULL && normal != NULL);
 	*position = coat->roots[index];
 	*normal = coat->normals[index];
 }
 
 bool plume_coat_is_key(const plume_coat *coat, int index)
 {
-	assert(coat != NULL && index >= 0 && index < coat->count);
+	PLUME_ASSERT_HANDLE(coat);
+	PLUME_ASSERT_INDEX(index, coat->count);
 	return coat->is_key[index];
 }
 
-const plume_mesh *plume_coat_surface(const plume_coat *coat) { return coat->surface; }
+const plume_mesh *plume_coat_surface(const plume_coat *coat)
+{
+	PLUME_ASSERT_HANDLE(coat);
+	return coat->surface;
+}
 
 void plume_coat_destroy(plume_coat *coat)
 {
 	if (coat == NULL)
 		return;
+	PLUME_ASSERT_HANDLE(coat);
+	coat->magic = 0;
 	for (int i = 0; i < coat->count; ++i)
 		plume_feather_destroy(coat->feathers[i]);
 	plume_free(coat->feathers);
@@ -621,6 +637,7 @@ plume_status coat_build(coat_def *def, plume_coat **out, plume_error *err)
 	plume_coat *coat = plume_calloc(1, sizeof *coat);
 	if (coat == NULL)
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory");
+	coat->magic = PLUME_HANDLE_MAGIC;
 	plume_status status = PLUME_OK;
 	if (def->surface == COAT_SURFACE_MESH) {
 		coat->surface = def->mesh;

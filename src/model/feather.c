@@ -1,16 +1,18 @@
 // The shared feather structure: storage, builders and read-only views.
-#include <assert.h>
 #include <math.h>
 #include <string.h>
 
+#include "../core/asserts.h"
 #include "../core/alloc.h"
 #include "feather_internal.h"
 
 plume_feather *plume_feather_create_empty(void)
 {
 	plume_feather *feather = plume_calloc(1, sizeof *feather);
-	if (feather != NULL)
+	if (feather != NULL) {
+		feather->magic = PLUME_HANDLE_MAGIC;
 		feather->afterfeather_t = 0.0;
+	}
 	return feather;
 }
 
@@ -18,6 +20,8 @@ void plume_feather_destroy(plume_feather *feather)
 {
 	if (feather == NULL)
 		return;
+	PLUME_ASSERT_HANDLE(feather);
+	feather->magic = 0;
 	plume_feather_destroy(feather->afterfeather);
 	plume_free(feather->shaft);
 	plume_free(feather->points);
@@ -45,7 +49,11 @@ int plume_feather_set_summary(plume_feather *feather, const char *json)
 	return 0;
 }
 
-const char *plume_feather_summary(const plume_feather *feather) { return feather->summary; }
+const char *plume_feather_summary(const plume_feather *feather)
+{
+	PLUME_ASSERT_HANDLE(feather);
+	return feather->summary;
+}
 
 plume_shaft_sample *plume_feather_add_shaft(plume_feather *feather, int count)
 {
@@ -158,7 +166,7 @@ static void grow_bounds(plume_vec3 *lo, plume_vec3 *hi, plume_vec3 p, double rad
 
 plume_feather_info plume_feather_get_info(const plume_feather *feather)
 {
-	assert(feather != NULL);
+	PLUME_ASSERT_HANDLE(feather);
 	plume_feather_info info = {
 	    .shaft_sample_count = feather->shaft_count,
 	    .calamus_sample_count = feather->calamus_count,
@@ -195,11 +203,16 @@ plume_feather_info plume_feather_get_info(const plume_feather *feather)
 	return info;
 }
 
-const plume_shaft_sample *plume_feather_shaft(const plume_feather *feather) { return feather->shaft; }
+const plume_shaft_sample *plume_feather_shaft(const plume_feather *feather)
+{
+	PLUME_ASSERT_HANDLE(feather);
+	return feather->shaft;
+}
 
 plume_barb plume_feather_barb(const plume_feather *feather, int i)
 {
-	assert(i >= 0 && i < feather->barb_count);
+	PLUME_ASSERT_HANDLE(feather);
+	PLUME_ASSERT_INDEX(i, feather->barb_count);
 	const plume_barb_record *record = feather->barbs + i;
 	return (plume_barb){
 	    .curve = polyline_view(feather, record->curve),
@@ -213,7 +226,8 @@ plume_barb plume_feather_barb(const plume_feather *feather, int i)
 
 plume_barbule plume_feather_barbule(const plume_feather *feather, int i)
 {
-	assert(i >= 0 && i < feather->barbule_count);
+	PLUME_ASSERT_HANDLE(feather);
+	PLUME_ASSERT_INDEX(i, feather->barbule_count);
 	const plume_barbule_record *record = feather->barbules + i;
 	return (plume_barbule){
 	    .curve = polyline_view(feather, record->curve),
@@ -223,9 +237,17 @@ plume_barbule plume_feather_barbule(const plume_feather *feather, int i)
 	};
 }
 
-const plume_feather *plume_feather_afterfeather(const plume_feather *feather) { return feather->afterfeather; }
+const plume_feather *plume_feather_afterfeather(const plume_feather *feather)
+{
+	PLUME_ASSERT_HANDLE(feather);
+	return feather->afterfeather;
+}
 
-double plume_feather_afterfeather_t(const plume_feather *feather) { return feather->afterfeather_t; }
+double plume_feather_afterfeather_t(const plume_feather *feather)
+{
+	PLUME_ASSERT_HANDLE(feather);
+	return feather->afterfeather_t;
+}
 
 // ---------------------------------------------------------------------------
 // Equality and copies
@@ -258,6 +280,8 @@ bool plume_feather_equal(const plume_feather *a, const plume_feather *b)
 {
 	if (a == NULL || b == NULL)
 		return a == b;
+	PLUME_ASSERT_HANDLE(a);
+	PLUME_ASSERT_HANDLE(b);
 	if (a->shaft_count != b->shaft_count || a->calamus_count != b->calamus_count || a->barb_count != b->barb_count ||
 	    a->barbule_count != b->barbule_count)
 		return false;
@@ -292,6 +316,7 @@ bool plume_feather_equal(const plume_feather *a, const plume_feather *b)
 
 plume_feather *plume_feather_clone(const plume_feather *feather)
 {
+	PLUME_ASSERT_HANDLE(feather);
 	plume_feather *copy = plume_feather_create_empty();
 	if (copy == NULL)
 		return NULL;

@@ -30,6 +30,7 @@ typedef struct plume_barbule_record {
 } plume_barbule_record;
 
 struct plume_feather {
+	uint32_t magic; ///< PLUME_HANDLE_MAGIC while alive (core/asserts.h)
 	plume_shaft_sample *shaft;
 	int shaft_count, shaft_capacity;
 	int calamus_count;

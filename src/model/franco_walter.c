@@ -12,11 +12,11 @@
 // The paper does not say which way +y points; plume takes it towards the tip,
 // so that v3 >= 0 bends barb ends tipwards as real barbs do, and mirrors the
 // frame between vanes so that S_v gives mirror-image vanes.
-#include <assert.h>
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
+#include "../core/asserts.h"
 #include "../core/alloc.h"
 #include "feather_internal.h"
 #include "plume/model.h"
@@ -85,7 +85,7 @@ static plume_status check_points(const plume_vec2 *points, int count, const char
 
 plume_status plume_fw_def_validate(const plume_fw_def *def, plume_error *err)
 {
-	assert(def != NULL && def->cookie == PLUME_DEF_COOKIE && "plume_fw_def not from plume_fw_default_def()");
+	PLUME_ASSERT_DEF(def);
 	plume_status status;
 	if ((status = check_points(def->shaft, 4, "shaft", err)) != PLUME_OK ||
 	    (status = check_points(def->left_outline, 5, "left_outline", err)) != PLUME_OK ||

@@ -20,6 +20,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "../core/asserts.h"
 #include "../core/alloc.h"
 #include "feather_internal.h"
 #include "streit_heidrich_internal.h"
@@ -105,6 +106,7 @@ plume_sh_def plume_sh_default_def(void)
 	def.barb_width_base = 1e-4;
 	def.barb_width_tip = 2.5e-5;
 	def.texture_mode = PLUME_SH_TEXTURE_BARB;
+	def.cookie = PLUME_DEF_COOKIE;
 	return def;
 }
 
@@ -226,6 +228,7 @@ plume_status sh_params_validate(const plume_sh_params *p, const char *prefix, pl
 
 plume_status plume_sh_def_validate(const plume_sh_def *def, plume_error *err)
 {
+	PLUME_ASSERT_DEF(def);
 	plume_status status = sh_params_validate(&def->main, "$", err);
 	if (status == PLUME_OK && def->has_afterfeather)
 		status = sh_params_validate(&def->afterfeather, "$.afterfeather", err);

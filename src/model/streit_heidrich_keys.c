@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "../core/asserts.h"
 #include "../core/alloc.h"
 #include "streit_heidrich_internal.h"
 
@@ -336,6 +337,9 @@ static int blend_params(const plume_sh_params *const *params, const double *weig
 plume_status plume_sh_def_blend(const plume_sh_def *const *defs, const double *weights, int count, plume_sh_def *out,
                                 plume_error *err)
 {
+	PLUME_ASSERT(count >= 1 && defs != NULL && weights != NULL && out != NULL);
+	for (int f = 0; f < count; ++f)
+		PLUME_ASSERT_DEF(defs[f]);
 	if (count < 1 || count > MAX_BLEND)
 		return plume_error_set(err, PLUME_ERROR_SPEC, "blend: %d feathers, allowed [1, %d]", count, MAX_BLEND);
 	double total = 0.0;
@@ -395,6 +399,7 @@ plume_status plume_sh_def_blend(const plume_sh_def *const *defs, const double *w
 		result.barb_width_tip += normalized[f] * defs[f]->barb_width_tip;
 	}
 	result.texture_mode = defs[heaviest]->texture_mode;
+	result.cookie = PLUME_DEF_COOKIE;
 	*out = result;
 	return PLUME_OK;
 }

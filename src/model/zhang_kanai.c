@@ -12,6 +12,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "../core/asserts.h"
 #include "../core/alloc.h"
 #include "feather_internal.h"
 #include "zhang_kanai_internal.h"
@@ -27,6 +28,7 @@ static plume_zk_curve curve3(double s0, double v0, double s1, double v1, double 
 plume_zk_def plume_zk_default_def(void)
 {
 	plume_zk_def def = {
+	    .cookie = PLUME_DEF_COOKIE,
 	    .collar_kind = PLUME_ZK_COLLAR_CIRCLE,
 	    .collar_radius = 0.01,
 	    .collar_point_count = 0,
@@ -171,6 +173,7 @@ static plume_status check_intervals(const plume_zk_def *def, plume_error *err)
 
 plume_status plume_zk_def_validate(const plume_zk_def *def, plume_error *err)
 {
+	PLUME_ASSERT_DEF(def);
 	plume_status status;
 	if ((status = check_collar(def, err)) != PLUME_OK || (status = check_intervals(def, err)) != PLUME_OK ||
 	    (status = check_positive(def->ridge_width, "$.ridge_width", "width in metres", err)) != PLUME_OK ||

@@ -2,6 +2,7 @@
 // (moved from model/coat_export.c: drawing is render's layer).
 #include <stdlib.h>
 
+#include "../core/asserts.h"
 #include "../core/alloc.h"
 #include "plume/coat.h"
 #include "plume/render.h"
@@ -22,6 +23,8 @@ static int compare_depth(const void *a, const void *b)
 plume_status plume_coat_render2d(const plume_coat *coat, const plume_render2d_def *def, plume_image_format format,
                                  const char *path, plume_error *err)
 {
+	PLUME_ASSERT(coat != NULL);
+	PLUME_ASSERT_DEF(def);
 	// Seen from +z: feathers on the far side of the surface (normal away from the camera) are hidden by it;
 	// the others are painted from the farthest root to the nearest, and in the coat's own bottom-to-top
 	// order where roots are equally far (a plane facing the camera).

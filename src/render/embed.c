@@ -9,12 +9,12 @@
 // shell's border) and the height above the plane. The reconstruction
 // evaluates the same affine map on the deformed triangle, so the rest shell
 // returns every point to rounding.
-#include <assert.h>
 #include <math.h>
 #include <string.h>
 
 #include <embree3/rtcore.h>
 
+#include "../core/asserts.h"
 #include "core/alloc.h"
 #include "model/feather_internal.h"
 #include "plume/embed.h"
@@ -31,6 +31,7 @@ typedef struct frame_coords {
 } frame_coords;
 
 struct plume_barb_embedding {
+	uint32_t magic;         ///< PLUME_HANDLE_MAGIC while alive (core/asserts.h)
 	plume_feather *feather; ///< a copy of the rest feather: the template of every rebuilt one
 	const plume_mesh *mesh;
 	int point_count;
@@ -165,14 +166,24 @@ static void count_points(const plume_feather *f, int *points, int *directions)
 	}
 }
 
-int plume_embedding_point_count(const plume_barb_embedding *embedding) { return embedding->point_count; }
+int plume_embedding_point_count(const plume_barb_embedding *embedding)
+{
+	PLUME_ASSERT_HANDLE(embedding);
+	return embedding->point_count;
+}
 
-double plume_embedding_max_offset(const plume_barb_embedding *embedding) { return embedding->max_offset; }
+double plume_embedding_max_offset(const plume_barb_embedding *embedding)
+{
+	PLUME_ASSERT_HANDLE(embedding);
+	return embedding->max_offset;
+}
 
 void plume_embedding_destroy(plume_barb_embedding *embedding)
 {
 	if (embedding == NULL)
 		return;
+	PLUME_ASSERT_HANDLE(embedding);
+	embedding->magic = 0;
 	plume_feather_destroy(embedding->feather);
 	plume_free(embedding->anchors);
 	plume_free(embedding->directions);
@@ -190,7 +201,7 @@ static plume_status rest_frames(const plume_mesh *mesh, triangle_frame **out, pl
 	int valid = 0;
 	for (int i = 0; i < mesh->face_count; ++i) {
 		for (int k = 0; k < 3; ++k)
-			assert(mesh->faces[3 * i + k] >= 0 && mesh->faces[3 * i + k] < mesh->vertex_count);
+			PLUME_ASSERT(mesh->faces[3 * i + k] >= 0 && mesh->faces[3 * i + k] < mesh->vertex_count);
 		frames[i] = make_frame(mesh->rest, mesh->faces + 3 * i);
 		valid += frames[i].valid;
 	}
@@ -232,7 +243,8 @@ static RTCScene build_scene(RTCDevice device, const plume_mesh *mesh)
 plume_status plume_embedding_create(const plume_feather *feather, const plume_mesh *mesh, plume_barb_embedding **out,
                                     plume_error *err)
 {
-	assert(feather != NULL && mesh != NULL && out != NULL);
+	PLUME_ASSERT_HANDLE(feather);
+	PLUME_ASSERT(mesh != NULL && out != NULL);
 	*out = NULL;
 	triangle_frame *frames = NULL;
 	plume_status status = rest_frames(mesh, &frames, err);
@@ -242,6 +254,7 @@ plume_status plume_embedding_create(const plume_feather *feather, const plume_me
 	int points = 0, directions = 0;
 	count_points(feather, &points, &directions);
 	if (e != NULL) {
+		e->magic = PLUME_HANDLE_MAGIC;
 		e->mesh = mesh;
 		e->point_count = points;
 		e->direction_count = directions;
@@ -334,7 +347,8 @@ static void measure(plume_feather *f, plume_curve_range range)
 plume_status plume_embedding_apply(const plume_barb_embedding *embedding, const plume_vec3 *positions,
                                    plume_feather **out, plume_error *err)
 {
-	assert(embedding != NULL && positions != NULL && out != NULL);
+	PLUME_ASSERT_HANDLE(embedding);
+	PLUME_ASSERT(positions != NULL && out != NULL);
 	*out = NULL;
 	const plume_mesh *mesh = embedding->mesh;
 	for (int i = 0; i < mesh->vertex_count; ++i)

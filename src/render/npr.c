@@ -3,7 +3,6 @@
 // the curve's widths; barbs in one colour (the paper's non-photorealistic
 // style) or coloured from a texture by their (s, t).
 #define _POSIX_C_SOURCE 200809L
-#include <assert.h>
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
@@ -14,6 +13,7 @@
 #include <cairo-svg.h>
 #include <cairo.h>
 
+#include "../core/asserts.h"
 #include "core/alloc.h"
 #include "core/atomic_file.h"
 #include "plume/render.h"
@@ -23,6 +23,7 @@
 plume_render2d_def plume_render2d_default_def(void)
 {
 	return (plume_render2d_def){
+	    .cookie = PLUME_DEF_COOKIE,
 	    .width = 1024,
 	    .height = 1024,
 	    .margin = 0.05,
@@ -574,14 +575,16 @@ static plume_status render_vector(const plume_feather *const *feathers, int coun
 plume_status plume_render2d(const plume_feather *feather, const plume_render2d_def *def, plume_image_format format,
                             const char *path, plume_error *err)
 {
-	assert(feather != NULL);
+	PLUME_ASSERT(feather != NULL);
 	return plume_render2d_feathers(&feather, 1, def, format, path, err);
 }
 
 plume_status plume_render2d_feathers(const plume_feather *const *feathers, int count, const plume_render2d_def *def,
                                      plume_image_format format, const char *path, plume_error *err)
 {
-	assert(feathers != NULL && def != NULL && path != NULL);
+	PLUME_ASSERT_DEF(def);
+	PLUME_ASSERT(count >= 0 && (count == 0 || feathers != NULL));
+	PLUME_ASSERT(feathers != NULL && def != NULL && path != NULL);
 	if (count < 1)
 		return plume_error_set(err, PLUME_ERROR_SPEC, "render2d: no feather to draw");
 	plume_status status = validate_def(def, err);

@@ -6,13 +6,13 @@
 // the feather never traverse a huge ground triangle), then gathers the lights
 // through shadow rays and the sky through ambient-occlusion rays. Samples are
 // accumulated premultiplied in linear light and encoded to sRGB at the end.
-#include <assert.h>
 #include <math.h>
 #include <omp.h>
 #include <string.h>
 
 #include <cairo.h>
 
+#include "../core/asserts.h"
 #include "core/alloc.h"
 #include "render/cairo_png.h"
 #include "render/raytrace_internal.h"
@@ -23,6 +23,7 @@
 plume_raytrace_def plume_raytrace_default_def(void)
 {
 	plume_raytrace_def def = {
+	    .cookie = PLUME_DEF_COOKIE,
 	    .camera = plume_camera_default(),
 	    .light_count = 2,
 	    .sky_color = {0.78, 0.84, 0.92, 1.0},
@@ -534,7 +535,8 @@ static bool want_barbules(const plume_raytrace_def *def, const plume_camera *cam
 plume_status plume_raytrace_render(const plume_raytrace_scene *scene, const plume_raytrace_def *def, uint8_t *rgba,
                                    plume_raytrace_stats *stats, plume_error *err)
 {
-	assert(scene != NULL && def != NULL && rgba != NULL);
+	PLUME_ASSERT_DEF(def);
+	PLUME_ASSERT(scene != NULL && def != NULL && rgba != NULL);
 	plume_status status = validate_def(def, err);
 	if (status != PLUME_OK)
 		return status;
@@ -640,6 +642,7 @@ plume_status plume_write_rgba_png(int width, int height, const uint8_t *rgba, co
 plume_status plume_raytrace_render_png(const plume_raytrace_scene *scene, const plume_raytrace_def *def,
                                        const char *path, plume_raytrace_stats *stats, plume_error *err)
 {
+	PLUME_ASSERT_DEF(def);
 	size_t size = 4 * (size_t)def->camera.width * (size_t)(def->camera.height > 0 ? def->camera.height : 0);
 	if (def->camera.width < 16 || def->camera.width > 16384 || def->camera.height < 16 || def->camera.height > 16384)
 		return rt_camera_check(&def->camera, err);

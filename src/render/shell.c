@@ -6,6 +6,7 @@
 
 #include <cairo.h>
 
+#include "../core/asserts.h"
 #include "core/alloc.h"
 #include "plume/mesh.h"
 #include "plume/render.h"
@@ -23,6 +24,7 @@ plume_shell_view_def plume_shell_view_default_def(void)
 	def.background = (plume_color){0.96, 0.96, 0.95, 1};
 	def.vane_color = (plume_color){0.78, 0.70, 0.58, 1};
 	def.rachis_color = (plume_color){0.35, 0.27, 0.20, 1};
+	def.cookie = PLUME_DEF_COOKIE;
 	return def;
 }
 
@@ -68,6 +70,8 @@ static void box_extent(const view_basis *b, plume_vec3 lo, plume_vec3 hi, double
 plume_status plume_render_shell_png(const plume_mesh *mesh, const plume_vec3 *positions,
                                     const plume_shell_view_def *def, const char *path, plume_error *err)
 {
+	PLUME_ASSERT(mesh != NULL && path != NULL);
+	PLUME_ASSERT_DEF(def);
 	if (def->width < 1 || def->height < 1 || def->width > 16384 || def->height > 16384)
 		return plume_error_set(err, PLUME_ERROR_SPEC, "image size %dx%d, allowed 1 to 16384 pixels a side", def->width,
 		                       def->height);

@@ -1,7 +1,6 @@
 // Textures for the 2D renderer (Franco & Walter 4.4): RGBA8 images, loaded
 // with stb_image, sampled with the paper's vane mapping, written with Cairo.
 #define _POSIX_C_SOURCE 200809L
-#include <assert.h>
 #include <errno.h>
 #include <limits.h>
 #include <math.h>
@@ -11,6 +10,7 @@
 #include <cairo.h>
 #include <stb_image.h>
 
+#include "../core/asserts.h"
 #include "core/alloc.h"
 #include "plume/render.h"
 #include "render/cairo_png.h"
@@ -35,7 +35,7 @@ static size_t image_bytes(int width, int height)
 
 plume_texture *plume_texture_create(int width, int height, const uint8_t *rgba)
 {
-	assert(width > 0 && height > 0 && rgba != NULL);
+	PLUME_ASSERT(width > 0 && height > 0 && rgba != NULL);
 	size_t bytes = image_bytes(width, height);
 	if (bytes == 0)
 		return NULL;
@@ -106,7 +106,7 @@ static plume_status read_whole_file(const char *path, uint8_t **data_out, size_t
 
 plume_status plume_texture_load(const char *path, plume_texture **out, plume_error *err)
 {
-	assert(path != NULL && out != NULL);
+	PLUME_ASSERT(path != NULL && out != NULL);
 	*out = NULL;
 	uint8_t *data = NULL;
 	size_t size = 0;
@@ -157,7 +157,7 @@ static int clamp_index(double value, int size)
 
 plume_color plume_texture_sample_vane(const plume_texture *texture, plume_side side, double s, double t)
 {
-	assert(texture != NULL && !isnan(s) && !isnan(t));
+	PLUME_ASSERT(texture != NULL && !isnan(s) && !isnan(t));
 	int m = texture->width, n = texture->height;
 	// Franco & Walter 4.4: i_n = floor(t n), i_ml = floor((1 - s) m / 2),
 	// i_mr = floor(s m / 2 + m / 2). The rachis (s = 0) sits at the middle
@@ -206,7 +206,7 @@ static plume_status texture_surface(const plume_texture *texture, const char *pa
 
 plume_status plume_texture_write_png(const plume_texture *texture, const char *path, plume_error *err)
 {
-	assert(texture != NULL && path != NULL);
+	PLUME_ASSERT(texture != NULL && path != NULL);
 	cairo_surface_t *surface = NULL;
 	plume_status status = texture_surface(texture, path, &surface, err);
 	if (status != PLUME_OK)

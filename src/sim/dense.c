@@ -1,9 +1,9 @@
 // Symmetric eigen-decomposition of the small element Hessians and their projection onto
 // the positive semidefinite cone (projected Newton). Plain loops, no allocation, no
 // threads: the same input gives the same bits.
+#include "../core/asserts.h"
 #include "sim/dense.h"
 
-#include <assert.h>
 #include <float.h>
 #include <math.h>
 #include <stdbool.h>
@@ -75,7 +75,7 @@ void plume_symmetric_eigen(const double *matrix, int n, double *values, double *
 	// Tridiagonal reduction, then the implicit QL iteration with Wilkinson-type shifts
 	// (the tql2 algorithm of EISPACK; Golub & Van Loan section 8.3). About five times
 	// cheaper than cyclic Jacobi at n = 9..12, and just as accurate for the projection.
-	assert(n >= 1 && n <= PLUME_DENSE_MAX);
+	PLUME_ASSERT(n >= 1 && n <= PLUME_DENSE_MAX);
 	double d[PLUME_DENSE_MAX], e[PLUME_DENSE_MAX], z[PLUME_DENSE_MAX * PLUME_DENSE_MAX];
 	tridiagonalize(matrix, n, d, e, z);
 	for (int l = 0; l < n; ++l) {
@@ -161,7 +161,7 @@ static bool project_if_indefinite(double *matrix, int n)
 
 void plume_project_psd(double *matrix, int n)
 {
-	assert(n >= 1 && n <= PLUME_DENSE_MAX);
+	PLUME_ASSERT(n >= 1 && n <= PLUME_DENSE_MAX);
 	project_if_indefinite(matrix, n);
 }
 
@@ -178,7 +178,7 @@ static void helmert_basis(int m, double U[4][3])
 
 void plume_project_psd_translation_free(double *matrix, int vertex_count)
 {
-	assert(vertex_count >= 2 && vertex_count <= PLUME_DENSE_MAX / 3);
+	PLUME_ASSERT(vertex_count >= 2 && vertex_count <= PLUME_DENSE_MAX / 3);
 	int m = vertex_count, n = 3 * m, r = 3 * (m - 1);
 	double U[4][3];
 	helmert_basis(m, U);

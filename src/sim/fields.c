@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "../core/alloc.h"
+#include "../core/asserts.h"
 #include "sim/sim_internal.h"
 
 /// A face found by its sorted vertex triple.
@@ -44,6 +45,8 @@ static int find_face(const face_key *keys, int count, int a, int b, int c)
 
 plume_status plume_sim_face_fields(const plume_sim *sim, plume_sim_face_field *out, plume_error *err)
 {
+	PLUME_ASSERT_HANDLE(sim);
+	PLUME_ASSERT(out != NULL);
 	int faces = sim->face_count;
 	for (int f = 0; f < faces; ++f) {
 		const plume_membrane_element *element = sim->membranes + f;

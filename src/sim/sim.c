@@ -1,11 +1,11 @@
 // The simulation object: definitions, set-up from a mesh, handles, statics and
 // implicit-Euler steps with substep retries, and measurements.
-#include <assert.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/asserts.h"
 #include "core/alloc.h"
 #include "sim/sim_internal.h"
 
@@ -44,7 +44,9 @@ static plume_status check_material(const plume_material *material, const char *p
 	if (!(condition))                                                                                                  \
 		return plume_error_set(err, PLUME_ERROR_SPEC, "%s.%s is %g, allowed " allowed, path, #field,                   \
 		                       (double)material->field);
-	REQUIRE(material->thickness > 0 && isfinite(material->thickness), thickness, "> 0");
+	// Floors and ceilings, not just > 0: a 1e-300 m shell or step makes the stiffness or the
+	// inertia term (mass / h^2) underflow or overflow, and Newton then works on NaN.
+	REQUIRE(material->thickness >= 1e-9 && material->thickness <= 1.0, thickness, "[1e-09, 1] m");
 	REQUIRE(material->surface_density >= 0 && isfinite(material->surface_density), surface_density, ">= 0");
 	REQUIRE(material->bending_along >= 0 && isfinite(material->bending_along), bending_along, ">= 0");
 	REQUIRE(isfinite(material->bending_across), bending_across, "finite");
@@ -69,6 +71,7 @@ static plume_status check_material(const plume_material *material, const char *p
 
 plume_status plume_sim_def_validate(const plume_sim_def *def, int mesh_material_count, plume_error *err)
 {
+	PLUME_ASSERT_DEF(def);
 	if (def->material_count < 1 || def->material_count > PLUME_MAX_MATERIALS)
 		return plume_error_set(err, PLUME_ERROR_SPEC, "$.materials: %d materials, allowed 1 to %d", def->material_count,
 		                       PLUME_MAX_MATERIALS);
@@ -81,8 +84,8 @@ plume_status plume_sim_def_validate(const plume_sim_def *def, int mesh_material_
 		if (status != PLUME_OK)
 			return status;
 	}
-	if (!(def->time_step > 0) || !isfinite(def->time_step))
-		return plume_error_set(err, PLUME_ERROR_SPEC, "$.time_step is %g, allowed > 0", def->time_step);
+	if (!(def->time_step >= 1e-9 && def->time_step <= 100.0))
+		return plume_error_set(err, PLUME_ERROR_SPEC, "$.time_step is %g, allowed [1e-09, 100] s", def->time_step);
 	if (!(def->drag >= 0) || !isfinite(def->drag))
 		return plume_error_set(err, PLUME_ERROR_SPEC, "$.drag is %g, allowed >= 0", def->drag);
 	if (!isfinite(def->gravity.x) || !isfinite(def->gravity.y) || !isfinite(def->gravity.z))
@@ -318,8 +321,9 @@ static double bounding_diagonal(const plume_mesh *mesh)
 
 plume_status plume_sim_create(const plume_mesh *mesh, const plume_sim_def *def, plume_sim **out, plume_error *err)
 {
-	assert(mesh != NULL && def != NULL && out != NULL);
-	assert(def->cookie == PLUME_DEF_COOKIE && "plume_sim_def not from plume_sim_default_def()");
+	PLUME_ASSERT(mesh != NULL && out != NULL);
+	PLUME_ASSERT_DEF(def);
+	PLUME_ASSERT(mesh->vertex_count >= 0 && mesh->face_count >= 0);
 	*out = NULL;
 	if (mesh->vertex_count < 3 || mesh->face_count < 1)
 		return plume_error_set(err, PLUME_ERROR_SPEC, "the mesh has no faces to simulate");
@@ -333,6 +337,7 @@ plume_status plume_sim_create(const plume_mesh *mesh, const plume_sim_def *def, 
 	plume_sim *sim = plume_calloc(1, sizeof *sim);
 	if (sim == NULL)
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory creating the simulation");
+	sim->magic = PLUME_HANDLE_MAGIC;
 	sim->def = *def;
 	sim->vertex_count = mesh->vertex_count;
 	sim->face_count = mesh->face_count;
@@ -390,6 +395,8 @@ void plume_sim_destroy(plume_sim *sim)
 {
 	if (sim == NULL)
 		return;
+	PLUME_ASSERT_HANDLE(sim);
+	sim->magic = 0;
 	plume_kkt_free(&sim->kkt);
 	void *arrays[] = {sim->x,
 	                  sim->v,
@@ -452,7 +459,8 @@ static const plume_vertex_group *find_group(const plume_sim *sim, const char *na
 
 int plume_sim_add_handle(plume_sim *sim, const char *group_name, plume_error *err)
 {
-	assert(sim != NULL && group_name != NULL);
+	PLUME_ASSERT_HANDLE(sim);
+	PLUME_ASSERT(group_name != NULL);
 	const plume_vertex_group *group = find_group(sim, group_name);
 	if (group == NULL) {
 		char known[512] = "";
@@ -498,7 +506,8 @@ int plume_sim_add_handle(plume_sim *sim, const char *group_name, plume_error *er
 
 plume_status plume_sim_set_group_load(plume_sim *sim, const char *group_name, plume_vec3 force, plume_error *err)
 {
-	assert(sim != NULL && group_name != NULL);
+	PLUME_ASSERT_HANDLE(sim);
+	PLUME_ASSERT(group_name != NULL);
 	const plume_vertex_group *group = find_group(sim, group_name);
 	if (group == NULL || group->count == 0)
 		return plume_error_set(err, PLUME_ERROR_SPEC, "no vertices in group \"%s\" to load", group_name);
@@ -510,8 +519,13 @@ plume_status plume_sim_set_group_load(plume_sim *sim, const char *group_name, pl
 
 void plume_sim_set_handle(plume_sim *sim, int index, plume_vec3 translation, plume_mat3 rotation, plume_vec3 pivot)
 {
-	assert(sim != NULL && index >= 0 && index < sim->handle_count && "handle index from plume_sim_add_handle");
-	assert(isfinite(translation.x) && isfinite(translation.y) && isfinite(translation.z));
+	PLUME_ASSERT_HANDLE(sim);
+	PLUME_ASSERT_INDEX(index, sim->handle_count); // an index from plume_sim_add_handle
+	PLUME_ASSERT(isfinite(translation.x) && isfinite(translation.y) && isfinite(translation.z));
+	PLUME_ASSERT(isfinite(pivot.x) && isfinite(pivot.y) && isfinite(pivot.z));
+	for (int r = 0; r < 3; ++r)
+		for (int c = 0; c < 3; ++c)
+			PLUME_ASSERT(isfinite(rotation.m[r][c]));
 	sim_handle *handle = sim->handles + index;
 	for (int i = 0; i < handle->count; ++i) {
 		plume_vec3 arm = plume_m3_apply(rotation, plume_v3_sub(handle->anchor[i], pivot));
@@ -521,7 +535,7 @@ void plume_sim_set_handle(plume_sim *sim, int index, plume_vec3 translation, plu
 
 void plume_sim_place_handles(plume_sim *sim, double s)
 {
-	assert(sim != NULL && s >= 0.0 && s <= 1.0);
+	PLUME_ASSERT(sim != NULL && s >= 0.0 && s <= 1.0);
 	for (int h = 0; h < sim->handle_count; ++h) {
 		const sim_handle *handle = sim->handles + h;
 		for (int i = 0; i < handle->count; ++i)
@@ -551,7 +565,7 @@ static void add_report(plume_solve_report *total, const plume_solve_report *part
 
 plume_status plume_sim_solve_static(plume_sim *sim, plume_solve_report *report, plume_error *err)
 {
-	assert(sim != NULL);
+	PLUME_ASSERT_HANDLE(sim);
 	plume_solve_report total = {0};
 	static const sim_problem statics = {false, 0, NULL, NULL, NULL};
 	size_t bytes = sizeof(plume_vec3) * (size_t)sim->vertex_count;
@@ -599,7 +613,7 @@ static void vertex_normals(const plume_sim *sim, const plume_vec3 *x, plume_vec3
 
 plume_status plume_sim_step(plume_sim *sim, plume_solve_report *report, plume_error *err)
 {
-	assert(sim != NULL);
+	PLUME_ASSERT_HANDLE(sim);
 	plume_solve_report total = {0};
 	size_t bytes = sizeof(plume_vec3) * (size_t)sim->vertex_count;
 	memcpy(sim->saved_x, sim->x, bytes);
@@ -654,14 +668,40 @@ plume_status plume_sim_step(plume_sim *sim, plume_solve_report *report, plume_er
 // ---------------------------------------------------------------------------
 // Measurements
 
-int plume_sim_vertex_count(const plume_sim *sim) { return sim->vertex_count; }
-int plume_sim_constraint_count(const plume_sim *sim) { return sim->constraint_count; }
-const plume_vec3 *plume_sim_positions(const plume_sim *sim) { return sim->x; }
-const plume_vec3 *plume_sim_velocities(const plume_sim *sim) { return sim->v; }
-double plume_sim_time(const plume_sim *sim) { return sim->time; }
+int plume_sim_vertex_count(const plume_sim *sim)
+{
+	PLUME_ASSERT_HANDLE(sim);
+	return sim->vertex_count;
+}
+
+int plume_sim_constraint_count(const plume_sim *sim)
+{
+	PLUME_ASSERT_HANDLE(sim);
+	return sim->constraint_count;
+}
+
+const plume_vec3 *plume_sim_positions(const plume_sim *sim)
+{
+	PLUME_ASSERT_HANDLE(sim);
+	return sim->x;
+}
+
+const plume_vec3 *plume_sim_velocities(const plume_sim *sim)
+{
+	PLUME_ASSERT_HANDLE(sim);
+	return sim->v;
+}
+
+double plume_sim_time(const plume_sim *sim)
+{
+	PLUME_ASSERT_HANDLE(sim);
+	return sim->time;
+}
 
 bool plume_sim_group_reaction(plume_sim *sim, const char *group_name, plume_vec3 *force)
 {
+	PLUME_ASSERT_HANDLE(sim);
+	PLUME_ASSERT(group_name != NULL && force != NULL);
 	const plume_vertex_group *group = find_group(sim, group_name);
 	if (group == NULL)
 		return false;
@@ -680,6 +720,7 @@ bool plume_sim_group_reaction(plume_sim *sim, const char *group_name, plume_vec3
 
 plume_sim_energies plume_sim_energy(plume_sim *sim)
 {
+	PLUME_ASSERT_HANDLE(sim);
 	plume_sim_energies out = {0};
 	for (int f = 0; f < sim->face_count; ++f) {
 		const plume_membrane_element *element = sim->membranes + f;

@@ -35,6 +35,7 @@ typedef struct sim_problem {
 } sim_problem;
 
 struct plume_sim {
+	uint32_t magic; ///< PLUME_HANDLE_MAGIC while alive (core/asserts.h)
 	plume_sim_def def;
 	int vertex_count;
 	plume_vec3 *x;

@@ -154,15 +154,60 @@ check "new run: summary replaced" bash -c "! cmp -s '$run/summary.json' '$scratc
 check "new run: the user's file in DIR kept" test "$(cat "$run/notes.txt")" = mine
 check "new run: the user's file in frames/ kept" test "$(cat "$run/frames/my-notes.txt")" = mine
 check "new run: no staging beside or inside" test -z "$(ls -A "$scratch" "$run" | grep plume-staging)"
-# Staging folders of a dead run are removed; those of a live process (this shell) are not.
-mkdir "$scratch/.run.plume-staging-999999-abcdef" "$run/.plume-staging-999998-abcdef" \
-	"$scratch/.run.plume-staging-$$-abcdef" "$scratch/.run.plume-staging-keep"
+# Staging folders of a dead run are removed, found by their name and the marker plume writes
+# in each (its PID and start time); those of a live process (this shell), those without a
+# valid marker and anything else are not.
+true &
+dead=$!
+wait "$dead"
+marker() { # marker FOLDER PID: a staging folder as plume makes it
+	mkdir -p "$1"
+	printf 'plume staging folder\npid %s\nstart 0\n' "$2" >"$1/.plume-staging-marker"
+	echo partial >"$1/stats.csv"
+}
+marker "$scratch/.run.plume-staging-$dead-abcdef" "$dead"
+marker "$run/.plume-staging-$dead-abcdeg" "$dead"
+marker "$scratch/.run.plume-staging-$$-abcdef" $$
+marker "$scratch/.run.plume-staging-$dead-other" "$((dead + 1))"
+mkdir "$scratch/.run.plume-staging-keep" "$scratch/.run.plume-staging-$dead-nomark"
+echo mine >"$scratch/.run.plume-staging-$dead-nomark/notes.txt"
+printf 'not plume\n' >"$scratch/.run.plume-staging-$dead-other/.plume-staging-marker"
 $T "$plume" simulate "$bad/scene-short.json" -o "$run" >/dev/null 2>&1
-check "stale staging beside DIR removed" test ! -e "$scratch/.run.plume-staging-999999-abcdef"
-check "stale staging inside DIR removed" test ! -e "$run/.plume-staging-999998-abcdef"
+check "stale staging beside DIR removed" test ! -e "$scratch/.run.plume-staging-$dead-abcdef"
+check "stale staging inside DIR removed" test ! -e "$run/.plume-staging-$dead-abcdeg"
 check "a live process's staging kept" test -d "$scratch/.run.plume-staging-$$-abcdef"
 check "a folder not of the pattern kept" test -d "$scratch/.run.plume-staging-keep"
-rmdir "$scratch/.run.plume-staging-$$-abcdef" "$scratch/.run.plume-staging-keep"
+check "a look-alike without a marker kept" test "$(cat "$scratch/.run.plume-staging-$dead-nomark/notes.txt")" = mine
+check "a look-alike with another marker kept" test -d "$scratch/.run.plume-staging-$dead-other"
+check "stale clean-up: the user's file in frames/ kept" test "$(cat "$run/frames/my-notes.txt")" = mine
+rm -r "$scratch/.run.plume-staging-$$-abcdef" "$scratch/.run.plume-staging-keep" \
+	"$scratch/.run.plume-staging-$dead-nomark" "$scratch/.run.plume-staging-$dead-other"
+
+# Ctrl-C (SIGINT) and SIGTERM during a run: its staging folder goes, plume ends by the
+# signal, and DIR keeps the earlier run. (set -m: a background job of a script would
+# otherwise start with SIGINT ignored, and plume keeps an ignored signal ignored.)
+edit "$bad/scene-short.json" "$bad/scene-slow.json" "d['duration'] = 30"
+cp "$run/summary.json" "$scratch/summary-before.json"
+for sig in INT TERM; do
+	set -m
+	"$plume" simulate "$bad/scene-slow.json" -o "$run" >/dev/null 2>&1 &
+	pid=$!
+	set +m
+	# Wait until the run has written a frame into its staging folder.
+	for _ in $(seq 300); do
+		ls "$scratch"/.run.plume-staging-*/frames/0001.obj >/dev/null 2>&1 && break
+		sleep 0.1
+	done
+	check "SIG$sig: the run was staging" bash -c "ls '$scratch'/.run.plume-staging-*/frames/0001.obj >/dev/null 2>&1"
+	kill -"$sig" "$pid"
+	wait "$pid"
+	status=$?
+	check "SIG$sig: plume ended by the signal (status $status)" test "$status" -eq $((128 + $(kill -l "$sig")))
+	check "SIG$sig: nothing left beside DIR" test -z "$(ls -A "$scratch" "$run" | grep plume-staging)"
+	check "SIG$sig: the earlier run intact" cmp -s "$run/summary.json" "$scratch/summary-before.json"
+	check "SIG$sig: the user's file in frames/ kept" test "$(cat "$run/frames/my-notes.txt")" = mine
+done
+
 # A folder of DIR with the name of a file of the run is not deleted: the run fails instead.
 gen=$scratch/gen
 mkdir -p "$gen/feather.obj"

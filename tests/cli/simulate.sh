@@ -50,9 +50,9 @@ bad() { # bad NAME FRAGMENT JSON-MEMBERS
 }
 bad "unknown group" '$.handles[0].group: unknown vertex group "rachis_bse"' '"handles": [{"group": "rachis_bse"}]'
 bad "negative modulus" '$.materials.vane.E_ww is -1, allowed > 0' '"materials": {"vane": {"E_ww": -1}}'
-bad "negative thickness" '$.materials.rachis.thickness is -0.001, allowed > 0' '"materials": {"rachis": {"thickness": -0.001}}'
-bad "zero time step" '$.time_step is 0, allowed > 0' '"time_step": 0'
-bad "negative time step" '$.time_step is -1, allowed > 0' '"time_step": -1'
+bad "negative thickness" '$.materials.rachis.thickness is -0.001, allowed [1e-09, 1] m' '"materials": {"rachis": {"thickness": -0.001}}'
+bad "zero time step" '$.time_step is 0, allowed [1e-09, 100] s' '"time_step": 0'
+bad "negative time step" '$.time_step is -1, allowed [1e-09, 100] s' '"time_step": -1'
 bad "unknown key" 'did you mean "duration"' '"durations": 1'
 expect_failure "missing scene" 4 "missing.json" "$plume" simulate "$scratch/missing.json" -o "$scratch/none"
 check "missing scene: nothing written" test ! -e "$scratch/none"
