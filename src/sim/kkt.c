@@ -155,7 +155,12 @@ static void shift_positions(plume_kkt *kkt, double amount)
 plume_status plume_kkt_factor(plume_kkt *kkt, bool allow_shift, double *shift, plume_error *err)
 {
 	*shift = 0;
-	if (plume_sparse_factor(&kkt->system))
+	bool factored = plume_sparse_factor(&kkt->system);
+	if (factored && !allow_shift && kkt->constraint_count > 0 &&
+	    plume_sparse_negative_pivots(&kkt->system) != kkt->constraint_count)
+		return plume_error_set(err, PLUME_ERROR_NUMERIC,
+		                       "the Newton matrix is not positive definite on the constraints' tangent space");
+	if (factored)
 		return PLUME_OK;
 	if (!allow_shift)
 		return plume_error_set(err, PLUME_ERROR_NUMERIC, "the Newton matrix is not positive definite");
@@ -189,7 +194,42 @@ static plume_status solve_once(plume_kkt *kkt, const double *rhs, double *soluti
 	return PLUME_OK;
 }
 
+/// At most this many refinement steps (each one solve); refinement stops earlier once
+/// the backward error is below REFINEMENT_TOLERANCE or stops falling.
 enum { REFINEMENT_STEPS = 3 };
+static const double REFINEMENT_TOLERANCE = 1e-14;
+
+/// residual = rhs - K0 x with K0 the matrix without the -d diagonal of the constraint rows,
+/// and the componentwise backward error max_i |residual_i| / (|K0| |x| + |rhs|)_i
+/// (Arioli, Demmel & Duff 1989): the relative change of K0's entries and of rhs that makes
+/// x exact. Rows whose denominator is zero (held unknowns, zero rows) do not count.
+static double backward_error(const plume_kkt *kkt, const double *rhs, const double *x, double *residual, double *scale)
+{
+	const int *p = kkt->system.matrix->p, *rows = kkt->system.matrix->i;
+	const double *values = kkt->system.matrix->x;
+	size_t size = kkt->system.matrix->ncol;
+	for (size_t i = 0; i < size; ++i) {
+		residual[i] = rhs[i];
+		scale[i] = fabs(rhs[i]);
+	}
+	for (size_t j = 0; j < size; ++j)
+		for (int e = p[j]; e < p[j + 1]; ++e) {
+			size_t i = (size_t)rows[e];
+			if (i == j && (int)j >= kkt->dof_count)
+				continue; // the regularisation: K0 has 0 there
+			residual[i] -= values[e] * x[j];
+			scale[i] += fabs(values[e] * x[j]);
+			if (i != j) {
+				residual[j] -= values[e] * x[i];
+				scale[j] += fabs(values[e] * x[i]);
+			}
+		}
+	double worst = 0;
+	for (size_t i = 0; i < size; ++i)
+		if (scale[i] > 0)
+			worst = fmax(worst, fabs(residual[i]) / scale[i]);
+	return worst;
+}
 
 plume_status plume_kkt_solve(plume_kkt *kkt, const double *rhs, double *solution, plume_error *err)
 {
@@ -197,21 +237,15 @@ plume_status plume_kkt_solve(plume_kkt *kkt, const double *rhs, double *solution
 	if (status != PLUME_OK || kkt->constraint_count == 0)
 		return status;
 	size_t size = kkt->system.rhs->nrow;
-	if (kkt->refine == NULL && (kkt->refine = plume_alloc(2 * sizeof(double) * size)) == NULL)
+	if (kkt->refine == NULL && (kkt->refine = plume_alloc(3 * sizeof(double) * size)) == NULL)
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory refining the Newton step");
-	double *residual = kkt->refine, *correction = kkt->refine + size;
-	const double *values = kkt->system.matrix->x;
-	for (int step = 0; step < REFINEMENT_STEPS; ++step) {
-		// residual = rhs - K0 x, K0 the matrix without the -d diagonal of the constraint rows.
-		for (size_t i = 0; i < size; ++i)
-			residual[i] = -rhs[i];
-		plume_kkt_multiply_add(kkt, solution, residual);
-		for (int k = 0; k < kkt->constraint_count; ++k) {
-			size_t row = (size_t)(kkt->dof_count + k);
-			residual[row] -= values[kkt->constraint_slots[7 * k + 6]] * solution[row];
-		}
-		for (size_t i = 0; i < size; ++i)
-			residual[i] = -residual[i];
+	double *residual = kkt->refine, *correction = kkt->refine + size, *scale = kkt->refine + 2 * size;
+	double previous = INFINITY;
+	for (int step = 0;; ++step) {
+		double error = backward_error(kkt, rhs, solution, residual, scale);
+		if (step == REFINEMENT_STEPS || error <= REFINEMENT_TOLERANCE || !(error < 0.5 * previous))
+			break;
+		previous = error;
 		if ((status = solve_once(kkt, residual, correction, err)) != PLUME_OK)
 			return status;
 		for (size_t i = 0; i < size; ++i)

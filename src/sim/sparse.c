@@ -101,3 +101,15 @@ bool plume_sparse_solve(plume_sparse *s)
 	return cholmod_solve2(CHOLMOD_A, s->factor, s->rhs, NULL, &s->solution, NULL, &s->work_y, &s->work_e, &s->common) !=
 	       0;
 }
+
+int plume_sparse_negative_pivots(const plume_sparse *s)
+{
+	if (s->factor->is_ll)
+		return 0;
+	const int *p = s->factor->p;
+	const double *x = s->factor->x;
+	int count = 0;
+	for (size_t j = 0; j < s->factor->n; ++j)
+		count += x[p[j]] < 0;
+	return count;
+}

@@ -54,6 +54,10 @@ int plume_csc_find(const cholmod_sparse *matrix, int row, int column);
 /// positivity test): the matrix then has no usable factorisation.
 bool plume_sparse_factor(plume_sparse *s);
 
+/// Number of negative pivots of the last LDL' factorisation (0 for LL'): by Sylvester's law
+/// of inertia, the number of negative eigenvalues of the factored matrix.
+int plume_sparse_negative_pivots(const plume_sparse *s);
+
 /// Solves with the last factorisation: s->rhs into s->solution. False on failure.
 bool plume_sparse_solve(plume_sparse *s);
 
