@@ -254,7 +254,8 @@ plume_status plume_sim_newton(plume_sim *sim, const sim_problem *problem, plume_
 	// factors, free once factored: one factorisation an iteration unless it fails. (The
 	// sign of g . dx is no test: on a constrained step it is positive whenever reaching
 	// the constraints costs potential, and the merit still descends.)
-	bool exact = false, exact_failed = false;
+	bool exact = !sim->exact_hessian_failed, exact_failed = false;
+	sim->exact_hessian_failed = false;
 	report->converged = false;
 	report->newton_iterations = 0;
 	sim->trace_count = 0;
@@ -287,7 +288,7 @@ plume_status plume_sim_newton(plume_sim *sim, const sim_problem *problem, plume_
 			// (its factors' inertia says so, kkt.h): project, and keep projecting for the
 			// rest of this solve rather than pay for that test again.
 			exact = false;
-			exact_failed = true;
+			exact_failed = sim->exact_hessian_failed = true;
 			status = newton_system(sim, problem, exact, &phi, &residual, report, err);
 			if (status == PLUME_OK)
 				status = factor_and_solve(sim, exact, report, err);
