@@ -29,13 +29,13 @@ static int push_block(entry_list *list, const int *vertices, int count)
 	return 0;
 }
 
-static void fill_block_slots(const cholmod_sparse *matrix, const int *vertices, int count, int *slots)
+static void fill_block_slots(const plume_sparse *system, const int *vertices, int count, int *slots)
 {
 	int n = 3 * count;
 	for (int a = 0; a < n; ++a)
 		for (int b = 0; b < n; ++b) {
 			int i = 3 * vertices[a / 3] + a % 3, j = 3 * vertices[b / 3] + b % 3;
-			slots[a * n + b] = i <= j ? plume_csc_find(matrix, i, j) : -1;
+			slots[a * n + b] = i <= j ? plume_sparse_find(system, i, j) : -1;
 		}
 }
 
@@ -82,7 +82,7 @@ plume_status plume_kkt_init(plume_kkt *kkt, int vertex_count, int face_count, co
 		plume_kkt_free(kkt);
 		return status;
 	}
-	const cholmod_sparse *matrix = kkt->system.matrix;
+	const plume_sparse *matrix = &kkt->system;
 
 	kkt->vertex_slots = plume_alloc(sizeof(int) * 9 * (size_t)(vertex_count > 0 ? vertex_count : 1));
 	kkt->face_slots = plume_alloc(sizeof(int) * 81 * (size_t)(face_count > 0 ? face_count : 1));
@@ -105,8 +105,8 @@ plume_status plume_kkt_init(plume_kkt *kkt, int vertex_count, int face_count, co
 		fill_block_slots(matrix, constraint_vertices + 2 * k, 2, kkt->pair_slots + 36 * k);
 		for (int a = 0; a < 6; ++a)
 			kkt->constraint_slots[7 * k + a] =
-			    plume_csc_find(matrix, 3 * constraint_vertices[2 * k + a / 3] + a % 3, column);
-		kkt->constraint_slots[7 * k + 6] = plume_csc_find(matrix, column, column);
+			    plume_sparse_find(matrix, 3 * constraint_vertices[2 * k + a / 3] + a % 3, column);
+		kkt->constraint_slots[7 * k + 6] = plume_sparse_find(matrix, column, column);
 	}
 
 	return PLUME_OK;
@@ -205,16 +205,16 @@ static const double REFINEMENT_TOLERANCE = 1e-14;
 /// x exact. Rows whose denominator is zero (held unknowns, zero rows) do not count.
 static double backward_error(const plume_kkt *kkt, const double *rhs, const double *x, double *residual, double *scale)
 {
-	const int *p = kkt->system.matrix->p, *rows = kkt->system.matrix->i;
+	const int *p = kkt->system.matrix->p, *rows = kkt->system.matrix->i, *unknown = kkt->system.permutation;
 	const double *values = kkt->system.matrix->x;
 	size_t size = kkt->system.matrix->ncol;
 	for (size_t i = 0; i < size; ++i) {
 		residual[i] = rhs[i];
 		scale[i] = fabs(rhs[i]);
 	}
-	for (size_t j = 0; j < size; ++j)
-		for (int e = p[j]; e < p[j + 1]; ++e) {
-			size_t i = (size_t)rows[e];
+	for (size_t column = 0; column < size; ++column)
+		for (int e = p[column]; e < p[column + 1]; ++e) {
+			size_t i = (size_t)unknown[rows[e]], j = (size_t)unknown[column];
 			if (i == j && (int)j >= kkt->dof_count)
 				continue; // the regularisation: K0 has 0 there
 			residual[i] -= values[e] * x[j];
@@ -256,11 +256,11 @@ plume_status plume_kkt_solve(plume_kkt *kkt, const double *rhs, double *solution
 
 void plume_kkt_multiply_add(const plume_kkt *kkt, const double *x, double *y)
 {
-	const int *p = kkt->system.matrix->p, *rows = kkt->system.matrix->i;
+	const int *p = kkt->system.matrix->p, *rows = kkt->system.matrix->i, *unknown = kkt->system.permutation;
 	const double *values = kkt->system.matrix->x;
-	for (size_t j = 0; j < kkt->system.matrix->ncol; ++j)
-		for (int e = p[j]; e < p[j + 1]; ++e) {
-			size_t i = (size_t)rows[e];
+	for (size_t column = 0; column < kkt->system.matrix->ncol; ++column)
+		for (int e = p[column]; e < p[column + 1]; ++e) {
+			size_t i = (size_t)unknown[rows[e]], j = (size_t)unknown[column];
 			y[i] += values[e] * x[j];
 			if (i != j)
 				y[j] += values[e] * x[i];
