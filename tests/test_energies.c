@@ -30,6 +30,11 @@ static double compression_fn(const void *element, const plume_vec3 *x, double *g
 	return plume_compression_energy(element, x, gradient, hessian);
 }
 
+static double triangle_fn(const void *element, const plume_vec3 *x, double *gradient, double *hessian)
+{
+	return plume_triangle_energy(element, x, gradient, hessian, false);
+}
+
 static double hinge_fn(const void *element, const plume_vec3 *x, double *gradient, double *hessian)
 {
 	return plume_hinge_energy(element, x, gradient, hessian);
@@ -916,6 +921,71 @@ static void test_project_psd_translation_free(void **state)
 	assert_true(changed >= 30);
 }
 
+/// The triangle's energy (membrane + compression on one strain evaluation): exact
+/// derivatives equal the two terms' sum and finite differences; the projected Hessian
+/// (stress clamped, strain-space curvature projected) is positive semidefinite, keeps
+/// the gradient, and equals the exact Hessian on a triangle in tension.
+static void test_triangle_energy_and_projection(void **state)
+{
+	(void)state;
+	plume_rng rng = plume_rng_seed(12);
+	int projected = 0;
+	for (int trial = 0; trial < 60; ++trial) {
+		double voigt[9];
+		if (trial % 3 == 2)
+			plume_isotropic_tensor(34e6, 0.49, voigt);
+		else
+			plume_orthotropic_tensor(3.6e8, 4.8e4, 2e4, plume_rng_range(&rng, -PI, PI), voigt);
+		plume_vec2 reference[3];
+		random_triangle(&rng, reference);
+		plume_membrane_element element;
+		assert_true(plume_membrane_element_init(&element, (int[]){0, 1, 2}, reference, 1.2e-4, voigt, 5.04e7));
+		bool tension = trial % 4 == 0;
+		// In tension: stretched 2-10 % along both reference axes, then rotated; otherwise
+		// shrunk and sheared at random (compression active on most of them).
+		double shrink = tension ? 1.0 : plume_rng_range(&rng, 0.5, 1.05);
+		plume_vec2 scaled[3];
+		double sx = tension ? plume_rng_range(&rng, 1.02, 1.1) : shrink;
+		double sy = tension ? plume_rng_range(&rng, 1.02, 1.1) : shrink;
+		for (int i = 0; i < 3; ++i)
+			scaled[i] = (plume_vec2){sx * reference[i].x, sy * reference[i].y};
+		plume_vec3 x[3];
+		if (tension) {
+			plume_mat3 R = random_rotation(&rng);
+			for (int i = 0; i < 3; ++i)
+				x[i] = plume_m3_apply(R, embed(scaled[i]));
+		} else {
+			deform(&rng, scaled, 3, 0.2, 0.05, x);
+		}
+		double g[9], H[81], gm[9], Hm[81], gc[9], Hc[81], gp[9], P[81];
+		double energy = plume_triangle_energy(&element, x, g, H, false);
+		double sum = plume_membrane_energy(&element, x, gm, Hm) + plume_compression_energy(&element, x, gc, Hc);
+		assert_close(energy, sum, 1e-13 * fabs(sum));
+		double scale = norm(Hm, 81) + norm(Hc, 81);
+		for (int i = 0; i < 9; ++i)
+			assert_close(g[i], gm[i] + gc[i], 1e-12 * (norm(gm, 9) + norm(gc, 9)));
+		for (int i = 0; i < 81; ++i)
+			assert_close(H[i], Hm[i] + Hc[i], 1e-12 * scale);
+		assert_true(finite_difference_error(triangle_fn, &element, x, 3, 1e-6) < 1e-6);
+
+		assert_true(plume_triangle_energy(&element, x, gp, P, true) == energy);
+		assert_memory_equal(gp, g, sizeof g);
+		double values[9];
+		plume_symmetric_eigen(P, 9, values, NULL);
+		for (int k = 0; k < 9; ++k)
+			assert_true(values[k] >= -1e-12 * norm(P, 81));
+		for (int r = 0; r < 9; ++r)
+			for (int c = 0; c < 9; ++c)
+				assert_true(P[9 * r + c] == P[9 * c + r]);
+		if (tension)
+			assert_memory_equal(P, H, sizeof H);
+		projected += memcmp(P, H, sizeof H) != 0;
+	}
+	// Most of the shrunk triangles are indefinite: the projection is exercised.
+	print_message("projected Hessians that differ from the exact one: %d of 60\n", projected);
+	assert_true(projected >= 30);
+}
+
 // ---------------------------------------------------------------------------
 // Materials of thesis Table 6.1
 
@@ -963,6 +1033,7 @@ int main(void)
 	    cmocka_unit_test(test_cylinder_bending_energy),
 	    cmocka_unit_test(test_project_psd),
 	    cmocka_unit_test(test_project_psd_translation_free),
+	    cmocka_unit_test(test_triangle_energy_and_projection),
 	    cmocka_unit_test(test_table_6_1_materials),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);

@@ -3,9 +3,24 @@
 // keyframes, and the errors of bad scene specs.
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "support.h"
+
+/// The positions after the last step of run_scene.
+static plume_vec3 *final_positions;
+static int final_count;
+
+static plume_status keep_positions(void *user, int step, double time, const plume_sim *sim,
+                                   const plume_solve_report *report, double wall_seconds, plume_error *err)
+{
+	(void)user, (void)step, (void)time, (void)report, (void)wall_seconds, (void)err;
+	final_count = plume_sim_vertex_count(sim);
+	final_positions = realloc(final_positions, sizeof(plume_vec3) * (size_t)final_count);
+	memcpy(final_positions, plume_sim_positions(sim), sizeof(plume_vec3) * (size_t)final_count);
+	return PLUME_OK;
+}
 
 static plume_scene_summary run_scene(const char *name)
 {
@@ -16,11 +31,40 @@ static plume_scene_summary run_scene(const char *name)
 	if (plume_scene_load(path, NULL, &scene, &err) != PLUME_OK)
 		fail_msg("%s", err.message);
 	plume_scene_summary summary;
-	if (plume_scene_run(scene, NULL, NULL, &summary, &err) != PLUME_OK)
+	if (plume_scene_run(scene, keep_positions, NULL, &summary, &err) != PLUME_OK)
 		fail_msg("%s", err.message);
 	assert_true(scene->mesh_report.aligned_fraction == 1);
 	plume_scene_destroy(scene);
 	return summary;
+}
+
+/// Compares final_positions with a fixture of positions recorded by an earlier solver
+/// (issue 15: a faster linear algebra must converge to the same state, to 1e-9 m).
+/// PLUME_RECORD_POSITIONS=1 in the environment rewrites the fixture instead.
+static void compare_positions(const char *name)
+{
+	char path[1024];
+	snprintf(path, sizeof path, "%s/tests/data/%s", PLUME_SOURCE_DIR, name);
+	const char *record = getenv("PLUME_RECORD_POSITIONS");
+	FILE *file = fopen(path, record && record[0] == '1' ? "w" : "r");
+	assert_non_null(file);
+	double worst = 0;
+	for (int i = 0; i < final_count; ++i) {
+		plume_vec3 p = final_positions[i], q;
+		if (record && record[0] == '1') {
+			fprintf(file, "%.17g %.17g %.17g\n", p.x, p.y, p.z);
+			continue;
+		}
+		assert_int_equal(fscanf(file, "%lf %lf %lf", &q.x, &q.y, &q.z), 3);
+		worst = fmax(worst, plume_v3_distance(p, q));
+	}
+	double extra;
+	assert_true(record || fscanf(file, "%lf", &extra) == EOF); // as many vertices as recorded
+	fclose(file);
+	free(final_positions);
+	final_positions = NULL;
+	printf("%s: largest distance to the recorded positions %.3g m\n", name, worst);
+	assert_true(worst <= 1e-9);
 }
 
 /// Paper Figure 1: with inextensible barbs the pull on the vane tip bends the rachis;
@@ -30,7 +74,10 @@ static void test_figure1_anisotropic_bends_the_rachis(void **state)
 {
 	(void)state;
 	plume_scene_summary anisotropic = run_scene("figure1-coarse-anisotropic.json");
+	compare_positions("figure1-coarse-anisotropic-positions.txt");
 	plume_scene_summary isotropic = run_scene("figure1-coarse-isotropic.json");
+	free(final_positions);
+	final_positions = NULL;
 	printf("rachis tip deflection: anisotropic %.4g m (%d steps, %d Newton iterations, barb strain %.3g), "
 	       "isotropic %.4g m (barb strain %.3g), ratio %.3f\n",
 	       anisotropic.rachis_tip_deflection, anisotropic.steps, anisotropic.newton_iterations,
@@ -81,7 +128,8 @@ static void expect_error(const char *text, plume_status status, const char *mess
 	assert_int_equal(plume_bytes_in_use(), 0);
 }
 
-#define FEATHER "\"feather\": \"" PLUME_SOURCE_DIR "/examples/franco-walter/blue.json\", \"mesh\": {\"edge_length\": 0.01}"
+#define FEATHER                                                                                                        \
+	"\"feather\": \"" PLUME_SOURCE_DIR "/examples/franco-walter/blue.json\", \"mesh\": {\"edge_length\": 0.01}"
 
 static void test_bad_scenes(void **state)
 {
@@ -98,7 +146,8 @@ static void test_bad_scenes(void **state)
 	             "did you mean \"orthotropic\"?");
 	expect_error("{" FEATHER ", \"duraton\": 1}", PLUME_ERROR_SPEC, "duration");
 	expect_error("{\"mesh\": {}}", PLUME_ERROR_SPEC, "exactly one of \"feather\"");
-	expect_error("{" FEATHER ", \"handles\": [{\"group\": \"rachis_tip\", \"keyframes\": [{\"time\": 1}, {\"time\": 0.5}]}]}",
+	expect_error("{" FEATHER
+	             ", \"handles\": [{\"group\": \"rachis_tip\", \"keyframes\": [{\"time\": 1}, {\"time\": 0.5}]}]}",
 	             PLUME_ERROR_SPEC, "keyframe times must be >= 0 and increasing");
 }
 

@@ -333,7 +333,7 @@ static plume_status build_matrix(plume_quadratic *m, plume_error *err)
 				int i = m->free_index[2 * nodes[r / 2] + r % 2], j = m->free_index[2 * nodes[c / 2] + c % 2];
 				// Each unordered pair once: (r, c) with i < j; i == j only on the diagonal r == c.
 				m->slots[(size_t)el * BLOCK + r * DOFS + c] =
-				    i >= 0 && j >= 0 && i <= j ? plume_csc_find(m->system.matrix, i, j) : -1;
+				    i >= 0 && j >= 0 && i <= j ? plume_sparse_find(&m->system, i, j) : -1;
 			}
 	}
 	return PLUME_OK;

@@ -8,29 +8,24 @@
 #include <math.h>
 #include <string.h>
 
-double plume_compression_energy(const plume_membrane_element *element, const plume_vec3 x[3], double gradient[9],
-                                double hessian[81])
+bool plume_compression_density(const plume_membrane_element *element, const double strain[3], double *psi,
+                               double dpsi[3], double d2psi[9])
 {
-	if (gradient)
-		memset(gradient, 0, 9 * sizeof(double));
-	if (hessian)
-		memset(hessian, 0, 81 * sizeof(double));
+	*psi = 0.0;
 	if (element->compression == 0.0)
-		return 0.0;
-	plume_green_strain strain;
-	plume_green_strain_eval(element, x, &strain);
-	const double *e = strain.strain;
+		return false;
+	const double *e = strain;
 	// F^T F = I + 2 eps, so J^2 = det(F^T F) = (1 + 2 e0)(1 + 2 e1) - e2^2 with e2 = 2 eps_xy.
 	double a = 1.0 + 2.0 * e[0], b = 1.0 + 2.0 * e[1];
 	double J = sqrt(fmax(a * b - e[2] * e[2], 0.0));
 	if (J >= 1.0)
-		return 0.0;
+		return false;
 	// psi(J) = c u^3 with u = (1 - J)/6 and c = b kappa / 12.
 	double c = element->compression / 12.0;
 	double u = (1.0 - J) / 6.0;
-	double energy = element->area * c * u * u * u;
-	if ((!gradient && !hessian) || !(J > 0.0))
-		return energy;
+	*psi = c * u * u * u;
+	if (dpsi == NULL || !(J > 0.0))
+		return false;
 	double psi_J = -0.5 * c * u * u; // d psi / dJ
 	double psi_JJ = c * u / 6.0;     // d2 psi / dJ2
 	// d = J^2 and its strain derivatives; then J = sqrt(d).
@@ -42,12 +37,30 @@ double plume_compression_energy(const plume_membrane_element *element, const plu
 	for (int k = 0; k < 3; ++k)
 		for (int l = 0; l < 3; ++l)
 			d2J[3 * k + l] = d2d[3 * k + l] / (2.0 * J) - dd[k] * dd[l] / (4.0 * J * J * J);
-	double dpsi[3], d2psi[9];
 	for (int k = 0; k < 3; ++k) {
 		dpsi[k] = psi_J * dJ[k];
 		for (int l = 0; l < 3; ++l)
 			d2psi[3 * k + l] = psi_JJ * dJ[k] * dJ[l] + psi_J * d2J[3 * k + l];
 	}
-	plume_green_strain_chain(&strain, element->area, dpsi, d2psi, gradient, hessian);
+	return true;
+}
+
+double plume_compression_energy(const plume_membrane_element *element, const plume_vec3 x[3], double gradient[9],
+                                double hessian[81])
+{
+	if (gradient)
+		memset(gradient, 0, 9 * sizeof(double));
+	if (hessian)
+		memset(hessian, 0, 81 * sizeof(double));
+	if (element->compression == 0.0)
+		return 0.0;
+	plume_green_strain strain;
+	plume_green_strain_eval(element, x, &strain);
+	double psi, dpsi[3], d2psi[9];
+	bool derivatives =
+	    plume_compression_density(element, strain.strain, &psi, (gradient || hessian) ? dpsi : NULL, d2psi);
+	double energy = element->area * psi;
+	if (derivatives)
+		plume_green_strain_chain(&strain, element->area, dpsi, d2psi, gradient, hessian);
 	return energy;
 }

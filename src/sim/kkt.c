@@ -29,13 +29,13 @@ static int push_block(entry_list *list, const int *vertices, int count)
 	return 0;
 }
 
-static void fill_block_slots(const cholmod_sparse *matrix, const int *vertices, int count, int *slots)
+static void fill_block_slots(const plume_sparse *system, const int *vertices, int count, int *slots)
 {
 	int n = 3 * count;
 	for (int a = 0; a < n; ++a)
 		for (int b = 0; b < n; ++b) {
 			int i = 3 * vertices[a / 3] + a % 3, j = 3 * vertices[b / 3] + b % 3;
-			slots[a * n + b] = i <= j ? plume_csc_find(matrix, i, j) : -1;
+			slots[a * n + b] = i <= j ? plume_sparse_find(system, i, j) : -1;
 		}
 }
 
@@ -82,7 +82,7 @@ plume_status plume_kkt_init(plume_kkt *kkt, int vertex_count, int face_count, co
 		plume_kkt_free(kkt);
 		return status;
 	}
-	const cholmod_sparse *matrix = kkt->system.matrix;
+	const plume_sparse *matrix = &kkt->system;
 
 	kkt->vertex_slots = plume_alloc(sizeof(int) * 9 * (size_t)(vertex_count > 0 ? vertex_count : 1));
 	kkt->face_slots = plume_alloc(sizeof(int) * 81 * (size_t)(face_count > 0 ? face_count : 1));
@@ -105,8 +105,8 @@ plume_status plume_kkt_init(plume_kkt *kkt, int vertex_count, int face_count, co
 		fill_block_slots(matrix, constraint_vertices + 2 * k, 2, kkt->pair_slots + 36 * k);
 		for (int a = 0; a < 6; ++a)
 			kkt->constraint_slots[7 * k + a] =
-			    plume_csc_find(matrix, 3 * constraint_vertices[2 * k + a / 3] + a % 3, column);
-		kkt->constraint_slots[7 * k + 6] = plume_csc_find(matrix, column, column);
+			    plume_sparse_find(matrix, 3 * constraint_vertices[2 * k + a / 3] + a % 3, column);
+		kkt->constraint_slots[7 * k + 6] = plume_sparse_find(matrix, column, column);
 	}
 
 	return PLUME_OK;
@@ -155,7 +155,12 @@ static void shift_positions(plume_kkt *kkt, double amount)
 plume_status plume_kkt_factor(plume_kkt *kkt, bool allow_shift, double *shift, plume_error *err)
 {
 	*shift = 0;
-	if (plume_sparse_factor(&kkt->system))
+	bool factored = plume_sparse_factor(&kkt->system);
+	if (factored && !allow_shift && kkt->constraint_count > 0 &&
+	    plume_sparse_negative_pivots(&kkt->system) != kkt->constraint_count)
+		return plume_error_set(err, PLUME_ERROR_NUMERIC,
+		                       "the Newton matrix is not positive definite on the constraints' tangent space");
+	if (factored)
 		return PLUME_OK;
 	if (!allow_shift)
 		return plume_error_set(err, PLUME_ERROR_NUMERIC, "the Newton matrix is not positive definite");
@@ -189,7 +194,42 @@ static plume_status solve_once(plume_kkt *kkt, const double *rhs, double *soluti
 	return PLUME_OK;
 }
 
+/// At most this many refinement steps (each one solve); refinement stops earlier once
+/// the backward error is below REFINEMENT_TOLERANCE or stops falling.
 enum { REFINEMENT_STEPS = 3 };
+static const double REFINEMENT_TOLERANCE = 1e-14;
+
+/// residual = rhs - K0 x with K0 the matrix without the -d diagonal of the constraint rows,
+/// and the componentwise backward error max_i |residual_i| / (|K0| |x| + |rhs|)_i
+/// (Arioli, Demmel & Duff 1989): the relative change of K0's entries and of rhs that makes
+/// x exact. Rows whose denominator is zero (held unknowns, zero rows) do not count.
+static double backward_error(const plume_kkt *kkt, const double *rhs, const double *x, double *residual, double *scale)
+{
+	const int *p = kkt->system.matrix->p, *rows = kkt->system.matrix->i, *unknown = kkt->system.permutation;
+	const double *values = kkt->system.matrix->x;
+	size_t size = kkt->system.matrix->ncol;
+	for (size_t i = 0; i < size; ++i) {
+		residual[i] = rhs[i];
+		scale[i] = fabs(rhs[i]);
+	}
+	for (size_t column = 0; column < size; ++column)
+		for (int e = p[column]; e < p[column + 1]; ++e) {
+			size_t i = (size_t)unknown[rows[e]], j = (size_t)unknown[column];
+			if (i == j && (int)j >= kkt->dof_count)
+				continue; // the regularisation: K0 has 0 there
+			residual[i] -= values[e] * x[j];
+			scale[i] += fabs(values[e] * x[j]);
+			if (i != j) {
+				residual[j] -= values[e] * x[i];
+				scale[j] += fabs(values[e] * x[i]);
+			}
+		}
+	double worst = 0;
+	for (size_t i = 0; i < size; ++i)
+		if (scale[i] > 0)
+			worst = fmax(worst, fabs(residual[i]) / scale[i]);
+	return worst;
+}
 
 plume_status plume_kkt_solve(plume_kkt *kkt, const double *rhs, double *solution, plume_error *err)
 {
@@ -197,21 +237,15 @@ plume_status plume_kkt_solve(plume_kkt *kkt, const double *rhs, double *solution
 	if (status != PLUME_OK || kkt->constraint_count == 0)
 		return status;
 	size_t size = kkt->system.rhs->nrow;
-	if (kkt->refine == NULL && (kkt->refine = plume_alloc(2 * sizeof(double) * size)) == NULL)
+	if (kkt->refine == NULL && (kkt->refine = plume_alloc(3 * sizeof(double) * size)) == NULL)
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory refining the Newton step");
-	double *residual = kkt->refine, *correction = kkt->refine + size;
-	const double *values = kkt->system.matrix->x;
-	for (int step = 0; step < REFINEMENT_STEPS; ++step) {
-		// residual = rhs - K0 x, K0 the matrix without the -d diagonal of the constraint rows.
-		for (size_t i = 0; i < size; ++i)
-			residual[i] = -rhs[i];
-		plume_kkt_multiply_add(kkt, solution, residual);
-		for (int k = 0; k < kkt->constraint_count; ++k) {
-			size_t row = (size_t)(kkt->dof_count + k);
-			residual[row] -= values[kkt->constraint_slots[7 * k + 6]] * solution[row];
-		}
-		for (size_t i = 0; i < size; ++i)
-			residual[i] = -residual[i];
+	double *residual = kkt->refine, *correction = kkt->refine + size, *scale = kkt->refine + 2 * size;
+	double previous = INFINITY;
+	for (int step = 0;; ++step) {
+		double error = backward_error(kkt, rhs, solution, residual, scale);
+		if (step == REFINEMENT_STEPS || error <= REFINEMENT_TOLERANCE || !(error < 0.5 * previous))
+			break;
+		previous = error;
 		if ((status = solve_once(kkt, residual, correction, err)) != PLUME_OK)
 			return status;
 		for (size_t i = 0; i < size; ++i)
@@ -222,11 +256,11 @@ plume_status plume_kkt_solve(plume_kkt *kkt, const double *rhs, double *solution
 
 void plume_kkt_multiply_add(const plume_kkt *kkt, const double *x, double *y)
 {
-	const int *p = kkt->system.matrix->p, *rows = kkt->system.matrix->i;
+	const int *p = kkt->system.matrix->p, *rows = kkt->system.matrix->i, *unknown = kkt->system.permutation;
 	const double *values = kkt->system.matrix->x;
-	for (size_t j = 0; j < kkt->system.matrix->ncol; ++j)
-		for (int e = p[j]; e < p[j + 1]; ++e) {
-			size_t i = (size_t)rows[e];
+	for (size_t column = 0; column < kkt->system.matrix->ncol; ++column)
+		for (int e = p[column]; e < p[column + 1]; ++e) {
+			size_t i = (size_t)unknown[rows[e]], j = (size_t)unknown[column];
 			y[i] += values[e] * x[j];
 			if (i != j)
 				y[j] += values[e] * x[i];

@@ -9,6 +9,8 @@
 #include <math.h>
 #include <string.h>
 
+#include "sim/dense.h"
+
 void plume_orthotropic_tensor(double E_vv, double E_ww, double E_vw, double theta, double voigt[9])
 {
 	// The barb-frame strain (eps_vv, eps_ww, 2 eps_vw) is T * (eps_xx, eps_yy, 2 eps_xy) with
@@ -159,5 +161,65 @@ double plume_membrane_energy(const plume_membrane_element *element, const plume_
 	double energy = element->area * 0.5 * (stress[0] * e[0] + stress[1] * e[1] + stress[2] * e[2]);
 	if (gradient || hessian)
 		plume_green_strain_chain(&strain, element->area, stress, C, gradient, hessian);
+	return energy;
+}
+
+/// The positive semidefinite part of the 2 x 2 symmetric stress [[s0, s2], [s2, s1]] in place
+/// (Voigt order s0, s1, s2): with eigenvalues m -/+ r, S+ = 0 when m + r <= 0, S when
+/// m - r >= 0, and otherwise lambda+ v v^T = lambda+ (S - lambda- I) / (2 r).
+static void clamp_stress(double s[3])
+{
+	double mean = 0.5 * (s[0] + s[1]), half = 0.5 * (s[0] - s[1]);
+	double r = sqrt(half * half + s[2] * s[2]);
+	double low = mean - r, high = mean + r;
+	if (low >= 0.0)
+		return;
+	if (high <= 0.0) {
+		s[0] = s[1] = s[2] = 0.0;
+		return;
+	}
+	double scale = high / (2.0 * r);
+	s[0] = scale * (s[0] - low);
+	s[1] = scale * (s[1] - low);
+	s[2] = scale * s[2];
+}
+
+double plume_triangle_energy(const plume_membrane_element *element, const plume_vec3 x[3], double gradient[9],
+                             double hessian[81], bool project)
+{
+	plume_green_strain strain;
+	plume_green_strain_eval(element, x, &strain);
+	const double *C = element->stiffness;
+	const double *e = strain.strain;
+	// Membrane (paper eq. 5): psi = (1/2) e^T C e, dpsi = C e, d2psi = C.
+	double dpsi[3], d2psi[9];
+	for (int k = 0; k < 3; ++k)
+		dpsi[k] = C[3 * k] * e[0] + C[3 * k + 1] * e[1] + C[3 * k + 2] * e[2];
+	double energy = element->area * 0.5 * (dpsi[0] * e[0] + dpsi[1] * e[1] + dpsi[2] * e[2]);
+	memcpy(d2psi, C, sizeof d2psi);
+	// Kikuuwe compression (thesis eq. 6.6), on the same strain.
+	double psi_c, dpsi_c[3], d2psi_c[9];
+	bool compressed = plume_compression_density(element, e, &psi_c, (gradient || hessian) ? dpsi_c : NULL, d2psi_c);
+	energy += element->area * psi_c;
+	if (compressed)
+		for (int k = 0; k < 3; ++k) {
+			dpsi[k] += dpsi_c[k];
+			for (int l = 0; l < 3; ++l)
+				d2psi[3 * k + l] += d2psi_c[3 * k + l];
+		}
+	if (!project || hessian == NULL) {
+		if (gradient || hessian)
+			plume_green_strain_chain(&strain, element->area, dpsi, d2psi, gradient, hessian);
+		return energy;
+	}
+	if (gradient)
+		plume_green_strain_chain(&strain, element->area, dpsi, d2psi, gradient, NULL);
+	// H = area (J^T d2psi J + (B^T S B) x I3), S the 2 x 2 stress: positive semidefinite
+	// when d2psi and S are. C is; the compression term may not be (then a 3 x 3
+	// projection), and S is not under compression (then clamped, closed form).
+	if (compressed && !plume_is_positive_semidefinite(d2psi, 3))
+		plume_project_psd(d2psi, 3);
+	clamp_stress(dpsi);
+	plume_green_strain_chain(&strain, element->area, dpsi, d2psi, NULL, hessian);
 	return energy;
 }

@@ -49,6 +49,23 @@ double plume_membrane_energy(const plume_membrane_element *element, const plume_
 double plume_compression_energy(const plume_membrane_element *element, const plume_vec3 x[3], double gradient[9],
                                 double hessian[81]);
 
+/// Kikuuwe density psi per unit reference area at Green strain (Voigt, reference frame):
+/// *psi always; with dpsi != NULL also its first (3) and second (3 x 3) strain derivatives,
+/// returning true when they were written (0 < J < 1), false when they are zero.
+bool plume_compression_density(const plume_membrane_element *element, const double strain[3], double *psi,
+                               double dpsi[3], double d2psi[9]);
+
+/// A shell triangle's in-plane energy: membrane plus compression (when element->compression
+/// > 0), with gradient and Hessian as above on one evaluation of the strain. With project,
+/// the Hessian is made positive semidefinite in strain space rather than by a 9 x 9
+/// eigen-decomposition: area (J^T P(d2psi) J + (B^T S+ B) x I3), with S+ the positive part
+/// of the 2 x 2 stress (closed form) and P(d2psi) d2psi projected when the compression term
+/// makes it indefinite (3 x 3). Not the nearest PSD matrix, but a PSD one that equals the
+/// exact Hessian wherever the element is in tension (S PSD, no compression term): the
+/// projected Newton steps are descent steps, and the exact ones are unchanged.
+double plume_triangle_energy(const plume_membrane_element *element, const plume_vec3 x[3], double gradient[9],
+                             double hessian[81], bool project);
+
 /// Green strain of a deformed triangle and its derivatives: the kinematics shared by every
 /// energy density psi(strain) of a triangle (library-internal).
 typedef struct plume_green_strain {

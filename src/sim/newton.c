@@ -8,8 +8,8 @@
 // curvature lambda_k (I - t t^T) / l. Each solve starts with per-element Hessians
 // projected to positive semidefinite and only the curvature of barbs in tension
 // (lambda_k > 0), which makes every step a descent step; once a full step is
-// accepted it switches to the exact H, and falls back when that does not factor or
-// gives no descent. A backtracking
+// accepted it switches to the exact H, and falls back when the inertia of its factors
+// shows it is not positive definite on the constraints' tangent space. A backtracking
 // line search on the exact l1
 // merit Phi + mu |c|_1 (mu above the largest multiplier) keeps every accepted
 // step a descent step; a second-order correction avoids the Maratos effect that
@@ -249,9 +249,13 @@ plume_status plume_sim_newton(plume_sim *sim, const sim_problem *problem, plume_
 	double mu = 0, scale = 0;
 	// Projected Hessians make every step a descent step far from the solution; near it
 	// they slow Newton to a linear rate (bending's indefinite part is dropped). Once a
-	// full step is accepted, try the exact Hessian, and fall back when it is not
-	// positive definite or gives no descent.
-	bool exact = false;
+	// full step is accepted, use the exact Hessian; fall back when it is not positive
+	// definite on the constraints' tangent space. That test is the inertia of the
+	// factors, free once factored: one factorisation an iteration unless it fails. (The
+	// sign of g . dx is no test: on a constrained step it is positive whenever reaching
+	// the constraints costs potential, and the merit still descends.)
+	bool exact = !sim->exact_hessian_failed, exact_failed = false;
+	sim->exact_hessian_failed = false;
 	report->converged = false;
 	report->newton_iterations = 0;
 	sim->trace_count = 0;
@@ -279,20 +283,21 @@ plume_status plume_sim_newton(plume_sim *sim, const sim_problem *problem, plume_
 			break;
 
 		status = factor_and_solve(sim, exact, report, err);
-		double slope = 0;
-		for (int i = 0; status == PLUME_OK && i < n3; ++i)
-			slope += g[i] * step[i];
-		if (exact && (status != PLUME_OK || slope >= 0)) {
+		if (exact && status != PLUME_OK) {
+			// The exact Hessian is not positive definite on the constraints' tangent space
+			// (its factors' inertia says so, kkt.h): project, and keep projecting for the
+			// rest of this solve rather than pay for that test again.
 			exact = false;
+			exact_failed = sim->exact_hessian_failed = true;
 			status = newton_system(sim, problem, exact, &phi, &residual, report, err);
 			if (status == PLUME_OK)
 				status = factor_and_solve(sim, exact, report, err);
-			slope = 0;
-			for (int i = 0; status == PLUME_OK && i < n3; ++i)
-				slope += g[i] * step[i];
 		}
 		if (status != PLUME_OK)
 			return status;
+		double slope = 0;
+		for (int i = 0; i < n3; ++i)
+			slope += g[i] * step[i];
 		++report->newton_iterations;
 
 		double largest_multiplier = 0, step_size = 0;
@@ -352,7 +357,7 @@ plume_status plume_sim_newton(plume_sim *sim, const sim_problem *problem, plume_
 		memcpy(x, sim->trial, sizeof(plume_vec3) * (size_t)sim->vertex_count);
 		for (int k = 0; k < m; ++k)
 			sim->lambda[k] += alpha * (step[n3 + k] - sim->lambda[k]);
-		exact = alpha == 1;
+		exact = alpha == 1 && !exact_failed;
 	}
 	report->max_barb_strain = plume_sim_max_barb_strain(sim, x);
 	return plume_error_set(err, PLUME_ERROR_NUMERIC,

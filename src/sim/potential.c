@@ -12,7 +12,6 @@
 #include <math.h>
 #include <string.h>
 
-#include "sim/dense.h"
 #include "sim/sim_internal.h"
 
 static void gather(const plume_vec3 *x, const int *vertices, int count, plume_vec3 *out)
@@ -31,18 +30,7 @@ static void evaluate_faces(plume_sim *sim, const plume_vec3 *x, bool gradient, b
 		gather(x, element->vertices, 3, local);
 		double *g = gradient ? sim->face_gradient + 9 * f : NULL;
 		double *h = hessian ? sim->face_hessian + 81 * f : NULL;
-		double energy = plume_membrane_energy(element, local, g, h);
-		if (element->compression > 0) {
-			double gc[9], hc[81];
-			energy += plume_compression_energy(element, local, g ? gc : NULL, h ? hc : NULL);
-			for (int i = 0; g != NULL && i < 9; ++i)
-				g[i] += gc[i];
-			for (int i = 0; h != NULL && i < 81; ++i)
-				h[i] += hc[i];
-		}
-		if (h != NULL && project && !plume_is_positive_semidefinite(h, 9))
-			plume_project_psd_translation_free(h, 3);
-		sim->face_energy[f] = energy;
+		sim->face_energy[f] = plume_triangle_energy(element, local, g, h, project);
 	}
 }
 

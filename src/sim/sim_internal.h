@@ -98,6 +98,9 @@ struct plume_sim {
 	plume_vec3 *previous;
 	plume_vec3 *predicted;
 	plume_vec3 *normals;
+	/// The last solve's exact Hessian was not positive definite on the constraints'
+	/// tangent space: the next solve starts projected (newton.c).
+	bool exact_hessian_failed;
 	/// Merit at each iteration of the last solve (tests check it decreases).
 	double trace[PLUME_SIM_TRACE];
 	int trace_count;
