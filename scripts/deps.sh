@@ -7,6 +7,8 @@ packages=(build-essential cmake pkg-config libcairo2-dev libjansson-dev libstb-d
 	libsuitesparse-dev libembree-dev libqhull-dev libplplot-dev)
 # The Python binding (python/) and its tests.
 packages+=(python3-cffi python3-numpy python3-pytest)
+# PNG decoding in the .glb texture check (tests/glb_check.py) and the plots of python/examples.
+packages+=(python3-matplotlib)
 
 missing=()
 for package in "${packages[@]}"; do
