@@ -46,7 +46,7 @@ static double relative(double a, double b, double floor) { return fabs(a - b) / 
 static void test_air_face_derivatives(void **state)
 {
 	(void)state;
-	sim_air_face face = {0.5 * 1.2 * 3e-4, 1.17 * 1.3, 0.07, plume_v3_normalize(plume_v3(0.2, -0.1, 1)),
+	sim_air_face face = {0.5 * 1.2 * 3e-4,        1.17 * 1.3, 0.07, 0.4, plume_v3_normalize(plume_v3(0.2, -0.1, 1)),
 	                     plume_v3(0.3, -0.2, 0.1)};
 	const double s = 1 / 0.011;
 	plume_vec3 x[3] = {{0.001, 0.002, 0.003}, {0.021, 0.001, -0.002}, {0.004, 0.018, 0.006}};
@@ -232,6 +232,90 @@ static void test_swing_keeps_its_energy(void **state)
 	assert_int_equal(plume_bytes_in_use(), 0);
 }
 
+typedef struct fall_trace {
+	const plume_mesh *mesh;
+	int count;
+	double time[400];
+	double height[400];    ///< area-weighted centroid z, m
+	double drift[400];     ///< centroid x, m
+	double alignment[400]; ///< |n . z| of the area-weighted mean normal: 1 flat, 0 edge-on
+} fall_trace;
+
+static plume_status record_fall(void *user, int step, double time, const plume_sim *sim,
+                                const plume_solve_report *report, double wall_seconds, plume_error *err)
+{
+	(void)step, (void)report, (void)wall_seconds, (void)err;
+	fall_trace *trace = user;
+	const plume_vec3 *x = plume_sim_positions(sim);
+	plume_vec3 normal = {0, 0, 0}, centre = {0, 0, 0};
+	double total = 0;
+	for (int f = 0; f < trace->mesh->face_count; ++f) {
+		const int *v = trace->mesh->faces + 3 * f;
+		plume_vec3 cross = plume_v3_cross(plume_v3_sub(x[v[1]], x[v[0]]), plume_v3_sub(x[v[2]], x[v[0]]));
+		double area = 0.5 * plume_v3_length(cross);
+		normal = plume_v3_add(normal, cross);
+		centre = plume_v3_mad(centre, area / 3, plume_v3_add(plume_v3_add(x[v[0]], x[v[1]]), x[v[2]]));
+		total += area;
+	}
+	if (trace->count < 400) {
+		trace->time[trace->count] = time;
+		trace->height[trace->count] = centre.z / total;
+		trace->drift[trace->count] = centre.x / total;
+		trace->alignment[trace->count] = fabs(normal.z) / plume_v3_length(normal);
+		++trace->count;
+	}
+	return PLUME_OK;
+}
+
+/// A coarse examples/scenes/falling.json for the given seconds, with extra air keys.
+static fall_trace *run_fall(double duration, const char *air)
+{
+	char format[1024];
+	snprintf(format, sizeof format,
+	         "{\"feather\": \"%%s/examples/franco-walter/hawk.json\", \"mesh\": {\"edge_length\": 0.012, "
+	         "\"rachis_width_base\": 0.008, \"rachis_width_tip\": 0.004}, \"gravity\": [0, 0, -9.81], "
+	         "\"air\": {\"density\": 1.2%%s}, \"integrator\": \"bdf2\", \"time_step\": 0.011, "
+	         "\"duration\": %g}",
+	         duration);
+	plume_scene *scene = parse_scene(format, air);
+	fall_trace *trace = calloc(1, sizeof *trace);
+	trace->mesh = scene->mesh;
+	plume_scene_summary summary;
+	plume_error err = {0};
+	if (plume_scene_run(scene, record_fall, trace, &summary, &err) != PLUME_OK)
+		fail_msg("%s", err.message);
+	plume_scene_destroy(scene);
+	return trace;
+}
+
+/// Issue 13: the falling feather reaches a steady descent well below free fall and below
+/// its own broadside terminal speed (it glides), in the range docs/simulation.md discusses,
+/// and is never edge-on for more than a quarter of the run (here: never within 15 degrees).
+/// Measured on this coarse mesh: see the printout; the full example descends at 0.92 m/s.
+static void test_falling_feather_settles(void **state)
+{
+	(void)state;
+	fall_trace *trace = run_fall(3.0, "");
+	int n = trace->count, edge_on = 0;
+	for (int i = 0; i < n; ++i)
+		edge_on += trace->alignment[i] < sin(15 * acos(-1.0) / 180);
+	// The descent speed over the last third, against free fall's over the same time.
+	int a = 2 * n / 3;
+	double speed = (trace->height[a] - trace->height[n - 1]) / (trace->time[n - 1] - trace->time[a]);
+	printf("falling: %.3f m in %.2f s, descent %.3f m/s over the last third, edge-on %d of %d steps\n",
+	       -trace->height[n - 1], trace->time[n - 1], speed, edge_on, n);
+	assert_true(speed > 0.3 && speed < 1.3);
+	assert_true(edge_on < n / 4);
+	free(trace);
+	// A wind along +x carries it downwind.
+	trace = run_fall(0.5, ", \"wind\": [1.5, 0, 0], \"gusts\": {\"speed\": 0.3}, \"seed\": 3");
+	printf("falling in a 1.5 m/s wind: drift %.3f m in %.2f s\n", trace->drift[trace->count - 1] - trace->drift[0],
+	       trace->time[trace->count - 1]);
+	assert_true(trace->drift[trace->count - 1] - trace->drift[0] > 0.1);
+	free(trace);
+	assert_int_equal(plume_bytes_in_use(), 0);
+}
+
 /// Gusts are a deterministic function of the seed, with the asked RMS speed.
 static void test_gusts_follow_the_seed(void **state)
 {
@@ -310,8 +394,8 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test(test_air_face_derivatives),   cmocka_unit_test(test_bdf2_potential_derivatives),
-	    cmocka_unit_test(test_swing_keeps_its_energy), cmocka_unit_test(test_gusts_follow_the_seed),
-	    cmocka_unit_test(test_bad_dynamics),
+	    cmocka_unit_test(test_swing_keeps_its_energy), cmocka_unit_test(test_falling_feather_settles),
+	    cmocka_unit_test(test_gusts_follow_the_seed),  cmocka_unit_test(test_bad_dynamics),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -2,15 +2,16 @@
 //
 // Each face of area A, unit normal n, moving at u relative to the air (the mean of its
 // vertices' velocities less the wind at its centroid) feels the quasi-steady force
-//   F = -1/2 rho A (C_n w |u_n| u_n n + C_t |u_t| u_t),   u_n = u . n,  u_t = u - u_n n:
-// a pressure force normal to the sheet, quadratic in the normal velocity (a flat plate
-// broadside, C_n = 1.17 for a square plate at Re ~ 1e4, Hoerner, Fluid-Dynamic Drag 1965,
-// ch. 3), and skin friction along it (Blasius: C_f = 1.328 / sqrt(Re) per side, 0.07 for
-// both sides at Re ~ 1.5e3, the Reynolds number of a feather falling at 0.5 m/s). A normal
-// force at an angle of attack alpha has a lift part as well as a drag part, so a tilted
-// sheet glides; this is the quasi-steady translational part of the falling-plate models
-// of Andersen, Pesavento & Wang 2005 (J. Fluid Mech. 541, 65-90, eqs. 2.7-2.9), whose
-// rotational lift and added mass are left out.
+//   F = -1/2 rho A (C_n w (|u_n| + |u_t|) u_n n + C_t |u_t| u_t),   u_n = u . n,  u_t = u - u_n n:
+// a pressure force normal to the sheet (C_n = 1.17 for a square plate broadside at Re ~ 1e4,
+// Hoerner, Fluid-Dynamic Drag 1965, ch. 3), whose coefficient at an angle of attack alpha,
+// C_N = C_n sin(alpha) (sin(alpha) + cos(alpha)), grows linearly with alpha near gliding as a
+// plate's does (Rayleigh's C_N = 2 pi sin(alpha) / (4 + pi sin(alpha)); a normal force
+// quadratic in u_n alone, C_n sin^2(alpha), let a tilted feather dive at 4 m/s), and skin friction along it (Blasius:
+// C_f = 1.328 / sqrt(Re) per side, 0.07 for both sides at Re ~ 1.5e3, the Reynolds number of a feather falling at 0.5
+// m/s). A normal force at an angle of attack alpha has a lift part as well as a drag part, so a tilted sheet glides;
+// this is the quasi-steady translational part of the falling-plate models of Andersen, Pesavento & Wang 2005 (J. Fluid
+// Mech. 541, 65-90, eqs. 2.7-2.9), whose rotational lift and added mass are left out.
 //
 // Centre of pressure. A uniform pressure acts at the area centroid and exerts no pitching
 // moment; on a real plate the normal force acts ahead of mid-chord, at
@@ -25,12 +26,14 @@
 // centre by exactly e when no weight is clipped.
 //
 // Newton sees the force as a dissipation potential. With the step's velocity affine in the
-// unknowns, v(x) = s (x - b) (integrator.c), R(u) = rho A / 6 (C_n w |u_n|^3 + C_t |u_t|^3)
-// has dR/du = -F, and the term R(u(x)) / s added to the incremental potential contributes
-// -F / 3 to each vertex's gradient and s / 9 d2R/du2 to each block of the face's Hessian,
-//   d2R/du2 = rho A / 2 (2 C_n w |u_n| n n^T + C_t (|u_t| P + u_t u_t^T / |u_t|)),  P = I - n n^T,
-// which is positive semidefinite (R is convex): the normal, area, weight and wind are frozen
-// at the start of the step, as the linear drag's normals are.
+// unknowns, v(x) = s (x - b) (integrator.c), and the in-plane speed in the normal force taken
+// at the start of the step (|u_t|_0), R(u) = rho A / 2 (C_n w (|u_n|^3 / 3 + |u_t|_0 u_n^2 / 2)
+// + C_t |u_t|^3 / 3) has dR/du = -F, and the term R(u(x)) / s added to the incremental
+// potential contributes -F / 3 to each vertex's gradient and s / 9 d2R/du2 to each block of the
+// face's Hessian,
+//   d2R/du2 = rho A / 2 (C_n w (2 |u_n| + |u_t|_0) n n^T + C_t (|u_t| P + u_t u_t^T / |u_t|)),
+// P = I - n n^T, which is positive semidefinite (R is convex): the normal, area, weight, wind
+// and |u_t|_0 are frozen at the start of the step, as the linear drag's normals are.
 //
 // Gusts: a divergence-free random field of PLUME_AIR_GUST_MODES Fourier modes (Kraichnan
 // 1970, Phys. Fluids 13, 22-31), sum_k a p_k cos(kappa_k e_k . x - omega_k t + phi_k) with
@@ -170,6 +173,8 @@ void plume_air_begin(plume_sim *sim, double t)
 		face->wind = plume_air_wind(air, face_centroid(x, vf), t);
 		plume_vec3 mean = plume_v3_scale(plume_v3_add(plume_v3_add(v[vf[0]], v[vf[1]]), v[vf[2]]), 1.0 / 3);
 		velocity[f] = plume_v3_sub(mean, face->wind);
+		face->sliding_speed =
+		    plume_v3_length(plume_v3_mad(velocity[f], -plume_v3_dot(velocity[f], face->normal), face->normal));
 	}
 	if (air->def.centre_of_pressure)
 		centre_of_pressure(sim, area, velocity);
@@ -186,10 +191,11 @@ double plume_air_face_potential(const sim_air_face *face, double s, const plume_
 	plume_vec3 t = plume_v3_mad(u, -un, n);
 	double tl = plume_v3_length(t);
 	double cn = face->normal_coefficient, ct = face->tangential_coefficient, k = face->factor;
-	double energy = k / 3 * (cn * fabs(un) * un * un + ct * tl * tl * tl) / s;
+	double slide = face->sliding_speed;
+	double energy = k * (cn * (fabs(un) * un * un / 3 + slide * un * un / 2) + ct * tl * tl * tl / 3) / s;
 	if (gradient != NULL) {
-		plume_vec3 force =
-		    plume_v3_scale(plume_v3_add(plume_v3_scale(n, cn * fabs(un) * un), plume_v3_scale(t, ct * tl)), k);
+		plume_vec3 normal_force = plume_v3_scale(n, cn * (fabs(un) + slide) * un);
+		plume_vec3 force = plume_v3_scale(plume_v3_add(normal_force, plume_v3_scale(t, ct * tl)), k);
 		for (int i = 0; i < 3; ++i) {
 			gradient[3 * i] = force.x / 3;
 			gradient[3 * i + 1] = force.y / 3;
@@ -203,7 +209,7 @@ double plume_air_face_potential(const sim_air_face *face, double s, const plume_
 			for (int b = 0; b < 3; ++b) {
 				double projector = (a == b ? 1 : 0) - nv[a] * nv[b];
 				double tangential = tl > 0 ? ct * (tl * projector + tv[a] * tv[b] / tl) : 0;
-				block[3 * a + b] = k * (2 * cn * fabs(un) * nv[a] * nv[b] + tangential) * s / 9;
+				block[3 * a + b] = k * (cn * (2 * fabs(un) + slide) * nv[a] * nv[b] + tangential) * s / 9;
 			}
 		for (int a = 0; a < 9; ++a)
 			for (int b = 0; b < 9; ++b)

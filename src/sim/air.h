@@ -16,6 +16,9 @@ typedef struct sim_air_face {
 	/// C_n times the face's centre-of-pressure weight, and C_t.
 	double normal_coefficient;
 	double tangential_coefficient;
+	/// The face's in-plane speed relative to the air at the start of the step, m/s: the
+	/// normal force grows with it (C_N ~ sin alpha near gliding, air.c).
+	double sliding_speed;
 	/// Unit normal at the start of the step.
 	plume_vec3 normal;
 	/// Air velocity at the face at the end of the step, m/s.
@@ -54,7 +57,8 @@ plume_vec3 plume_air_wind(const sim_air *air, plume_vec3 p, double t);
 void plume_air_begin(struct plume_sim *sim, double t);
 
 /// One face's dissipation potential R(u) / s with u = s (mean x - mean base) - wind,
-/// R = factor / 3 (C_n |u.n|^3 + C_t |u_t|^3); its gradient (9) and Hessian (81) when not NULL.
+/// R = factor (C_n (|u.n|^3 / 3 + sliding_speed (u.n)^2 / 2) + C_t |u_t|^3 / 3); its gradient (9) and Hessian (81) when
+/// not NULL.
 double plume_air_face_potential(const sim_air_face *face, double s, const plume_vec3 x[3], const plume_vec3 base[3],
                                 double *gradient, double *hessian);
 
