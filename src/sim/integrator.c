@@ -14,7 +14,7 @@
 // omega = h / h_back and
 //   a0 = (1 + 2 omega)/(1 + omega), a1 = -(1 + omega), a2 = omega^2/(1 + omega)
 // (3/2, -2, 1/2 for equal steps), both x and v obey a0 y_{n+1} + a1 y_n + a2 y_{n-1} = h y'_{n+1}:
-//   v(x) = (a0/h)(x - b),      b = -(a1 x_n + a2 x_{n-1}) / a0,
+//   v(x) = (a0/h)(x - b),      b = -(a1 x_n + a2 x_{n-1}) / a0 = x_n + (a2/a0)(x_n - x_{n-1}),
 //   a(x) = (a0^2/h^2)(x - x_pred), x_pred = b - h (a1 v_n + a2 v_{n-1}) / a0^2.
 // For equal steps x_pred = (4 x_n - x_{n-1})/3 + (2h/9)(4 v_n - v_{n-1}), inertia = 9/(4 h^2).
 // The first step, and a step more than twice the one before (after substeps, where the
@@ -91,7 +91,9 @@ void plume_integrator_begin(plume_sim *sim, double h, sim_problem *problem)
 	}
 	for (int i = 0; i < n; ++i) {
 		plume_vec3 xb = bdf2 ? integrator->x_back[i] : x[i], vb = bdf2 ? integrator->v_back[i] : v[i];
-		base[i] = plume_v3_scale(plume_v3_add(plume_v3_scale(x[i], a1), plume_v3_scale(xb, a2)), -1 / a0);
+		// b = -(a1 x_n + a2 x_{n-1}) / a0 written with a0 + a1 + a2 = 0, so that a vertex that
+		// has not moved (a handle held still) gets exactly zero velocity.
+		base[i] = plume_v3_mad(x[i], a2 / a0, plume_v3_sub(x[i], xb));
 		plume_vec3 vsum = plume_v3_add(plume_v3_scale(v[i], a1), plume_v3_scale(vb, a2));
 		predicted[i] = plume_v3_mad(base[i], -h / (a0 * a0), vsum);
 	}
