@@ -149,6 +149,57 @@ static void test_bdf2_potential_derivatives(void **state)
 	assert_int_equal(plume_bytes_in_use(), 0);
 }
 
+/// Variable-step BDF2 is exact on a uniformly accelerated motion (degree 2 in time): with the
+/// exact history at steps h_back and h = omega h_back, the step's minimiser under the force
+/// m g, x = x_pred + g / inertia, and its velocity s (x - b) are the exact ones, for equal
+/// steps, after a halving (omega = 1/2) and after a doubling (omega = 2). Implicit Euler is not.
+static void test_bdf2_is_exact_on_uniform_acceleration(void **state)
+{
+	(void)state;
+	plume_mesh *mesh = make_sheet();
+	plume_sim_def def = plume_sim_default_def();
+	def.material_count = 1;
+	plume_sim *sim = NULL;
+	plume_error err = {0};
+	assert_int_equal(plume_sim_create(mesh, &def, &sim, &err), PLUME_OK);
+	const plume_vec3 g = {0.3, -2, -9.81}, v0 = {0.5, 0.1, 1.2};
+	const double h_back = 0.011, t_back = 0.05;
+	const double ratios[] = {1, 0.5, 2};
+	for (int r = 0; r < 3; ++r) {
+		double h = ratios[r] * h_back, t = t_back + h_back;
+		for (int i = 0; i < sim->vertex_count; ++i) {
+			plume_vec3 x0 = mesh->rest[i];
+			sim->integrator.x_back[i] = plume_v3_mad(plume_v3_mad(x0, t_back, v0), 0.5 * t_back * t_back, g);
+			sim->integrator.v_back[i] = plume_v3_mad(v0, t_back, g);
+			sim->x[i] = plume_v3_mad(plume_v3_mad(x0, t, v0), 0.5 * t * t, g);
+			sim->v[i] = plume_v3_mad(v0, t, g);
+		}
+		sim->integrator.h_back = h_back;
+		sim_problem problem;
+		plume_integrator_begin(sim, h, &problem);
+		double worst_x = 0, worst_v = 0, te = t + h;
+		for (int i = 0; i < sim->vertex_count; ++i) {
+			plume_vec3 x = plume_v3_mad(sim->predicted[i], 1 / problem.inertia, g);
+			plume_vec3 v = plume_v3_scale(plume_v3_sub(x, problem.velocity_base[i]), problem.velocity_scale);
+			plume_vec3 exact = plume_v3_mad(plume_v3_mad(mesh->rest[i], te, v0), 0.5 * te * te, g);
+			worst_x = fmax(worst_x, plume_v3_distance(x, exact));
+			worst_v = fmax(worst_v, plume_v3_distance(v, plume_v3_mad(v0, te, g)));
+		}
+		printf("BDF2, omega = %g: position error %.2e m, velocity error %.2e m/s\n", ratios[r], worst_x, worst_v);
+		assert_true(worst_x < 1e-14 && worst_v < 1e-12);
+	}
+	// Implicit Euler (no history) misses the step's position by g h^2 / 2.
+	sim->integrator.h_back = 0;
+	sim_problem problem;
+	plume_integrator_begin(sim, h_back, &problem);
+	plume_vec3 x = plume_v3_mad(sim->predicted[0], 1 / problem.inertia, g);
+	double te = t_back + 2 * h_back;
+	plume_vec3 exact = plume_v3_mad(plume_v3_mad(mesh->rest[0], te, v0), 0.5 * te * te, g);
+	assert_close(plume_v3_distance(x, exact), 0.5 * plume_v3_length(g) * h_back * h_back, 1e-12);
+	plume_sim_destroy(sim);
+	plume_mesh_destroy(mesh);
+}
+
 typedef struct energy_trace {
 	int count;
 	double time[256];
@@ -393,9 +444,13 @@ static void test_bad_dynamics(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-	    cmocka_unit_test(test_air_face_derivatives),   cmocka_unit_test(test_bdf2_potential_derivatives),
-	    cmocka_unit_test(test_swing_keeps_its_energy), cmocka_unit_test(test_falling_feather_settles),
-	    cmocka_unit_test(test_gusts_follow_the_seed),  cmocka_unit_test(test_bad_dynamics),
+	    cmocka_unit_test(test_air_face_derivatives),
+	    cmocka_unit_test(test_bdf2_is_exact_on_uniform_acceleration),
+	    cmocka_unit_test(test_bdf2_potential_derivatives),
+	    cmocka_unit_test(test_swing_keeps_its_energy),
+	    cmocka_unit_test(test_falling_feather_settles),
+	    cmocka_unit_test(test_gusts_follow_the_seed),
+	    cmocka_unit_test(test_bad_dynamics),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
