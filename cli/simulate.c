@@ -27,7 +27,8 @@ void cli_help_simulate(void)
 	     "  DIR/sim.usda          the same as USD text: time-sampled points\n"
 	     "  DIR/frames/NNNN.png   a shaded view of each frame, with --png\n"
 	     "  DIR/stats.csv         per step: time, Newton iterations, gradient norm,\n"
-	     "                        energy, largest barb-edge strain, wall seconds, and\n"
+	     "                        energy, largest barb-edge strain, wall seconds, the\n"
+	     "                        kinetic, elastic and gravitational energy (J), and\n"
 	     "                        per handle N (in the scene's order) the reaction force\n"
 	     "                        handleN_f{x,y,z} (N) and displacement handleN_d{x,y,z} (m)\n"
 	     "  DIR/summary.json      steps, iterations, timings, largest barb strain,\n"
@@ -180,8 +181,13 @@ static plume_status on_step(void *user, int step, double time, const plume_sim *
 {
 	run_state *run = user;
 	if (report != NULL) {
-		fprintf(run->stats, "%.9g,%d,%.6e,%.12e,%.6e,%.6f", time, report->newton_iterations, report->gradient_norm,
-		        report->energy, report->max_barb_strain, wall_seconds);
+		// The energies of the state (docs/simulation.md): kinetic, elastic (membrane, compression,
+		// bending) and gravitational (with the scene's constant forces). Like the reactions, they
+		// re-evaluate the const simulator's state and change nothing it reports.
+		plume_sim_energies e = plume_sim_energy((plume_sim *)sim);
+		fprintf(run->stats, "%.9g,%d,%.6e,%.12e,%.6e,%.6f,%.9e,%.9e,%.9e", time, report->newton_iterations,
+		        report->gradient_norm, report->energy, report->max_barb_strain, wall_seconds, e.kinetic,
+		        e.membrane + e.compression + e.bending, e.gravity);
 		write_handle_columns(run, time, sim);
 		fputc('\n', run->stats);
 		run->max_strain = fmax(run->max_strain, report->max_barb_strain);
@@ -302,7 +308,8 @@ static plume_status simulate(const plume_scene *scene, cli_output *output, run_s
 	run->stats = fopen(cli_output_path(output, "stats.csv", path, sizeof path), "wb");
 	if (run->stats == NULL)
 		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write", path);
-	fprintf(run->stats, "time,newton_iterations,gradient_norm,energy,max_barb_strain,wall_seconds");
+	fprintf(run->stats, "time,newton_iterations,gradient_norm,energy,max_barb_strain,wall_seconds,kinetic_energy,"
+	                    "elastic_energy,gravitational_energy");
 	for (int h = 0; h < scene->handle_count; ++h)
 		fprintf(run->stats, ",handle%d_fx,handle%d_fy,handle%d_fz,handle%d_dx,handle%d_dy,handle%d_dz", h, h, h, h, h,
 		        h);

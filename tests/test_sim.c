@@ -215,6 +215,7 @@ static void test_free_fall_is_exact(void **state)
 	plume_sim_def def = plate_def(plate(1e5, 1e-4, 1e-6, 0.03));
 	def.gravity = plume_v3(0, -9.81, 0);
 	def.time_step = 0.01;
+	def.integrator = PLUME_INTEGRATOR_IMPLICIT_EULER;
 	plume_sim *sim = NULL;
 	plume_error err = {0};
 	assert_int_equal(plume_sim_create(mesh, &def, &sim, &err), PLUME_OK);

@@ -20,8 +20,20 @@ done
 for frame in 0000 0050 0100; do
 	cp "$work/pull/frames/$frame.png" "$here/sim-figure6.5-$frame.png"
 done
-# A falling feather, followed by the camera.
-"$plume" simulate "$root/examples/scenes/falling.json" -o "$work/falling" --png --size 400x400 --view 30,35 >/dev/null
-for frame in 0000 0023 0045; do
+# A falling feather in air, followed by the camera: every 0.44 s (frames are every 2 steps).
+"$plume" simulate "$root/examples/scenes/falling.json" -o "$work/falling" --png --size 320x320 --view 30,35 >/dev/null
+for frame in 0000 0020 0040 0060 0080; do
 	cp "$work/falling/frames/$frame.png" "$here/sim-falling-$frame.png"
 done
+# The swing (BDF2), ray-traced from the side by plume render: every 0.22 s (frames are every
+# 5 steps), a quarter of its 0.86 s period, gathered into a folder of their own for --strip.
+"$plume" simulate "$root/examples/scenes/swing.json" -o "$work/swing" >/dev/null
+mkdir -p "$work/swing-strip/frames"
+cp "$work/swing/mesh.obj" "$work/swing/feather.json" "$work/swing/feather.bin" "$work/swing-strip/"
+k=0
+for frame in 0000 0004 0008 0012 0016; do
+	cp "$work/swing/frames/$frame.obj" "$work/swing-strip/frames/$(printf %04d $k).obj"
+	k=$((k + 1))
+done
+"$plume" render "$work/swing-strip" -o "$work/swing-render" -c "$here/sim-side-camera.json" --strip 5 -f png >/dev/null
+cp "$work/swing-render/strip.png" "$here/sim-swing-strip.png"

@@ -2,8 +2,8 @@
 // (Jouve et al. 2024, sections 5-7; Jouve thesis chapters 4 and 6).
 //
 // A plume_sim owns a copy of what it needs from a plume_mesh, the current
-// positions and velocities, and the sparse solver. Each step minimises the
-// implicit-Euler incremental potential with Newton's method; statics is the
+// positions and velocities, and the sparse solver. Each step minimises an
+// incremental potential (implicit Euler or BDF2) with Newton's method; statics is the
 // same minimisation without inertia. Barb-aligned edges can be held at their
 // reference length as hard constraints (paper section 6).
 #ifndef PLUME_SIM_H
@@ -74,6 +74,38 @@ typedef struct plume_solver_def {
 	int max_substep_halvings;
 } plume_solver_def;
 
+/// How a dynamic step advances in time (docs/simulation.md). Each is one minimisation of an
+/// incremental potential, so the same Newton/SQP solver and barb constraints serve all.
+typedef enum plume_integrator {
+	/// First order; damps motion by about 2 pi omega h of its energy a period (thesis eq. B.2).
+	PLUME_INTEGRATOR_IMPLICIT_EULER = 0,
+	/// Second-order backward differentiation (variable step; implicit Euler for the first step):
+	/// damps resolved motion by O((omega h)^3) a period and unresolved vibrations strongly.
+	PLUME_INTEGRATOR_BDF2 = 1,
+} plume_integrator;
+
+/// Quadratic per-face aerodynamic forces (src/sim/air.c, docs/simulation.md): on a face of area A,
+/// unit normal n and velocity u relative to the air, -1/2 rho A (C_n w |u.n| (u.n) n + C_t |u_t| u_t),
+/// with w the face's share of a centre of pressure ahead of mid-chord (Rayleigh's flat plate).
+typedef struct plume_air_def {
+	/// Air density, kg/m^3, >= 0; 0 turns the model off. Default 0 (off); 1.2 for air.
+	double density;
+	/// Normal (pressure) drag coefficient, >= 0. Default 1.17 (flat plate broadside, Hoerner 1965).
+	double normal_drag;
+	/// Tangential (skin friction) coefficient, >= 0. Default 0.07 (Blasius, both sides, Re ~ 1.5e3).
+	double tangential_drag;
+	/// Move the normal force's centre of pressure ahead of mid-chord (Rayleigh 1876). Default true.
+	bool centre_of_pressure;
+	/// Uniform wind, m/s. Default 0.
+	plume_vec3 wind;
+	/// Turbulent gusts: RMS speed, m/s (>= 0; 0: none), length scale, m (> 0), time scale, s (> 0).
+	double gust_speed;
+	double gust_length;
+	double gust_time;
+	/// Seed of the gusts' random modes: the same seed gives the same wind.
+	uint64_t seed;
+} plume_air_def;
+
 typedef struct plume_sim_def {
 	/// Material table indexed by plume_mesh.material. Default: [vane, rachis].
 	plume_material materials[PLUME_MAX_MATERIALS];
@@ -83,8 +115,12 @@ typedef struct plume_sim_def {
 	/// Linear aerodynamic drag per unit area, kg/(m^2 s): force -c A (v . n) n on each vertex's
 	/// share of area A. Default 0.
 	double drag;
+	/// Quadratic aerodynamics and wind. Default off (density 0).
+	plume_air_def air;
 	/// Time step, s, > 0. Default 0.011 (thesis Table 6.1).
 	double time_step;
+	/// Time integration of plume_sim_step. Default BDF2; the thesis (Table 6.1) used implicit Euler.
+	plume_integrator integrator;
 	/// Include the bending energy. Default true.
 	bool bending;
 	/// Fix every vertex's z: in-plane problems (the lab's samples). Default false.
@@ -139,7 +175,7 @@ typedef struct plume_solve_report {
 /// the last iterate (finite), and report says so.
 plume_status plume_sim_solve_static(plume_sim *sim, plume_solve_report *report, plume_error *err);
 
-/// One implicit-Euler step of def.time_step; handles must be set for the end of the step.
+/// One step of def.time_step with def.integrator; handles must be set for the end of the step.
 /// A step that does not converge is retried with substeps (handles interpolated linearly);
 /// if that fails too, the state is left as before the step and PLUME_ERROR_NUMERIC returned.
 plume_status plume_sim_step(plume_sim *sim, plume_solve_report *report, plume_error *err);

@@ -14,7 +14,7 @@
 
 static const char *const top_keys[] = {
     "description", "feather", "guides",       "seed",     "mesh",        "materials", "handles", "forces", "gravity",
-    "drag",        "bending", "time_step",    "duration", "frame_every", "quasi_static", "solver", NULL,
+    "drag",        "bending", "time_step",    "duration", "frame_every", "quasi_static", "solver", "integrator", "air", NULL,
 };
 static const char *const material_keys[] = {
     "model",           "E_vv",          "E_ww",          "E_vw",           "youngs_modulus",
@@ -27,6 +27,10 @@ static const char *const force_keys[] = {"group", "force", NULL};
 static const char *const solver_keys[] = {"tolerance", "max_iterations", "max_substep_halvings", NULL};
 static const char *const material_models[] = {"orthotropic", "isotropic", NULL};
 static const char *const interpolations[] = {"linear", "smooth", NULL};
+static const char *const integrators[] = {"implicit-euler", "bdf2", NULL};
+static const char *const air_keys[] = {"density", "normal_drag", "tangential_drag", "centre_of_pressure", "wind",
+                                       "gusts", "seed", NULL};
+static const char *const gust_keys[] = {"speed", "length", "time", NULL};
 
 /// An array of exactly n numbers.
 static bool read_numbers(plume_spec_reader *reader, const json_t *object, const char *path, const char *key,
@@ -130,6 +134,35 @@ static void read_solver(plume_spec_reader *reader, const json_t *root, plume_sim
 	plume_spec_number(reader, solver, "$.solver", "tolerance", &def->solver.tolerance);
 	plume_spec_int(reader, solver, "$.solver", "max_iterations", &def->solver.max_iterations);
 	plume_spec_int(reader, solver, "$.solver", "max_substep_halvings", &def->solver.max_substep_halvings);
+}
+
+/// "integrator" (a word) and "air" (docs/scene.md); plume_sim_def_validate checks the numbers.
+static void read_dynamics(plume_spec_reader *reader, const json_t *root, plume_sim_def *def)
+{
+	const char *integrator = NULL;
+	if (plume_spec_string(reader, root, "$", "integrator", &integrator)) {
+		int which = word_index(reader, "$.integrator", integrator, integrators);
+		if (which >= 0)
+			def->integrator = (plume_integrator)which;
+	}
+	const json_t *air = plume_spec_object(reader, root, "$", "air");
+	if (air == NULL)
+		return;
+	plume_spec_check_keys(reader, air, "$.air", air_keys);
+	def->air.density = 1.2; // a scene that asks for air gets air at sea level unless it says otherwise
+	plume_spec_number(reader, air, "$.air", "density", &def->air.density);
+	plume_spec_number(reader, air, "$.air", "normal_drag", &def->air.normal_drag);
+	plume_spec_number(reader, air, "$.air", "tangential_drag", &def->air.tangential_drag);
+	plume_spec_bool(reader, air, "$.air", "centre_of_pressure", &def->air.centre_of_pressure);
+	read_vec3(reader, air, "$.air", "wind", &def->air.wind);
+	plume_spec_uint64(reader, air, "$.air", "seed", &def->air.seed);
+	const json_t *gusts = plume_spec_object(reader, air, "$.air", "gusts");
+	if (gusts == NULL)
+		return;
+	plume_spec_check_keys(reader, gusts, "$.air.gusts", gust_keys);
+	plume_spec_number(reader, gusts, "$.air.gusts", "speed", &def->air.gust_speed);
+	plume_spec_number(reader, gusts, "$.air.gusts", "length", &def->air.gust_length);
+	plume_spec_number(reader, gusts, "$.air.gusts", "time", &def->air.gust_time);
 }
 
 static void read_keyframes(plume_spec_reader *reader, const json_t *array, const char *path,
@@ -428,6 +461,7 @@ static plume_status scene_from_json(const char *path, json_t *root, const plume_
 	plume_spec_int(&reader, root, "$", "frame_every", &scene->frame_every);
 	plume_spec_bool(&reader, root, "$", "quasi_static", &scene->quasi_static);
 	read_solver(&reader, root, &scene->sim);
+	read_dynamics(&reader, root, &scene->sim);
 	if (reader.status == PLUME_OK && !(scene->duration > 0 && isfinite(scene->duration)))
 		plume_spec_fail(&reader, "$.duration", "is %g, allowed > 0 (seconds)", scene->duration);
 	if (reader.status == PLUME_OK && scene->frame_every < 1)

@@ -1,11 +1,12 @@
 // The potential Newton minimises, its gradient and its projected Hessian.
 //
 // Statics: Phi(x) = E_membrane + E_compression + E_bending - sum m_i g . x_i.
-// An implicit-Euler step of length h minimises the incremental potential
-//   Phi(x) + sum m_i |x_i - x_hat_i|^2 / (2 h^2) + h R((x - x_n) / h),
-// whose stationarity is M (v_{n+1} - v_n) / h = f(x_{n+1}) exactly (thesis B.2),
-// with R the Rayleigh dissipation of the linear drag, (1/2) c A_i (v_i . n_i)^2,
-// normals frozen at the start of the step.
+// A dynamic step minimises the incremental potential (integrator.c)
+//   Phi(x) + inertia/2 sum m_i |x_i - x_pred_i|^2 + R(v(x)) / s,   v(x) = s (x - base),
+// whose stationarity is the integrator's update (for implicit Euler, inertia = 1/h^2 and
+// s = 1/h: M (v_{n+1} - v_n) / h = f(x_{n+1}), thesis B.2), with R the Rayleigh dissipation
+// of the linear drag, (1/2) c A_i (v_i . n_i)^2, normals frozen at the start of the step,
+// plus the quadratic air model's (air.c), added per face.
 //
 // Elements are evaluated in parallel into per-element buffers and summed in a
 // fixed order, so results do not depend on the number of threads.
@@ -92,6 +93,8 @@ double plume_sim_potential(plume_sim *sim, const sim_problem *problem, const plu
 	evaluate_faces(sim, x, want_gradient, hessian, project);
 	if (sim->def.bending)
 		evaluate_hinges(sim, x, want_gradient, hessian, project);
+	if (problem->dynamic && sim->air.active)
+		plume_air_add(sim, problem, x, want_gradient, hessian);
 
 	double *values = hessian ? plume_kkt_values(&sim->kkt) : NULL;
 	if (hessian)
@@ -118,7 +121,7 @@ double plume_sim_potential(plume_sim *sim, const sim_problem *problem, const plu
 	}
 
 	plume_vec3 g = sim->def.gravity;
-	double h2 = problem->dynamic ? problem->h * problem->h : 1;
+	double inertia = problem->dynamic ? problem->inertia : 0;
 	for (int i = 0; i < n; ++i) {
 		double m = sim->mass[i];
 		plume_vec3 load = sim->load[i];
@@ -127,23 +130,23 @@ double plume_sim_potential(plume_sim *sim, const sim_problem *problem, const plu
 		double block[9] = {0};
 		if (problem->dynamic) {
 			plume_vec3 d = plume_v3_sub(x[i], problem->predicted[i]);
-			energy += 0.5 * m * plume_v3_dot(d, d) / h2;
-			local_gradient[0] += m * d.x / h2;
-			local_gradient[1] += m * d.y / h2;
-			local_gradient[2] += m * d.z / h2;
-			block[0] = block[4] = block[8] = m / h2;
+			energy += 0.5 * m * inertia * plume_v3_dot(d, d);
+			local_gradient[0] += m * inertia * d.x;
+			local_gradient[1] += m * inertia * d.y;
+			local_gradient[2] += m * inertia * d.z;
+			block[0] = block[4] = block[8] = m * inertia;
 			double c = sim->def.drag * sim->vertex_area[i];
 			if (c > 0) {
+				// R(v) / s with v . n = s (x - base) . n: (1/2) c (v . n)^2 / s.
+				double s = problem->velocity_scale;
 				plume_vec3 normal = problem->drag_normals[i];
-				double along = plume_v3_dot(plume_v3_sub(x[i], problem->previous[i]), normal);
-				// h R(v) with v . n = along / h: (1/2) c along^2 / h.
-				energy += 0.5 * c * along * along / problem->h;
-				double k = c / problem->h;
+				double along = s * plume_v3_dot(plume_v3_sub(x[i], problem->velocity_base[i]), normal);
+				energy += 0.5 * c * along * along / s;
 				const double nv[3] = {normal.x, normal.y, normal.z};
 				for (int a = 0; a < 3; ++a) {
-					local_gradient[a] += k * along * nv[a];
+					local_gradient[a] += c * along * nv[a];
 					for (int b = 0; b < 3; ++b)
-						block[3 * a + b] += k * nv[a] * nv[b];
+						block[3 * a + b] += c * s * nv[a] * nv[b];
 				}
 			}
 		}

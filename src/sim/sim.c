@@ -1,5 +1,5 @@
 // The simulation object: definitions, set-up from a mesh, handles, statics and
-// implicit-Euler steps with substep retries, and measurements.
+// dynamic steps (integrator.c) with substep retries, and measurements.
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -18,7 +18,14 @@ plume_sim_def plume_sim_default_def(void)
 	def.material_count = 2;
 	def.gravity = plume_v3(0, -9.81, 0);
 	def.drag = 0;
+	def.air.density = 0;
+	def.air.normal_drag = 1.17;
+	def.air.tangential_drag = 0.07;
+	def.air.centre_of_pressure = true;
+	def.air.gust_length = 0.1;
+	def.air.gust_time = 0.5;
 	def.time_step = 0.011;
+	def.integrator = PLUME_INTEGRATOR_BDF2;
 	def.bending = true;
 	def.planar = false;
 	def.solver.tolerance = 1e-7;
@@ -72,6 +79,7 @@ static plume_status check_material(const plume_material *material, const char *p
 plume_status plume_sim_def_validate(const plume_sim_def *def, int mesh_material_count, plume_error *err)
 {
 	PLUME_ASSERT_DEF(def);
+	plume_status status = PLUME_OK;
 	if (def->material_count < 1 || def->material_count > PLUME_MAX_MATERIALS)
 		return plume_error_set(err, PLUME_ERROR_SPEC, "$.materials: %d materials, allowed 1 to %d", def->material_count,
 		                       PLUME_MAX_MATERIALS);
@@ -80,7 +88,7 @@ plume_status plume_sim_def_validate(const plume_sim_def *def, int mesh_material_
 		                       mesh_material_count, def->material_count);
 	char buffer[32];
 	for (int i = 0; i < def->material_count; ++i) {
-		plume_status status = check_material(def->materials + i, material_path(i, buffer, sizeof buffer), err);
+		status = check_material(def->materials + i, material_path(i, buffer, sizeof buffer), err);
 		if (status != PLUME_OK)
 			return status;
 	}
@@ -88,6 +96,12 @@ plume_status plume_sim_def_validate(const plume_sim_def *def, int mesh_material_
 		return plume_error_set(err, PLUME_ERROR_SPEC, "$.time_step is %g, allowed [1e-09, 100] s", def->time_step);
 	if (!(def->drag >= 0) || !isfinite(def->drag))
 		return plume_error_set(err, PLUME_ERROR_SPEC, "$.drag is %g, allowed >= 0", def->drag);
+	if (def->integrator != PLUME_INTEGRATOR_IMPLICIT_EULER && def->integrator != PLUME_INTEGRATOR_BDF2)
+		return plume_error_set(err, PLUME_ERROR_SPEC, "$.integrator is %d, allowed implicit-euler or bdf2",
+		                       (int)def->integrator);
+	status = plume_air_def_validate(&def->air, err);
+	if (status != PLUME_OK)
+		return status;
 	if (!isfinite(def->gravity.x) || !isfinite(def->gravity.y) || !isfinite(def->gravity.z))
 		return plume_error_set(err, PLUME_ERROR_SPEC, "$.gravity must be finite");
 	if (!(def->solver.tolerance > 0) || !(def->solver.tolerance < 1))
@@ -296,7 +310,9 @@ static bool allocate_state(plume_sim *sim)
 	return sim->x && sim->v && sim->rest && sim->mass && sim->load && sim->vertex_area && sim->fixed &&
 	       sim->face_energy && sim->face_gradient && sim->face_hessian && sim->gradient && sim->residual && sim->rhs &&
 	       sim->step && sim->trial && sim->scratch && sim->saved_x && sim->saved_v && sim->previous && sim->predicted &&
-	       sim->normals && sim->lambda;
+	       sim->normals && sim->lambda &&
+	       plume_integrator_init(&sim->integrator, sim->def.integrator, sim->vertex_count) &&
+	       plume_air_init(&sim->air, &sim->def.air, sim->face_count);
 }
 
 static bool allocate_hinge_buffers(plume_sim *sim)
@@ -398,6 +414,8 @@ void plume_sim_destroy(plume_sim *sim)
 	PLUME_ASSERT_HANDLE(sim);
 	sim->magic = 0;
 	plume_kkt_free(&sim->kkt);
+	plume_integrator_free(&sim->integrator);
+	plume_air_free(&sim->air);
 	void *arrays[] = {sim->x,
 	                  sim->v,
 	                  sim->rest,
@@ -567,7 +585,7 @@ plume_status plume_sim_solve_static(plume_sim *sim, plume_solve_report *report, 
 {
 	PLUME_ASSERT_HANDLE(sim);
 	plume_solve_report total = {0};
-	static const sim_problem statics = {false, 0, NULL, NULL, NULL};
+	static const sim_problem statics = {.dynamic = false};
 	size_t bytes = sizeof(plume_vec3) * (size_t)sim->vertex_count;
 	memcpy(sim->saved_x, sim->x, bytes);
 	plume_status status = PLUME_ERROR_NUMERIC;
@@ -618,6 +636,7 @@ plume_status plume_sim_step(plume_sim *sim, plume_solve_report *report, plume_er
 	size_t bytes = sizeof(plume_vec3) * (size_t)sim->vertex_count;
 	memcpy(sim->saved_x, sim->x, bytes);
 	memcpy(sim->saved_v, sim->v, bytes);
+	plume_integrator_save(&sim->integrator, sim->vertex_count);
 	plume_status status = PLUME_ERROR_NUMERIC;
 	plume_error last = {0};
 	for (int halvings = 0; halvings <= sim->def.solver.max_substep_halvings; ++halvings) {
@@ -625,24 +644,24 @@ plume_status plume_sim_step(plume_sim *sim, plume_solve_report *report, plume_er
 		double h = sim->def.time_step / substeps;
 		memcpy(sim->x, sim->saved_x, bytes);
 		memcpy(sim->v, sim->saved_v, bytes);
+		plume_integrator_restore(&sim->integrator, sim->vertex_count);
 		total.substeps = substeps;
 		for (int s = 1; s <= substeps; ++s) {
-			memcpy(sim->previous, sim->x, bytes);
-			for (int i = 0; i < sim->vertex_count; ++i)
-				sim->predicted[i] = plume_v3_mad(sim->x[i], h, sim->v[i]);
+			sim_problem problem;
+			plume_integrator_begin(sim, h, &problem);
 			if (sim->def.drag > 0)
 				vertex_normals(sim, sim->x, sim->normals);
+			if (sim->air.active)
+				plume_air_begin(sim, sim->time + s * h);
 			// Free vertices start from the prediction, handle vertices at their targets.
 			memcpy(sim->x, sim->predicted, bytes);
 			plume_sim_place_handles(sim, (double)s / substeps);
-			sim_problem problem = {true, h, sim->predicted, sim->previous, sim->normals};
 			plume_solve_report part = {0};
 			status = plume_sim_newton(sim, &problem, &part, &last);
 			add_report(&total, &part);
 			if (status != PLUME_OK)
 				break;
-			for (int i = 0; i < sim->vertex_count; ++i)
-				sim->v[i] = plume_v3_scale(plume_v3_sub(sim->x[i], sim->previous[i]), 1 / h);
+			plume_integrator_end(sim, &problem);
 		}
 		// Substeps help a step that did not converge, not one that ran out of memory:
 		// a retry that then succeeded would make the result depend on the allocator.
@@ -652,6 +671,7 @@ plume_status plume_sim_step(plume_sim *sim, plume_solve_report *report, plume_er
 	if (status != PLUME_OK) {
 		memcpy(sim->x, sim->saved_x, bytes);
 		memcpy(sim->v, sim->saved_v, bytes);
+		plume_integrator_restore(&sim->integrator, sim->vertex_count);
 		if (report != NULL)
 			*report = total;
 		return plume_error_set(err, status, "step at t = %.6g s failed with %d substeps: %s", sim->time, total.substeps,
@@ -705,7 +725,7 @@ bool plume_sim_group_reaction(plume_sim *sim, const char *group_name, plume_vec3
 	const plume_vertex_group *group = find_group(sim, group_name);
 	if (group == NULL)
 		return false;
-	static const sim_problem statics = {false, 0, NULL, NULL, NULL};
+	static const sim_problem statics = {.dynamic = false};
 	double *g = sim->gradient;
 	plume_sim_potential(sim, &statics, sim->x, g, false, false);
 	plume_sim_add_constraint_forces(sim, sim->x, g);

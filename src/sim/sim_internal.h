@@ -5,7 +5,9 @@
 #define PLUME_SIM_INTERNAL_H
 
 #include "plume/sim.h"
+#include "sim/air.h"
 #include "sim/bending.h"
+#include "sim/integrator.h"
 #include "sim/kkt.h"
 #include "sim/membrane.h"
 
@@ -21,16 +23,21 @@ typedef struct sim_handle {
 	plume_vec3 *end;
 } sim_handle;
 
-/// What a solve minimises: statics (no inertia) or one implicit-Euler (sub)step.
+/// What a solve minimises: statics (no inertia) or one (sub)step of the integrator
+/// (integrator.c): inertia |x - predicted|^2_M * inertia / 2, with the velocity at the
+/// end of the step an affine function of the unknowns, v(x) = velocity_scale (x - velocity_base),
+/// which the dissipation terms (drag, air) are written in.
 typedef struct sim_problem {
 	bool dynamic;
 	/// Step length, s (dynamic only).
 	double h;
-	/// x_hat = x_n + h v_n: where the vertices go without forces (dynamic only).
+	/// 1 / (beta h^2): h^-2 for implicit Euler, 9/4 h^-2 for BDF2 with equal steps.
+	double inertia;
+	/// Where the vertices go without forces (dynamic only).
 	const plume_vec3 *predicted;
-	/// Positions at the start of the step, for drag (dynamic only).
-	const plume_vec3 *previous;
-	/// Vertex normals at the start of the step, for drag (dynamic only).
+	double velocity_scale;
+	const plume_vec3 *velocity_base;
+	/// Vertex normals at the start of the step, for the linear drag (dynamic only).
 	const plume_vec3 *drag_normals;
 } sim_problem;
 
@@ -101,6 +108,9 @@ struct plume_sim {
 	/// The last solve's exact Hessian was not positive definite on the constraints'
 	/// tangent space: the next solve starts projected (newton.c).
 	bool exact_hessian_failed;
+	/// Time integration history (integrator.c) and the air's per-step state (air.c).
+	sim_integrator integrator;
+	sim_air air;
 	/// Merit at each iteration of the last solve (tests check it decreases).
 	double trace[PLUME_SIM_TRACE];
 	int trace_count;

@@ -25,6 +25,7 @@ done
 check "feather.json is version 2, its numbers in feather.bin" grep -q '"buffer": {"uri": "feather.bin"}' "$out/feather.json"
 check "frame 3 is the last (steps 0, 2, 4, 5)" test ! -e "$out/frames/0004.obj"
 check "stats has a header and 5 steps" test "$(wc -l <"$out/stats.csv")" -eq 6
+check "stats has the energies" grep -q "^time,newton_iterations,gradient_norm,energy,max_barb_strain,wall_seconds,kinetic_energy,elastic_energy,gravitational_energy" "$out/stats.csv"
 check "summary says completed" grep -q '"completed": true' "$out/summary.json"
 check "summary has steps" grep -q '"steps": 5' "$out/summary.json"
 check "summary has max_barb_strain" grep -q '"max_barb_strain"' "$out/summary.json"
@@ -54,6 +55,9 @@ bad "negative thickness" '$.materials.rachis.thickness is -0.001, allowed [1e-09
 bad "zero time step" '$.time_step is 0, allowed [1e-09, 100] s' '"time_step": 0'
 bad "negative time step" '$.time_step is -1, allowed [1e-09, 100] s' '"time_step": -1'
 bad "unknown key" 'did you mean "duration"' '"durations": 1'
+bad "unknown integrator" '$.integrator: unknown value "bdf3"' '"integrator": "bdf3"'
+bad "negative normal drag" '$.air.normal_drag is -1, allowed >= 0' '"air": {"normal_drag": -1}'
+bad "NaN wind" '$.air.wind: element 1 is not a number' '"air": {"wind": [0, "NaN", 0]}'
 expect_failure "missing scene" 4 "missing.json" "$plume" simulate "$scratch/missing.json" -o "$scratch/none"
 check "missing scene: nothing written" test ! -e "$scratch/none"
 expect_failure "no output" 2 "missing -o DIR" "$plume" simulate "$scratch/swing.json"
