@@ -163,6 +163,10 @@ void plume_ff_face_gauss_newton(const plume_ff_face *face, const plume_vec3 x[6]
 		for (int c = 0; c < 18; ++c)
 			hessian[18 * r + c] = J[c] * MJ[0] + J[18 + c] * MJ[1] + J[36 + c] * MJ[2];
 	}
+	// Symmetric exactly, not just to rounding (the solver stores one triangle).
+	for (int r = 0; r < 18; ++r)
+		for (int c = r + 1; c < 18; ++c)
+			hessian[18 * c + r] = hessian[18 * r + c] = 0.5 * (hessian[18 * r + c] + hessian[18 * c + r]);
 }
 
 double plume_ff_face_energy(const plume_ff_face *face, const plume_vec3 x[6], double gradient[18], double hessian[324])
