@@ -49,6 +49,17 @@ static void condense(double M[9], int b)
 		M[3 * k + b] = M[3 * b + k] = 0;
 }
 
+// t t^T of the unit in-plane normal of the edge opposite vertex i, as (xx, yy, xy).
+static void edge_normal_form(const plume_vec2 reference[3], int i, double form[3])
+{
+	plume_vec2 p = reference[(i + 1) % 3], q = reference[(i + 2) % 3];
+	double ex = q.x - p.x, ey = q.y - p.y, length = hypot(ex, ey);
+	double tx = -ey / length, ty = ex / length;
+	form[0] = tx * tx;
+	form[1] = ty * ty;
+	form[2] = tx * ty;
+}
+
 bool plume_ff_face_init(plume_ff_face *face, const int vertices[6], const plume_vec2 reference[3],
                         const plume_vec3 rest[6], double barb_angle, double along, double across)
 {
@@ -60,14 +71,13 @@ bool plume_ff_face_init(plume_ff_face *face, const int vertices[6], const plume_
 	double form[3][3], scale = 0;
 	for (int i = 0; i < 3; ++i) {
 		plume_vec2 p = reference[(i + 1) % 3], q = reference[(i + 2) % 3];
-		double ex = q.x - p.x, ey = q.y - p.y, length = hypot(ex, ey);
+		double length = hypot(q.x - p.x, q.y - p.y);
 		scale = fmax(scale, length * length);
 		if (!(length > 0))
 			return false;
-		double tx = -ey / length, ty = ex / length;
-		form[i][0] = length * tx * tx;
-		form[i][1] = length * ty * ty;
-		form[i][2] = length * tx * ty;
+		edge_normal_form(reference, i, form[i]);
+		for (int k = 0; k < 3; ++k)
+			form[i][k] *= length;
 	}
 	if (!isfinite(area) || !(area > 1e-12 * scale))
 		return false;
@@ -77,7 +87,7 @@ bool plume_ff_face_init(plume_ff_face *face, const int vertices[6], const plume_
 			face->stiffness[3 * i + j] = plume_ff_tensor_form(form[i], form[j], barb_angle, along, across) / (4 * area);
 	for (int i = 0; i < 3; ++i) {
 		face->rest_angle[i] = 0;
-		face->edge_scale[i] = 1;
+		face->edge_scale[i] = face->border_scale[i] = 1;
 		if (vertices[3 + i] < 0) {
 			condense(face->stiffness, i);
 			continue;
@@ -90,12 +100,25 @@ bool plume_ff_face_init(plume_ff_face *face, const int vertices[6], const plume_
 	return true;
 }
 
+double plume_ff_edge_modulus(const plume_vec2 reference[3], int i, double barb_angle, double along, double across)
+{
+	double form[3];
+	edge_normal_form(reference, i, form);
+	return plume_ff_tensor_form(form, form, barb_angle, along, across);
+}
+
+void plume_ff_face_border(plume_ff_face *face, int i, double own_modulus, double other_modulus)
+{
+	double sum = own_modulus + other_modulus;
+	face->border_scale[i] = face->edge_scale[i] = sum > 0 ? 2 * other_modulus / sum : 1;
+}
+
 void plume_ff_face_clamp(plume_ff_face *face, const bool held[6])
 {
 	bool clamped = held[0] && held[1] && held[2];
 	for (int i = 0; i < 3; ++i) {
 		bool neighbour_clamped = face->vertices[3 + i] >= 0 && held[(i + 1) % 3] && held[(i + 2) % 3] && held[3 + i];
-		face->edge_scale[i] = clamped ? 0 : neighbour_clamped ? 2 : 1;
+		face->edge_scale[i] = clamped ? 0 : neighbour_clamped ? 2 : face->border_scale[i];
 	}
 }
 

@@ -29,6 +29,13 @@
 // free (as a director would be) and minimised away: M is condensed onto the interior edges
 // by the Schur complement, which is the exact energy of a face at a free edge.
 //
+// Material borders: the average normal splits an edge's angle half and half between its
+// faces, right for one material; across a border (rachis 6.4 N m, vane 1e-7 N m) it would
+// make the stiff side hold the soft side's fold. There the edge's normal is placed where
+// it minimises D_f phi_f^2 + D_g phi_g^2 with phi_f + phi_g = chi (D the faces' moduli for a
+// fold along the edge): face f sees s chi / 2 with s = 2 D_g / (D_f + D_g), 1 inside one
+// material, 2 next to a much stiffer face, 0 next to a much softer one.
+//
 // Clamps: a face whose three vertices are held by handles moves rigidly, so its bending is
 // prescribed (its energy is dropped), and the mid-edge normal on an edge it shares with a
 // free face is the clamp's normal, not the average: the free face sees the full dihedral
@@ -49,8 +56,11 @@ typedef struct plume_ff_face {
 	double rest_angle[3];
 	/// M, 3 x 3 row-major, symmetric positive semidefinite, N m: W = 1/2 dchi^T M dchi.
 	double stiffness[9];
-	/// s_i: dchi_i enters as s_i dchi_i; 1, 2 next to a clamped face, 0 in a clamped face.
+	/// s_i: dchi_i enters as s_i dchi_i: border_scale inside and next to free faces, 2 next to a
+	/// clamped face, 0 in a clamped face.
 	double edge_scale[3];
+	/// 2 D_g / (D_f + D_g) of the material border rule above; 1 inside one material.
+	double border_scale[3];
 } plume_ff_face;
 
 /// The bilinear form of the bending tensor on two symmetric 2 x 2 curvatures given as
@@ -63,6 +73,13 @@ double plume_ff_tensor_form(const double a[3], const double b[3], double barb_an
 /// the reference triangle is degenerate.
 bool plume_ff_face_init(plume_ff_face *face, const int vertices[6], const plume_vec2 reference[3],
                         const plume_vec3 rest[6], double barb_angle, double along, double across);
+
+/// D_f for a fold along the edge opposite v_i of a face (reference triangle, barb direction
+/// and moduli as for plume_ff_face_init): the material border rule's modulus, N m.
+double plume_ff_edge_modulus(const plume_vec2 reference[3], int i, double barb_angle, double along, double across);
+
+/// Sets border_scale (and edge_scale) of edge i from the two faces' moduli for folds along it.
+void plume_ff_face_border(plume_ff_face *face, int i, double own_modulus, double other_modulus);
 
 /// Sets edge_scale from which stencil vertices are held by handles (see Clamps above).
 void plume_ff_face_clamp(plume_ff_face *face, const bool held[6]);

@@ -275,9 +275,30 @@ static plume_status build_ff_faces(plume_sim *sim, const plume_mesh *mesh, const
 			rest[i] = vertices[i] >= 0 ? mesh->rest[vertices[i]] : plume_v3(0, 0, 0);
 		double along, across_modulus;
 		bending_moduli(sim->def.materials + mesh->material[f], &along, &across_modulus);
-		if (plume_ff_face_init(sim->ff_faces + sim->ff_count, vertices, reference, rest, mesh->barb_angle[f], along,
-		                       across_modulus))
-			++sim->ff_count;
+		if (!plume_ff_face_init(sim->ff_faces + f, vertices, reference, rest, mesh->barb_angle[f], along,
+		                        across_modulus)) {
+			plume_free(across);
+			return plume_error_set(err, PLUME_ERROR_NUMERIC, "mesh face %d is degenerate in the reference plane", f);
+		}
+	}
+	sim->ff_count = faces;
+	// Material borders (fundamental_form.h): each face's share of the edge's angle.
+	for (int e = 0; e < pair_count; ++e) {
+		int side[2] = {pairs[2 * e], pairs[2 * e + 1]};
+		if (mesh->material[side[0] / 3] == mesh->material[side[1] / 3])
+			continue;
+		double modulus[2];
+		for (int k = 0; k < 2; ++k) {
+			int f = side[k] / 3;
+			const int *v = mesh->faces + 3 * f;
+			plume_vec2 reference[3] = {mesh->reference[v[0]], mesh->reference[v[1]], mesh->reference[v[2]]};
+			double along, across_modulus;
+			bending_moduli(sim->def.materials + mesh->material[f], &along, &across_modulus);
+			modulus[k] =
+			    plume_ff_edge_modulus(reference, (side[k] % 3 + 2) % 3, mesh->barb_angle[f], along, across_modulus);
+		}
+		for (int k = 0; k < 2; ++k)
+			plume_ff_face_border(sim->ff_faces + side[k] / 3, (side[k] % 3 + 2) % 3, modulus[k], modulus[1 - k]);
 	}
 	plume_free(across);
 	return PLUME_OK;

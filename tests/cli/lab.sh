@@ -100,7 +100,7 @@ check "calibrate out of reach: both ends of the range" grep -q 'is [0-9.e+]* Pa 
 check "calibrate out of reach: nothing on stdout" test ! -s "$scratch/out.txt"
 
 # --- study ---------------------------------------------------------------------
-expect_failure "unknown study" 2 "unknown study 'bending'" "$plume" lab study bending -o "$scratch/s"
+expect_failure "unknown study" 2 "unknown study 'buckling'" "$plume" lab study buckling -o "$scratch/s"
 # The locking study at a twentieth of its size: the paper's point, unaligned meshes lock.
 # On a pseudo-terminal (script(1)) for its progress line; stdout still goes to a file.
 script -qec "'$plume' lab study locking -o '$scratch/locking' --scale 0.05 >'$scratch/out.txt'" /dev/null >"$scratch/err.txt"
