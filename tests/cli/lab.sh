@@ -118,6 +118,26 @@ ratio = r['unaligned_over_aligned_error_alpha_1e4']
 assert ratio['elements'] == 50 and ratio['ratio'] > 10
 "
 
+# The bending study at 2 and 4 cells across (--scale below 1): both models, four
+# families, barbs along and across; the hinge's right-isosceles strip is 25 % too soft.
+"$plume" lab study bending -o "$scratch/bending" --scale 0.5 >"$scratch/out.txt" 2>"$scratch/err.txt"
+succeeded "bending study succeeds"
+for file in bending.csv bending.png bending.svg; do
+	check "bending study: $file written" test -s "$scratch/bending/$file"
+done
+check "bending study: 32 rows and a header" test "$(wc -l <"$scratch/bending/bending.csv")" -eq 33
+check "bending study: mesh independence of the fundamental form" python3 -c "
+import csv, json
+r = json.load(open('$scratch/out.txt'))
+assert r['study'] == 'bending' and r['finest_cells_across'] == 4
+rows = list(csv.DictReader(open('$scratch/bending/bending.csv')))
+ratio = {(int(float(x['model'])), int(float(x['family'])), int(float(x['barbs_across'])), int(float(x['cells_across']))):
+         float(x['deflection_over_euler_bernoulli']) for x in rows}
+for family in range(4):
+    assert abs(ratio[(0, family, 0, 4)] - 1) < 0.03, (family, ratio[(0, family, 0, 4)])
+assert ratio[(1, 0, 0, 4)] > 1.2
+"
+
 # --- compression (thesis A.3): the barbs buckle, the stress plateaus -------------
 "$plume" lab traction "$examples/compression-mesoscale.json" -o "$scratch/compression" >/dev/null 2>"$scratch/err.txt"
 succeeded "compression succeeds"
