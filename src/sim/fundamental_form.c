@@ -174,11 +174,9 @@ static void angle_changes(const plume_ff_face *face, const plume_vec3 x[6], doub
 	}
 }
 
-void plume_ff_face_gauss_newton(const plume_ff_face *face, const plume_vec3 x[6], double hessian[324])
+// J^T M J, symmetric exactly (the solver stores one triangle).
+static void gauss_newton(const double M[9], const double J[54], double hessian[324])
 {
-	double delta[3], J[54];
-	angle_changes(face, x, delta, J);
-	const double *M = face->stiffness;
 	for (int r = 0; r < 18; ++r) {
 		double MJ[3]; // (M J)_{:, r}
 		for (int i = 0; i < 3; ++i)
@@ -186,28 +184,43 @@ void plume_ff_face_gauss_newton(const plume_ff_face *face, const plume_vec3 x[6]
 		for (int c = 0; c < 18; ++c)
 			hessian[18 * r + c] = J[c] * MJ[0] + J[18 + c] * MJ[1] + J[36 + c] * MJ[2];
 	}
-	// Symmetric exactly, not just to rounding (the solver stores one triangle).
 	for (int r = 0; r < 18; ++r)
 		for (int c = r + 1; c < 18; ++c)
 			hessian[18 * c + r] = hessian[18 * r + c] = 0.5 * (hessian[18 * r + c] + hessian[18 * c + r]);
 }
 
-double plume_ff_face_energy(const plume_ff_face *face, const plume_vec3 x[6], double gradient[18], double hessian[324])
+// Energy, gradient (M dchi)^T J and the Gauss-Newton Hessian J^T M J from one pass over
+// the angles; force receives M dchi.
+static double energy_and_gauss_newton(const plume_ff_face *face, const plume_vec3 x[6], double gradient[18],
+                                      double hessian[324], double force[3])
 {
 	double delta[3], J[54];
 	bool derivatives = gradient != NULL || hessian != NULL;
 	angle_changes(face, x, delta, derivatives ? J : NULL);
 	const double *M = face->stiffness;
-	double force[3]; // M dchi
 	for (int i = 0; i < 3; ++i)
 		force[i] = M[3 * i] * delta[0] + M[3 * i + 1] * delta[1] + M[3 * i + 2] * delta[2];
-	double energy = 0.5 * (force[0] * delta[0] + force[1] * delta[1] + force[2] * delta[2]);
 	if (gradient)
 		for (int r = 0; r < 18; ++r)
 			gradient[r] = force[0] * J[r] + force[1] * J[18 + r] + force[2] * J[36 + r];
+	if (hessian)
+		gauss_newton(M, J, hessian);
+	return 0.5 * (force[0] * delta[0] + force[1] * delta[1] + force[2] * delta[2]);
+}
+
+double plume_ff_face_energy_gauss_newton(const plume_ff_face *face, const plume_vec3 x[6], double gradient[18],
+                                         double hessian[324])
+{
+	double force[3];
+	return energy_and_gauss_newton(face, x, gradient, hessian, force);
+}
+
+double plume_ff_face_energy(const plume_ff_face *face, const plume_vec3 x[6], double gradient[18], double hessian[324])
+{
+	double force[3];
+	double energy = energy_and_gauss_newton(face, x, gradient, hessian, force);
 	if (hessian) {
 		// J^T M J + sum_i (M dchi)_i Hess chi_i.
-		plume_ff_face_gauss_newton(face, x, hessian);
 		for (int i = 0; i < 3; ++i) {
 			if (force[i] == 0 || face->vertices[3 + i] < 0)
 				continue;

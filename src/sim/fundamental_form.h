@@ -89,8 +89,10 @@ void plume_ff_face_clamp(plume_ff_face *face, const bool held[6]);
 /// Rows and columns of absent vertices are zero.
 double plume_ff_face_energy(const plume_ff_face *face, const plume_vec3 x[6], double gradient[18], double hessian[324]);
 
-/// The positive semidefinite Gauss-Newton part J^T M J of the Hessian (J: the dihedral
-/// angles' gradients), exact at the rest angles; what the Newton solver assembles.
-void plume_ff_face_gauss_newton(const plume_ff_face *face, const plume_vec3 x[6], double hessian[324]);
+/// plume_ff_face_energy with, in place of the Hessian, its positive semidefinite
+/// Gauss-Newton part J^T M J (J: the dihedral angles' gradients), exact at the rest angles:
+/// what the Newton solver assembles. One pass over the angles.
+double plume_ff_face_energy_gauss_newton(const plume_ff_face *face, const plume_vec3 x[6], double gradient[18],
+                                         double hessian[324]);
 
 #endif // PLUME_SIM_FUNDAMENTAL_FORM_H

@@ -111,9 +111,8 @@ static void evaluate_ff_faces(plume_sim *sim, const plume_vec3 *x, bool gradient
 		double *g = gradient ? sim->hinge_gradient + 18 * e : NULL;
 		double *h = hessian ? sim->hinge_hessian + 324 * e : NULL;
 		// Projected: the Gauss-Newton part J^T M J, for the reason given for the hinges.
-		sim->hinge_energy[e] = plume_ff_face_energy(face, local, g, project ? NULL : h);
-		if (h != NULL && project)
-			plume_ff_face_gauss_newton(face, local, h);
+		sim->hinge_energy[e] =
+		    project ? plume_ff_face_energy_gauss_newton(face, local, g, h) : plume_ff_face_energy(face, local, g, h);
 	}
 }
 
