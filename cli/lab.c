@@ -1,6 +1,6 @@
 // plume lab traction LAB.json -o DIR
 // plume lab calibrate --phi PHI --Eb E_b --EB E_B [--aspect A] [--period T] ...
-// plume lab study locking|conditioning|angles|size -o DIR [--scale S]
+// plume lab study locking|conditioning|angles|size|bending -o DIR [--scale S]
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <getopt.h>
@@ -16,7 +16,7 @@ void cli_help_lab(void)
 {
 	puts("Usage: plume lab traction LAB.json -o DIR\n"
 	     "       plume lab calibrate --phi PHI --Eb E_b --EB E_B [options]\n"
-	     "       plume lab study locking|conditioning|angles|size -o DIR [--scale S]\n"
+	     "       plume lab study locking|conditioning|angles|size|bending -o DIR [--scale S]\n"
 	     "\n"
 	     "The virtual feather lab of Jouve's thesis (chapters 3-5): traction tests on\n"
 	     "rectangular vane samples, the mesoscale band model, the calibration of the\n"
@@ -400,13 +400,13 @@ static int run_study(int argc, char **argv)
 		}
 	}
 	if (optind >= argc)
-		return cli_usage_error("lab", "missing the study: locking, conditioning, angles or size");
+		return cli_usage_error("lab", "missing the study: locking, conditioning, angles, size or bending");
 	if (optind + 1 < argc)
 		return cli_usage_error("lab", "unexpected argument '%s'", argv[optind + 1]);
 	const char *name = argv[optind];
 	plume_study_kind kind;
 	if (!plume_study_kind_from_name(name, &kind))
-		return cli_usage_error("lab", "unknown study '%s': locking, conditioning, angles or size", name);
+		return cli_usage_error("lab", "unknown study '%s': locking, conditioning, angles, size or bending", name);
 	if (output_dir == NULL)
 		return cli_usage_error("lab", "missing -o DIR");
 	if (!(scale > 0.0 && scale <= 16.0))

@@ -10,6 +10,7 @@
 #include "support.h"
 
 #include "sim/bending.h"
+#include "sim/fundamental_form.h"
 #include "sim/dense.h"
 #include "sim/membrane.h"
 
@@ -38,6 +39,11 @@ static double triangle_fn(const void *element, const plume_vec3 *x, double *grad
 static double hinge_fn(const void *element, const plume_vec3 *x, double *gradient, double *hessian)
 {
 	return plume_hinge_energy(element, x, gradient, hessian);
+}
+
+static double ff_fn(const void *element, const plume_vec3 *x, double *gradient, double *hessian)
+{
+	return plume_ff_face_energy(element, x, gradient, hessian);
 }
 
 static double coordinate(const plume_vec3 *x, int k)
@@ -71,9 +77,9 @@ static double norm(const double *v, int n)
 static double finite_difference_error(energy_fn *fn, const void *element, const plume_vec3 *x0, int vertex_count,
                                       double h)
 {
-	enum { MAX = 12 };
+	enum { MAX = 18 };
 	int n = 3 * vertex_count;
-	plume_vec3 x[4];
+	plume_vec3 x[6];
 	memcpy(x, x0, (size_t)vertex_count * sizeof *x);
 	double gradient[MAX], hessian[MAX * MAX];
 	double energy = fn(element, x, gradient, hessian);
@@ -485,6 +491,89 @@ static void test_hinge_finite_differences(void **state)
 		assert_true(error < 1e-6);
 	}
 	print_message("bending: worst relative finite-difference error %.2e\n", worst);
+}
+
+/// A fundamental-form stencil: a random face, each neighbour the reflection of the
+/// opposite vertex across the edge, jittered; edge i on the boundary when bit i of
+/// boundary is set. rest: lifted out of plane at random (a curved rest shape).
+static void random_ff_stencil(plume_rng *rng, int boundary, int vertices[6], plume_vec2 reference[6],
+                              plume_vec3 rest[6])
+{
+	random_triangle(rng, reference);
+	for (int i = 0; i < 3; ++i) {
+		plume_vec2 a = reference[(i + 1) % 3], b = reference[(i + 2) % 3], p = reference[i];
+		double ex = b.x - a.x, ey = b.y - a.y, t = ((p.x - a.x) * ex + (p.y - a.y) * ey) / (ex * ex + ey * ey);
+		plume_vec2 foot = {a.x + t * ex, a.y + t * ey};
+		reference[3 + i] = (plume_vec2){2 * foot.x - p.x + plume_rng_range(rng, -0.1, 0.1),
+		                                2 * foot.y - p.y + plume_rng_range(rng, -0.1, 0.1)};
+	}
+	for (int i = 0; i < 6; ++i) {
+		vertices[i] = i >= 3 && (boundary >> (i - 3) & 1) ? -1 : i;
+		rest[i] = plume_v3(reference[i].x, reference[i].y, plume_rng_range(rng, -0.3, 0.3));
+	}
+}
+
+static void test_fundamental_form_finite_differences(void **state)
+{
+	(void)state;
+	plume_rng rng = plume_rng_seed(17);
+	double worst = 0.0;
+	for (int trial = 0; trial < 64; ++trial) {
+		int vertices[6];
+		plume_vec2 reference[6];
+		plume_vec3 rest[6], x[6];
+		random_ff_stencil(&rng, trial % 8, vertices, reference, rest);
+		plume_ff_face face;
+		double barb = plume_rng_range(&rng, -PI, PI);
+		assert_true(plume_ff_face_init(&face, vertices, reference, rest, barb, 1e-7, 2.5e-4));
+		if (trial % 5 == 4) // next to a clamp, or inside one
+			plume_ff_face_clamp(&face, (bool[6]){trial % 2, true, true, true, true, true});
+		plume_mat3 Q = random_rotation(&rng);
+		for (int i = 0; i < 6; ++i) {
+			plume_vec3 p = plume_v3(reference[i].x, reference[i].y, plume_rng_range(&rng, -0.6, 0.6));
+			x[i] = plume_m3_apply(Q, p);
+		}
+		if (face.edge_scale[0] == 0 || trial % 8 == 7)
+			continue; // a clamped face, and a lone one (three free edges), store nothing
+		double error = finite_difference_error(ff_fn, &face, x, 6, 1e-6);
+		worst = fmax(worst, error);
+		assert_true(error < 1e-6);
+	}
+	print_message("fundamental-form bending: worst relative finite-difference error %.2e\n", worst);
+}
+
+static void test_fundamental_form_tensor_and_rigid_motion(void **state)
+{
+	(void)state;
+	// The fold of curvature k across an edge at tilt beta to the barbs stores (1/2) D(beta) k^2
+	// (eq. 6.4): the tensor's form on t t^T, t normal to the edge.
+	const double along = 1e-7, across = 2.5e-4;
+	for (int k = 0; k <= 12; ++k) {
+		double beta = k * PI / 24, barb = 0.3;
+		double edge = barb + beta, tx = -sin(edge), ty = cos(edge);
+		double K[3] = {tx * tx, ty * ty, tx * ty};
+		assert_close(plume_ff_tensor_form(K, K, barb, along, across), plume_bending_modulus(along, across, beta),
+		             1e-12 * across);
+	}
+	// Rigid motions of a curved rest shape store nothing.
+	plume_rng rng = plume_rng_seed(18);
+	for (int trial = 0; trial < 30; ++trial) {
+		int vertices[6];
+		plume_vec2 reference[6];
+		plume_vec3 rest[6], x[6];
+		random_ff_stencil(&rng, trial % 8, vertices, reference, rest);
+		plume_ff_face face;
+		assert_true(plume_ff_face_init(&face, vertices, reference, rest, plume_rng_range(&rng, 0, PI), along, across));
+		plume_mat3 Q = random_rotation(&rng);
+		plume_vec3 t =
+		    plume_v3(plume_rng_range(&rng, -5, 5), plume_rng_range(&rng, -5, 5), plume_rng_range(&rng, -5, 5));
+		for (int i = 0; i < 6; ++i)
+			x[i] = plume_v3_add(plume_m3_apply(Q, rest[i]), t);
+		double gradient[18];
+		double energy = plume_ff_face_energy(&face, x, gradient, NULL);
+		assert_true(energy <= 1e-26 * across);
+		assert_true(norm(gradient, 18) <= 1e-12 * across);
+	}
 }
 
 // ---------------------------------------------------------------------------
@@ -1026,6 +1115,8 @@ int main(void)
 	    cmocka_unit_test(test_compression_finite_differences),
 	    cmocka_unit_test(test_dihedral_angle_sign_and_value),
 	    cmocka_unit_test(test_hinge_finite_differences),
+	    cmocka_unit_test(test_fundamental_form_finite_differences),
+	    cmocka_unit_test(test_fundamental_form_tensor_and_rigid_motion),
 	    cmocka_unit_test(test_rigid_motion_stores_nothing),
 	    cmocka_unit_test(test_compression_only_under_compression),
 	    cmocka_unit_test(test_degenerate_elements_are_refused),

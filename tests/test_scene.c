@@ -149,6 +149,34 @@ static void test_bad_scenes(void **state)
 	expect_error("{" FEATHER
 	             ", \"handles\": [{\"group\": \"rachis_tip\", \"keyframes\": [{\"time\": 1}, {\"time\": 0.5}]}]}",
 	             PLUME_ERROR_SPEC, "keyframe times must be >= 0 and increasing");
+	expect_error("{" FEATHER ", \"bending\": \"paper_hinge\"}", PLUME_ERROR_SPEC,
+	             "$.bending: unknown value \"paper_hinge\"; did you mean \"paper-hinge\"? (allowed: fundamental-form, "
+	             "paper-hinge)");
+	expect_error("{" FEATHER ", \"bending\": 1}", PLUME_ERROR_SPEC, "$.bending");
+}
+
+/// "bending": a model's name selects it (and bending stays on); true/false switch it.
+static void test_bending_key(void **state)
+{
+	(void)state;
+	const char *texts[4] = {"{" FEATHER "}", "{" FEATHER ", \"bending\": \"paper-hinge\"}",
+	                        "{" FEATHER ", \"bending\": \"fundamental-form\"}", "{" FEATHER ", \"bending\": false}"};
+	const plume_bending_model models[4] = {PLUME_BENDING_FUNDAMENTAL_FORM, PLUME_BENDING_PAPER_HINGE,
+	                                       PLUME_BENDING_FUNDAMENTAL_FORM, PLUME_BENDING_FUNDAMENTAL_FORM};
+	for (int k = 0; k < 4; ++k) {
+		char dir[512], path[1024];
+		test_make_temp_dir(dir, sizeof dir);
+		snprintf(path, sizeof path, "%s/scene.json", dir);
+		test_write_file(path, texts[k]);
+		plume_scene *scene = NULL;
+		plume_error err = {0};
+		assert_int_equal(plume_scene_load(path, NULL, &scene, &err), PLUME_OK);
+		assert_int_equal(scene->sim.bending_model, models[k]);
+		assert_true(scene->sim.bending == (k != 3));
+		plume_scene_destroy(scene);
+		test_remove_tree(dir);
+	}
+	assert_int_equal(plume_bytes_in_use(), 0);
 }
 
 int main(void)
@@ -156,6 +184,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test(test_handle_pose_interpolation),
 	    cmocka_unit_test(test_bad_scenes),
+	    cmocka_unit_test(test_bending_key),
 	    cmocka_unit_test(test_figure1_anisotropic_bends_the_rachis),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);

@@ -118,20 +118,22 @@ static double mean_z(const plume_sim *sim, const plume_mesh *mesh, const char *g
 // ---------------------------------------------------------------------------
 
 /// Euler–Bernoulli: a cantilever plate of bending stiffness EI = D W under a tip load P
-/// deflects P L^3 / (3 D W). The clamp holds two columns of vertices, so the beam's root
-/// is the line between them (L = length - dx / 2), and the deflection is read on the
-/// middle half of the tip edge, away from the free sides where the discrete hinge energy
-/// (effective Poisson ratio -1/3 in doubly curved bending, docs/physics-energies.md)
-/// curls the plate. Measured errors: 0.6%, 0.4%, 0.7% for 9, 17, 33 rows.
+/// deflects P L^3 / (3 D W). The clamp holds two columns of vertices; the fundamental-form
+/// bending (the default) makes the faces between them a clamp whose edge normals the free
+/// faces see (sim/fundamental_form.h), so the beam's root is the second column
+/// (L = length - dx). The deflection is read on the middle half of the tip edge.
+/// Measured errors: 2.4%, 0.70%, 0.22% for 9, 17, 33 rows (the paper's hinge, root at
+/// length - dx/2: 0.6%, 0.4%, 0.7%, not converging).
 static void test_cantilever_matches_euler_bernoulli(void **state)
 {
 	(void)state;
 	const double length = 0.05, width = 0.1, bending = 1e-3, load = 1e-5;
 	int resolutions[3] = {9, 17, 33};
+	const double tolerance[3] = {0.03, 0.01, 0.004};
 	for (int r = 0; r < 3; ++r) {
 		plume_mesh *mesh = make_strip(length, width, resolutions[r]);
 		// Clamped over the first two columns: the beam starts at the second.
-		double free_length = length - 0.5 * mesh->reference[resolutions[r]].x;
+		double free_length = length - mesh->reference[resolutions[r]].x;
 		double expected = load * pow(free_length, 3) / (3 * bending * width);
 		plume_sim_def def = plate_def(plate(1e7, 1e-3, bending, 0));
 		plume_sim *sim = NULL;
@@ -152,7 +154,7 @@ static void test_cantilever_matches_euler_bernoulli(void **state)
 		double error = fabs(deflection - expected) / expected;
 		printf("cantilever rows %d: deflection %.6g m, Euler-Bernoulli %.6g m, error %.4f, %d Newton iterations\n",
 		       resolutions[r], deflection, expected, error, report.newton_iterations);
-		assert_true(error < 0.02);
+		assert_true(error < tolerance[r]);
 		plume_sim_destroy(sim);
 		plume_mesh_destroy(mesh);
 	}
@@ -324,7 +326,7 @@ static void test_kkt_factor_reports_indefinite(void **state)
 	plume_kkt kkt;
 	memset(&kkt, 0, sizeof kkt);
 	plume_error err = {0};
-	assert_int_equal(plume_kkt_init(&kkt, 2, 0, NULL, 0, NULL, 0, 0, NULL, &err), PLUME_OK);
+	assert_int_equal(plume_kkt_init(&kkt, 2, 0, NULL, 0, NULL, 0, 4, 0, NULL, &err), PLUME_OK);
 	double *values = plume_kkt_values(&kkt);
 	double shift = -1.0, rhs[6] = {1, 2, 3, 4, 5, 6}, x[6];
 	plume_kkt_zero(&kkt);

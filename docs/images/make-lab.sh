@@ -2,13 +2,13 @@
 # Re-makes the lab's pictures in docs/images (docs/lab.md) with plume itself.
 # Run from the repository root after `make`. The studies take minutes (the
 # angle sweep the longest); pass study names to re-make only those:
-#   docs/images/make-lab.sh traction size conditioning locking angles
+#   docs/images/make-lab.sh traction size conditioning locking angles bending
 set -euo pipefail
 plume=${PLUME:-build/plume}
 export OMP_NUM_THREADS=${OMP_NUM_THREADS:-1}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-what=${*:-traction size conditioning locking angles}
+what=${*:-traction size conditioning locking angles bending}
 for item in $what; do
 	case $item in
 	traction)

@@ -317,6 +317,60 @@ plume_status plume_lab_calibrate(const plume_calibration_def *def, plume_calibra
 void plume_calibration_result_free(plume_calibration_result *result);
 
 // ---------------------------------------------------------------------------
+// Bending under refinement: cantilever strips on four triangulation families
+
+typedef enum plume_strip_family {
+	/// Square cells split by one diagonal (right-isosceles triangles).
+	PLUME_STRIP_RIGHT = 0,
+	/// Rows shifted by half an edge: equilateral triangles, one edge family along the strip.
+	PLUME_STRIP_EQUILATERAL = 1,
+	/// Cells 4 times longer than wide, split by one diagonal.
+	PLUME_STRIP_ELONGATED = 2,
+	/// Square rows sheared so that one edge family runs at 60 degrees to the strip, as the barb
+	/// guides of a barb-aligned mesh do.
+	PLUME_STRIP_SLANTED = 3,
+} plume_strip_family;
+
+enum { PLUME_STRIP_FAMILY_COUNT = 4 };
+
+/// "right-isosceles", "equilateral", "elongated-4to1", "slanted-60".
+const char *plume_strip_family_name(plume_strip_family family);
+
+/// A flat strip [-c, length] x [0, width] (m), c = clamp_cells cell lengths, meshed by the
+/// family with `across` (>= 1) rows of cells across the width, every face's barb direction
+/// barb_angle (radians from +x), material 0. The lines x = -c, 0 and length are straight
+/// vertex lines (the nearest lattice vertex of each row moved onto them, by at most half a
+/// cell). Groups: "clamp" (x <= 0), "tip" (x = length), "tip_corners" (its two ends) and
+/// "tip_inner" (the rest).
+plume_status plume_lab_strip_mesh(plume_strip_family family, double length, double width, int clamp_cells, int across,
+                                  double barb_angle, plume_mesh **out, plume_error *err);
+
+typedef struct plume_cantilever_def {
+	plume_strip_family family;
+	/// Rows of cells across the width. Default 8.
+	int across;
+	/// Free length and width, m. Default 0.1 and 0.01.
+	double length;
+	double width;
+	/// Barb direction, radians from the strip axis. Default 0 (bending the strip bends the barbs).
+	double barb_angle;
+	/// Bending moduli, N m (plume_material). Default 1e-3 and 1e-3 (isotropic).
+	double bending_along;
+	double bending_across;
+	plume_bending_model model;
+} plume_cantilever_def;
+
+plume_cantilever_def plume_cantilever_default_def(void);
+
+/// The strip clamped at x <= 0, a tip load P across the width at x = length (shared as a
+/// line load: half shares at the corners), sized so that the deflection is 1e-4 of the length
+/// (linear range), no gravity, a membrane so stiff that only bending deforms. Returns the
+/// tip deflection over Euler-Bernoulli's P L^3 / (3 D W), D = D(beta) of the strip axis
+/// (thesis eq. 6.4; exact for the Poisson-free plate strip of plume's bending tensor when
+/// the barbs are along or across the strip).
+plume_status plume_lab_cantilever(const plume_cantilever_def *def, double *ratio, plume_error *err);
+
+// ---------------------------------------------------------------------------
 // Studies (docs/lab.md)
 
 typedef enum plume_study_kind {
@@ -332,6 +386,9 @@ typedef enum plume_study_kind {
 	PLUME_STUDY_ANGLES = 2,
 	/// Mesoscale longitudinal compression for several N = W / T (thesis A.3, Figures A.5-A.6).
 	PLUME_STUDY_SIZE = 3,
+	/// Cantilever strips on the four triangulation families under refinement, barbs along
+	/// and across the strip, both bending models: delta / delta_EB (issue 13, docs/lab.md).
+	PLUME_STUDY_BENDING = 4,
 } plume_study_kind;
 
 typedef struct plume_study_def {
@@ -347,7 +404,7 @@ typedef struct plume_study_def {
 
 plume_study_def plume_study_default_def(plume_study_kind kind);
 
-/// "locking", "conditioning", "angles" or "size".
+/// "locking", "conditioning", "angles", "size" or "bending".
 bool plume_study_kind_from_name(const char *name, plume_study_kind *kind);
 const char *plume_study_name(plume_study_kind kind);
 

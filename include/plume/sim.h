@@ -106,6 +106,15 @@ typedef struct plume_air_def {
 	uint64_t seed;
 } plume_air_def;
 
+/// The discretisation of the bending energy (docs/physics-energies.md).
+typedef enum plume_bending_model {
+	/// Per-face second fundamental form from mid-edge normals with the anisotropic bending
+	/// tensor of paper eqs. 6-8: the continuum stiffness on any lattice triangulation.
+	PLUME_BENDING_FUNDAMENTAL_FORM = 0,
+	/// The paper's hinge energy (thesis eqs. 6.2-6.5): exact on equilateral triangles only.
+	PLUME_BENDING_PAPER_HINGE = 1,
+} plume_bending_model;
+
 typedef struct plume_sim_def {
 	/// Material table indexed by plume_mesh.material. Default: [vane, rachis].
 	plume_material materials[PLUME_MAX_MATERIALS];
@@ -123,6 +132,8 @@ typedef struct plume_sim_def {
 	plume_integrator integrator;
 	/// Include the bending energy. Default true.
 	bool bending;
+	/// How bending is discretised. Default PLUME_BENDING_FUNDAMENTAL_FORM.
+	plume_bending_model bending_model;
 	/// Fix every vertex's z: in-plane problems (the lab's samples). Default false.
 	bool planar;
 	plume_solver_def solver;

@@ -17,9 +17,19 @@ static const char *const top_keys[] = {
     "drag",        "bending", "time_step",    "duration", "frame_every", "quasi_static", "solver", "integrator", "air", NULL,
 };
 static const char *const material_keys[] = {
-    "model",           "E_vv",          "E_ww",          "E_vw",           "youngs_modulus",
-    "poisson_ratio",   "thickness",     "surface_density", "barb_constraint", "bending_along",
-    "bending_across",  "compression_coefficient", NULL,
+    "model",
+    "E_vv",
+    "E_ww",
+    "E_vw",
+    "youngs_modulus",
+    "poisson_ratio",
+    "thickness",
+    "surface_density",
+    "barb_constraint",
+    "bending_along",
+    "bending_across",
+    "compression_coefficient",
+    NULL,
 };
 static const char *const handle_keys[] = {"group", "near", "radius", "pivot", "interpolation", "keyframes", NULL};
 static const char *const keyframe_keys[] = {"time", "translation", "rotation_axis", "rotation_deg", NULL};
@@ -31,6 +41,8 @@ static const char *const integrators[] = {"implicit-euler", "bdf2", NULL};
 static const char *const air_keys[] = {"density", "normal_drag", "tangential_drag", "centre_of_pressure", "wind",
                                        "gusts", "seed", NULL};
 static const char *const gust_keys[] = {"speed", "length", "time", NULL};
+/// Indexed by plume_bending_model.
+static const char *const bending_models[] = {"fundamental-form", "paper-hinge", NULL};
 
 /// An array of exactly n numbers.
 static bool read_numbers(plume_spec_reader *reader, const json_t *object, const char *path, const char *key,
@@ -165,8 +177,7 @@ static void read_dynamics(plume_spec_reader *reader, const json_t *root, plume_s
 	plume_spec_number(reader, gusts, "$.air.gusts", "time", &def->air.gust_time);
 }
 
-static void read_keyframes(plume_spec_reader *reader, const json_t *array, const char *path,
-                           plume_scene_handle *handle)
+static void read_keyframes(plume_spec_reader *reader, const json_t *array, const char *path, plume_scene_handle *handle)
 {
 	size_t count = json_array_size(array);
 	handle->keyframes = plume_calloc(count > 0 ? count : 1, sizeof(plume_keyframe));
@@ -365,8 +376,9 @@ static plume_status load_feather(const char *file, const json_t *root, const plu
 		plume_error_prefix(err, file);
 		return err != NULL ? err->status : PLUME_ERROR_IO;
 	}
-	plume_status status = json_object_get(spec, "model") != NULL ? plume_spec_generate_json(path, spec, options, out, err)
-	                                                             : plume_read_json(path, out, err);
+	plume_status status = json_object_get(spec, "model") != NULL
+	                          ? plume_spec_generate_json(path, spec, options, out, err)
+	                          : plume_read_json(path, out, err);
 	json_decref(spec);
 	return status;
 }
@@ -406,8 +418,7 @@ static plume_status build_mesh(const char *file, const json_t *root, const plume
 static plume_status scene_from_json(const char *path, json_t *root, const plume_spec_options *options,
                                     plume_scene **out, plume_error *err);
 
-plume_status plume_scene_load(const char *path, const plume_spec_options *options, plume_scene **out,
-                              plume_error *err)
+plume_status plume_scene_load(const char *path, const plume_spec_options *options, plume_scene **out, plume_error *err)
 {
 	*out = NULL;
 	json_t *root = plume_spec_load(path, err);
@@ -416,8 +427,8 @@ plume_status plume_scene_load(const char *path, const plume_spec_options *option
 	return scene_from_json(path, root, options, out, err);
 }
 
-plume_status plume_scene_parse(const char *text, const char *name, const plume_spec_options *options,
-                               plume_scene **out, plume_error *err)
+plume_status plume_scene_parse(const char *text, const char *name, const plume_spec_options *options, plume_scene **out,
+                               plume_error *err)
 {
 	*out = NULL;
 	json_error_t error;
@@ -430,6 +441,22 @@ plume_status plume_scene_parse(const char *text, const char *name, const plume_s
 		return status;
 	}
 	return scene_from_json(name, root, options, out, err);
+}
+
+/// "bending": true or false (on or off), or the model's name (on, that model).
+static void read_bending(plume_spec_reader *reader, const json_t *root, plume_sim_def *def)
+{
+	const json_t *value = json_object_get(root, "bending");
+	if (value == NULL || json_is_boolean(value)) {
+		plume_spec_bool(reader, root, "$", "bending", &def->bending);
+		return;
+	}
+	const char *name;
+	if (!plume_spec_string(reader, root, "$", "bending", &name))
+		return;
+	int model = word_index(reader, "$.bending", name, bending_models);
+	if (model >= 0)
+		def->bending_model = (plume_bending_model)model;
 }
 
 /// Reads the scene and releases root.
@@ -455,7 +482,7 @@ static plume_status scene_from_json(const char *path, json_t *root, const plume_
 	read_materials(&reader, root, &scene->sim);
 	read_vec3(&reader, root, "$", "gravity", &scene->sim.gravity);
 	plume_spec_number(&reader, root, "$", "drag", &scene->sim.drag);
-	plume_spec_bool(&reader, root, "$", "bending", &scene->sim.bending);
+	read_bending(&reader, root, &scene->sim);
 	plume_spec_number(&reader, root, "$", "time_step", &scene->sim.time_step);
 	plume_spec_number(&reader, root, "$", "duration", &scene->duration);
 	plume_spec_int(&reader, root, "$", "frame_every", &scene->frame_every);

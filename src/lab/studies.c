@@ -12,7 +12,7 @@
 
 static const double PI = 3.14159265358979323846;
 
-static const char *const study_names[] = {"locking", "conditioning", "angles", "size"};
+static const char *const study_names[] = {"locking", "conditioning", "angles", "size", "bending"};
 
 plume_study_def plume_study_default_def(plume_study_kind kind)
 {
@@ -21,7 +21,7 @@ plume_study_def plume_study_default_def(plume_study_kind kind)
 
 bool plume_study_kind_from_name(const char *name, plume_study_kind *kind)
 {
-	for (int k = 0; k < 4; ++k)
+	for (int k = 0; k < 5; ++k)
 		if (strcmp(name, study_names[k]) == 0) {
 			*kind = (plume_study_kind)k;
 			return true;
@@ -29,7 +29,7 @@ bool plume_study_kind_from_name(const char *name, plume_study_kind *kind)
 	return false;
 }
 
-const char *plume_study_name(plume_study_kind kind) { return kind >= 0 && kind < 4 ? study_names[kind] : "unknown"; }
+const char *plume_study_name(plume_study_kind kind) { return kind >= 0 && kind < 5 ? study_names[kind] : "unknown"; }
 
 static int scaled(int count, double scale)
 {
@@ -500,6 +500,79 @@ static plume_status study_size(const plume_study_def *def, const char *csv, cons
 	return status;
 }
 
+// ---------------------------------------------------------------------------
+// Bending: cantilever strips under refinement (issue 13)
+
+static plume_status study_bending(const plume_study_def *def, const char *csv, const char *png, const char *svg,
+                                  char *summary, size_t summary_size, plume_error *err)
+{
+	enum { MAX_LEVELS = 4, SERIES = 2 * 2 * PLUME_STRIP_FAMILY_COUNT };
+	static const int levels[MAX_LEVELS] = {2, 4, 8, 16};
+	// A scale below 1 (a quick look, the CLI test) stops at 4 cells across.
+	const int LEVELS = def->scale < 1 ? 2 : MAX_LEVELS;
+	// Rows: model (0 fundamental form, 1 paper hinge), family, barbs (0 along the strip,
+	// 1 across), cells across the width, delta / delta_EB.
+	table t = {.column_count = 5};
+	double xs[SERIES][MAX_LEVELS], ys[SERIES][MAX_LEVELS];
+	double worst_finest[2] = {0, 0};
+	plume_status status = PLUME_OK;
+	int done = 0, total = SERIES * LEVELS;
+	for (int model = 0; model < 2 && status == PLUME_OK; ++model)
+		for (int family = 0; family < PLUME_STRIP_FAMILY_COUNT && status == PLUME_OK; ++family)
+			for (int barbs = 0; barbs < 2 && status == PLUME_OK; ++barbs)
+				for (int l = 0; l < LEVELS && status == PLUME_OK; ++l) {
+					plume_cantilever_def c = plume_cantilever_default_def();
+					c.model = model == 0 ? PLUME_BENDING_FUNDAMENTAL_FORM : PLUME_BENDING_PAPER_HINGE;
+					c.family = (plume_strip_family)family;
+					c.across = levels[l];
+					// The vane's moduli (thesis Table 6.1): stiff when the strip bends the barbs.
+					c.bending_along = 1e-7;
+					c.bending_across = 2.5e-4;
+					c.barb_angle = barbs == 0 ? 0 : 0.5 * PI;
+					double ratio;
+					status = plume_lab_cantilever(&c, &ratio, err);
+					study_progress(def, &done, total);
+					int series = (model * PLUME_STRIP_FAMILY_COUNT + family) * 2 + barbs;
+					xs[series][l] = levels[l];
+					ys[series][l] = ratio;
+					double row[5] = {model, family, barbs, levels[l], ratio};
+					if (status == PLUME_OK && table_add(&t, row) != 0)
+						status = memory_error(err);
+					if (l == LEVELS - 1)
+						worst_finest[model] = fmax(worst_finest[model], fabs(ratio - 1));
+				}
+	if (status == PLUME_OK)
+		status = plume_lab_write_csv(csv, "model,family,barbs_across,cells_across,deflection_over_euler_bernoulli",
+		                             (const double *const *)t.columns, 5, t.row_count, err);
+	if (status == PLUME_OK) {
+		plume_plot_series series[SERIES];
+		char labels[SERIES][64];
+		for (int k = 0; k < SERIES; ++k) {
+			int model = k / (2 * PLUME_STRIP_FAMILY_COUNT), family = k / 2 % PLUME_STRIP_FAMILY_COUNT;
+			snprintf(labels[k], sizeof labels[k], "%s, %s, barbs %s", model == 0 ? "fundamental form" : "paper hinge",
+			         plume_strip_family_name((plume_strip_family)family), k % 2 == 0 ? "along" : "across");
+			series[k] = (plume_plot_series){labels[k], xs[k], ys[k], LEVELS, false, model == 1};
+		}
+		plume_plot plot = {.title = "Cantilever strips: tip deflection over Euler-Bernoulli",
+		                   .x_label = "cells across the width",
+		                   .y_label = "#gd / #gd#dEB#u",
+		                   .log_x = true,
+		                   .legend = PLUME_LEGEND_TOP_RIGHT,
+		                   .series_count = SERIES,
+		                   .series = series,
+		                   .width = 1280,
+		                   .height = 960};
+		status = plume_lab_plot(&plot, png, svg, err);
+	}
+	if (status == PLUME_OK && summary != NULL)
+		snprintf(summary, summary_size,
+		         "{\"study\": \"bending\", \"rows\": %d, \"finest_cells_across\": %d, \"largest_error_at_finest\": "
+		         "{\"fundamental_form\": %.4g, \"paper_hinge\": %.4g}}",
+		         t.row_count, levels[LEVELS - 1], worst_finest[0], worst_finest[1]);
+	table_free(&t);
+	return status;
+}
+
 plume_status plume_lab_study(const plume_study_def *def, const char *csv_path, const char *png_path,
                              const char *svg_path, char *summary, size_t summary_size, plume_error *err)
 {
@@ -514,6 +587,7 @@ plume_status plume_lab_study(const plume_study_def *def, const char *csv_path, c
 		return study_conditioning(def, csv_path, png_path, svg_path, summary, summary_size, err);
 	case PLUME_STUDY_ANGLES: return study_angles(def, csv_path, png_path, svg_path, summary, summary_size, err);
 	case PLUME_STUDY_SIZE: return study_size(def, csv_path, png_path, svg_path, summary, summary_size, err);
+	case PLUME_STUDY_BENDING: return study_bending(def, csv_path, png_path, svg_path, summary, summary_size, err);
 	}
 	return plume_error_set(err, PLUME_ERROR_SPEC, "unknown study %d", (int)def->kind);
 }

@@ -1,7 +1,7 @@
 // Per-face fields for output (plume_sim_face_fields): the same kinematics and
 // material tensors the energies use (membrane.c), evaluated once at the current
 // positions, and the bending energy of each hinge shared half and half by its
-// two faces.
+// two faces (of each fundamental-form element: its face's).
 #include <stdlib.h>
 #include <string.h>
 
@@ -70,7 +70,7 @@ plume_status plume_sim_face_fields(const plume_sim *sim, plume_sim_face_field *o
 		    element->compression > 0 ? plume_compression_energy(element, local, NULL, NULL) / element->area : 0.0;
 		o->bending_energy_density = 0.0;
 	}
-	if (!sim->def.bending || sim->hinge_count == 0)
+	if (!sim->def.bending || plume_sim_bending_count(sim) == 0)
 		return PLUME_OK;
 	face_key *keys = plume_alloc((size_t)(faces > 0 ? faces : 1) * sizeof *keys);
 	if (keys == NULL)
@@ -81,17 +81,16 @@ plume_status plume_sim_face_fields(const plume_sim *sim, plume_sim_face_field *o
 		keys[f].face = f;
 	}
 	qsort(keys, (size_t)faces, sizeof *keys, compare_key);
-	for (int e = 0; e < sim->hinge_count; ++e) {
-		const plume_hinge *hinge = sim->hinges + e;
-		plume_vec3 local[4];
-		for (int i = 0; i < 4; ++i)
-			local[i] = sim->x[hinge->vertices[i]];
-		double energy = plume_hinge_energy(hinge, local, NULL, NULL);
-		const int *v = hinge->vertices;
-		int sides[2] = {find_face(keys, faces, v[0], v[1], v[2]), find_face(keys, faces, v[0], v[1], v[3])};
+	// A hinge's energy goes half and half to its faces; a fundamental-form element's to its face.
+	bool hinges = sim->def.bending_model == PLUME_BENDING_PAPER_HINGE;
+	for (int e = 0; e < plume_sim_bending_count(sim); ++e) {
+		double energy = plume_sim_bending_energy(sim, sim->x, e);
+		const int *v = plume_sim_bending_vertices(sim, e);
+		int sides[2] = {find_face(keys, faces, v[0], v[1], v[2]),
+		                hinges ? find_face(keys, faces, v[0], v[1], v[3]) : -1};
 		for (int k = 0; k < 2; ++k)
 			if (sides[k] >= 0)
-				out[sides[k]].bending_energy_density += 0.5 * energy / sim->membranes[sides[k]].area;
+				out[sides[k]].bending_energy_density += (hinges ? 0.5 : 1.0) * energy / sim->membranes[sides[k]].area;
 	}
 	plume_free(keys);
 	return PLUME_OK;

@@ -20,7 +20,7 @@ static int push_block(entry_list *list, const int *vertices, int count)
 	for (int a = 0; a < 3 * count; ++a)
 		for (int b = 0; b < 3 * count; ++b) {
 			int i = 3 * vertices[a / 3] + a % 3, j = 3 * vertices[b / 3] + b % 3;
-			if (i > j)
+			if (i > j || vertices[a / 3] < 0 || vertices[b / 3] < 0)
 				continue;
 			if (PLUME_GROW(list->items, list->capacity, list->count + 1) != 0)
 				return -1;
@@ -35,12 +35,13 @@ static void fill_block_slots(const plume_sparse *system, const int *vertices, in
 	for (int a = 0; a < n; ++a)
 		for (int b = 0; b < n; ++b) {
 			int i = 3 * vertices[a / 3] + a % 3, j = 3 * vertices[b / 3] + b % 3;
-			slots[a * n + b] = i <= j ? plume_sparse_find(system, i, j) : -1;
+			bool present = vertices[a / 3] >= 0 && vertices[b / 3] >= 0;
+			slots[a * n + b] = present && i <= j ? plume_sparse_find(system, i, j) : -1;
 		}
 }
 
-plume_status plume_kkt_init(plume_kkt *kkt, int vertex_count, int face_count, const int *faces, int hinge_count,
-                            const int *hinge_vertices, int hinge_stride, int constraint_count,
+plume_status plume_kkt_init(plume_kkt *kkt, int vertex_count, int face_count, const int *faces, int bending_count,
+                            const int *bending_vertices, int bending_stride, int bending_size, int constraint_count,
                             const int *constraint_vertices, plume_error *err)
 {
 	memset(kkt, 0, sizeof *kkt);
@@ -54,8 +55,9 @@ plume_status plume_kkt_init(plume_kkt *kkt, int vertex_count, int face_count, co
 		failed = push_block(&list, &v, 1);
 	for (int f = 0; f < face_count && !failed; ++f)
 		failed = push_block(&list, faces + 3 * f, 3);
-	for (int h = 0; h < hinge_count && !failed; ++h)
-		failed = push_block(&list, (const int *)((const char *)hinge_vertices + (size_t)h * hinge_stride), 4);
+	for (int h = 0; h < bending_count && !failed; ++h)
+		failed =
+		    push_block(&list, (const int *)((const char *)bending_vertices + (size_t)h * bending_stride), bending_size);
 	for (int k = 0; k < constraint_count && !failed; ++k)
 		failed = push_block(&list, constraint_vertices + 2 * k, 2);
 	for (int k = 0; k < constraint_count && !failed; ++k) {
@@ -86,10 +88,12 @@ plume_status plume_kkt_init(plume_kkt *kkt, int vertex_count, int face_count, co
 
 	kkt->vertex_slots = plume_alloc(sizeof(int) * 9 * (size_t)(vertex_count > 0 ? vertex_count : 1));
 	kkt->face_slots = plume_alloc(sizeof(int) * 81 * (size_t)(face_count > 0 ? face_count : 1));
-	kkt->hinge_slots = plume_alloc(sizeof(int) * 144 * (size_t)(hinge_count > 0 ? hinge_count : 1));
+	int block = 9 * bending_size * bending_size;
+	kkt->bending_size = bending_size;
+	kkt->bending_slots = plume_alloc(sizeof(int) * (size_t)block * (size_t)(bending_count > 0 ? bending_count : 1));
 	kkt->constraint_slots = plume_alloc(sizeof(int) * 7 * (size_t)(constraint_count > 0 ? constraint_count : 1));
 	kkt->pair_slots = plume_alloc(sizeof(int) * 36 * (size_t)(constraint_count > 0 ? constraint_count : 1));
-	if (!kkt->vertex_slots || !kkt->face_slots || !kkt->hinge_slots || !kkt->constraint_slots || !kkt->pair_slots) {
+	if (!kkt->vertex_slots || !kkt->face_slots || !kkt->bending_slots || !kkt->constraint_slots || !kkt->pair_slots) {
 		plume_kkt_free(kkt);
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory allocating the solver's slot maps");
 	}
@@ -97,9 +101,9 @@ plume_status plume_kkt_init(plume_kkt *kkt, int vertex_count, int face_count, co
 		fill_block_slots(matrix, &v, 1, kkt->vertex_slots + 9 * v);
 	for (int f = 0; f < face_count; ++f)
 		fill_block_slots(matrix, faces + 3 * f, 3, kkt->face_slots + 81 * f);
-	for (int h = 0; h < hinge_count; ++h)
-		fill_block_slots(matrix, (const int *)((const char *)hinge_vertices + (size_t)h * hinge_stride), 4,
-		                 kkt->hinge_slots + 144 * h);
+	for (int h = 0; h < bending_count; ++h)
+		fill_block_slots(matrix, (const int *)((const char *)bending_vertices + (size_t)h * bending_stride),
+		                 bending_size, kkt->bending_slots + (size_t)block * h);
 	for (int k = 0; k < constraint_count; ++k) {
 		int column = kkt->dof_count + k;
 		fill_block_slots(matrix, constraint_vertices + 2 * k, 2, kkt->pair_slots + 36 * k);
@@ -117,7 +121,7 @@ void plume_kkt_free(plume_kkt *kkt)
 	plume_sparse_free(&kkt->system);
 	plume_free(kkt->vertex_slots);
 	plume_free(kkt->face_slots);
-	plume_free(kkt->hinge_slots);
+	plume_free(kkt->bending_slots);
 	plume_free(kkt->constraint_slots);
 	plume_free(kkt->pair_slots);
 	plume_free(kkt->refine);

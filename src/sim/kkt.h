@@ -25,17 +25,19 @@ typedef struct plume_kkt {
 	int constraint_count;
 	/// Slot of the entry for each element block pair (upper part), -1 for the lower part.
 	int *face_slots;       ///< 81 per face
-	int *hinge_slots;      ///< 144 per hinge
+	int *bending_slots;    ///< (3 k)^2 per bending element of k vertices
+	int bending_size;      ///< k: 4 (hinge) or 6 (fundamental-form face)
 	int *vertex_slots;     ///< 9 per vertex
 	int *constraint_slots; ///< 7 per constraint: 6 Jacobian entries and the diagonal
 	int *pair_slots;       ///< 36 per constraint: the 6x6 position block of its two vertices
 	double *refine;        ///< scratch for iterative refinement (3 x size)
 } plume_kkt;
 
-/// Builds the pattern from faces (3 vertices), hinges (4 vertices), per-vertex blocks and
+/// Builds the pattern from faces (3 vertices), bending elements (bending_size vertices
+/// each, bending_stride bytes apart; a negative vertex is absent), per-vertex blocks and
 /// constraints (2 vertices each), and runs the symbolic analysis.
-plume_status plume_kkt_init(plume_kkt *kkt, int vertex_count, int face_count, const int *faces, int hinge_count,
-                            const int *hinge_vertices, int hinge_stride, int constraint_count,
+plume_status plume_kkt_init(plume_kkt *kkt, int vertex_count, int face_count, const int *faces, int bending_count,
+                            const int *bending_vertices, int bending_stride, int bending_size, int constraint_count,
                             const int *constraint_vertices, plume_error *err);
 void plume_kkt_free(plume_kkt *kkt);
 

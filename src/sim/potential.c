@@ -18,7 +18,7 @@
 static void gather(const plume_vec3 *x, const int *vertices, int count, plume_vec3 *out)
 {
 	for (int i = 0; i < count; ++i)
-		out[i] = x[vertices[i]];
+		out[i] = vertices[i] >= 0 ? x[vertices[i]] : plume_v3(0, 0, 0);
 }
 
 static void evaluate_faces(plume_sim *sim, const plume_vec3 *x, bool gradient, bool hessian, bool project)
@@ -33,6 +33,32 @@ static void evaluate_faces(plume_sim *sim, const plume_vec3 *x, bool gradient, b
 		double *h = hessian ? sim->face_hessian + 81 * f : NULL;
 		sim->face_energy[f] = plume_triangle_energy(element, local, g, h, project);
 	}
+}
+
+int plume_sim_bending_count(const plume_sim *sim)
+{
+	return sim->def.bending_model == PLUME_BENDING_PAPER_HINGE ? sim->hinge_count : sim->ff_count;
+}
+
+int plume_sim_bending_size(const plume_sim *sim) { return sim->def.bending_model == PLUME_BENDING_PAPER_HINGE ? 4 : 6; }
+
+int plume_sim_bending_stride(const plume_sim *sim)
+{
+	return sim->def.bending_model == PLUME_BENDING_PAPER_HINGE ? (int)sizeof(plume_hinge) : (int)sizeof(plume_ff_face);
+}
+
+const int *plume_sim_bending_vertices(const plume_sim *sim, int e)
+{
+	return sim->def.bending_model == PLUME_BENDING_PAPER_HINGE ? sim->hinges[e].vertices : sim->ff_faces[e].vertices;
+}
+
+double plume_sim_bending_energy(const plume_sim *sim, const plume_vec3 *x, int e)
+{
+	plume_vec3 local[6];
+	gather(x, plume_sim_bending_vertices(sim, e), plume_sim_bending_size(sim), local);
+	return sim->def.bending_model == PLUME_BENDING_PAPER_HINGE
+	           ? plume_hinge_energy(sim->hinges + e, local, NULL, NULL)
+	           : plume_ff_face_energy(sim->ff_faces + e, local, NULL, NULL);
 }
 
 static void evaluate_hinges(plume_sim *sim, const plume_vec3 *x, bool gradient, bool hessian, bool project)
@@ -63,16 +89,32 @@ static void evaluate_hinges(plume_sim *sim, const plume_vec3 *x, bool gradient, 
 	}
 }
 
+static void evaluate_ff_faces(plume_sim *sim, const plume_vec3 *x, bool gradient, bool hessian, bool project)
+{
+	int count = sim->ff_count;
+#pragma omp parallel for schedule(static) if (count >= 2048)
+	for (int e = 0; e < count; ++e) {
+		const plume_ff_face *face = sim->ff_faces + e;
+		plume_vec3 local[6];
+		gather(x, face->vertices, 6, local);
+		double *g = gradient ? sim->hinge_gradient + 18 * e : NULL;
+		double *h = hessian ? sim->hinge_hessian + 324 * e : NULL;
+		// Projected: the Gauss-Newton part J^T M J, for the reason given for the hinges.
+		sim->hinge_energy[e] =
+		    project ? plume_ff_face_energy_gauss_newton(face, local, g, h) : plume_ff_face_energy(face, local, g, h);
+	}
+}
+
 /// Adds a symmetric element block into the matrix, skipping held unknowns.
 static void scatter_block(const plume_sim *sim, double *values, const int *vertices, int count, const int *slots,
                           const double *block)
 {
 	int n = 3 * count;
 	for (int a = 0; a < n; ++a) {
-		if (sim->fixed[3 * vertices[a / 3] + a % 3])
+		if (vertices[a / 3] < 0 || sim->fixed[3 * vertices[a / 3] + a % 3])
 			continue;
 		for (int b = 0; b < n; ++b) {
-			int slot = slots[a * n + b];
+			int slot = slots[a * n + b]; // -1 for the lower part and absent vertices
 			if (slot >= 0 && !sim->fixed[3 * vertices[b / 3] + b % 3])
 				values[slot] += block[a * n + b];
 		}
@@ -82,7 +124,8 @@ static void scatter_block(const plume_sim *sim, double *values, const int *verti
 static void scatter_gradient(double *gradient, const int *vertices, int count, const double *local)
 {
 	for (int a = 0; a < 3 * count; ++a)
-		gradient[3 * vertices[a / 3] + a % 3] += local[a];
+		if (vertices[a / 3] >= 0)
+			gradient[3 * vertices[a / 3] + a % 3] += local[a];
 }
 
 double plume_sim_potential(plume_sim *sim, const sim_problem *problem, const plume_vec3 *x, double *gradient,
@@ -91,8 +134,10 @@ double plume_sim_potential(plume_sim *sim, const sim_problem *problem, const plu
 	int n = sim->vertex_count;
 	bool want_gradient = gradient != NULL;
 	evaluate_faces(sim, x, want_gradient, hessian, project);
-	if (sim->def.bending)
+	if (sim->def.bending && sim->def.bending_model == PLUME_BENDING_PAPER_HINGE)
 		evaluate_hinges(sim, x, want_gradient, hessian, project);
+	else if (sim->def.bending)
+		evaluate_ff_faces(sim, x, want_gradient, hessian, project);
 	if (problem->dynamic && sim->air.active)
 		plume_air_add(sim, problem, x, want_gradient, hessian);
 
@@ -111,13 +156,15 @@ double plume_sim_potential(plume_sim *sim, const sim_problem *problem, const plu
 		if (hessian)
 			scatter_block(sim, values, vertices, 3, sim->kkt.face_slots + 81 * f, sim->face_hessian + 81 * f);
 	}
-	for (int e = 0; sim->def.bending && e < sim->hinge_count; ++e) {
+	int size = plume_sim_bending_size(sim), dofs = 3 * size;
+	for (int e = 0; sim->def.bending && e < plume_sim_bending_count(sim); ++e) {
 		energy += sim->hinge_energy[e];
-		const int *vertices = sim->hinges[e].vertices;
+		const int *vertices = plume_sim_bending_vertices(sim, e);
+		size_t block = (size_t)dofs * (size_t)dofs * (size_t)e;
 		if (want_gradient)
-			scatter_gradient(gradient, vertices, 4, sim->hinge_gradient + 12 * e);
+			scatter_gradient(gradient, vertices, size, sim->hinge_gradient + (size_t)dofs * e);
 		if (hessian)
-			scatter_block(sim, values, vertices, 4, sim->kkt.hinge_slots + 144 * e, sim->hinge_hessian + 144 * e);
+			scatter_block(sim, values, vertices, size, sim->kkt.bending_slots + block, sim->hinge_hessian + block);
 	}
 
 	plume_vec3 g = sim->def.gravity;

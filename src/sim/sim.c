@@ -27,6 +27,7 @@ plume_sim_def plume_sim_default_def(void)
 	def.time_step = 0.011;
 	def.integrator = PLUME_INTEGRATOR_BDF2;
 	def.bending = true;
+	def.bending_model = PLUME_BENDING_FUNDAMENTAL_FORM;
 	def.planar = false;
 	def.solver.tolerance = 1e-7;
 	def.solver.max_iterations = 50;
@@ -94,6 +95,9 @@ plume_status plume_sim_def_validate(const plume_sim_def *def, int mesh_material_
 	}
 	if (!(def->time_step >= 1e-9 && def->time_step <= 100.0))
 		return plume_error_set(err, PLUME_ERROR_SPEC, "$.time_step is %g, allowed [1e-09, 100] s", def->time_step);
+	if (def->bending_model != PLUME_BENDING_FUNDAMENTAL_FORM && def->bending_model != PLUME_BENDING_PAPER_HINGE)
+		return plume_error_set(err, PLUME_ERROR_SPEC, "$.bending is model %d, allowed fundamental-form or paper-hinge",
+		                       (int)def->bending_model);
 	if (!(def->drag >= 0) || !isfinite(def->drag))
 		return plume_error_set(err, PLUME_ERROR_SPEC, "$.drag is %g, allowed >= 0", def->drag);
 	if (def->integrator != PLUME_INTEGRATOR_IMPLICIT_EULER && def->integrator != PLUME_INTEGRATOR_BDF2)
@@ -193,14 +197,18 @@ static void bending_moduli(const plume_material *material, double *along, double
 
 static double harmonic_mean(double a, double b) { return a + b > 0 ? 2 * a * b / (a + b) : 0; }
 
-static plume_status build_hinges(plume_sim *sim, const plume_mesh *mesh, plume_error *err)
+// The plain two-face edges (non-manifold fans left out: only they bend), in the order of
+// their sorted vertex pair: pairs of face edges 3 f + k, edge k of face f being
+// (faces[3f+k], faces[3f+(k+1)%3]). Returns the number of pairs, -1 when out of memory.
+static int pair_face_edges(const plume_mesh *mesh, int **out)
 {
 	int count = 3 * mesh->face_count;
 	half_edge *edges = plume_alloc(sizeof(half_edge) * (size_t)(count > 0 ? count : 1));
-	sim->hinges = plume_alloc(sizeof(plume_hinge) * (size_t)(count / 2 + 1));
-	if (edges == NULL || sim->hinges == NULL) {
+	int *pairs = plume_alloc(sizeof(int) * (size_t)(count > 0 ? count : 1));
+	if (edges == NULL || pairs == NULL) {
 		plume_free(edges);
-		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory building hinges");
+		plume_free(pairs);
+		return -1;
 	}
 	for (int f = 0; f < mesh->face_count; ++f)
 		for (int k = 0; k < 3; ++k) {
@@ -208,16 +216,35 @@ static plume_status build_hinges(plume_sim *sim, const plume_mesh *mesh, plume_e
 			edges[3 * f + k] = (half_edge){a < b ? a : b, a < b ? b : a, f, k};
 		}
 	qsort(edges, (size_t)count, sizeof *edges, compare_half_edges);
+	int pair_count = 0;
 	for (int e = 0; e + 1 < count; ++e) {
 		const half_edge *p = edges + e, *q = edges + e + 1;
 		if (p->low != q->low || p->high != q->high)
 			continue;
-		// Skip non-manifold fans: only plain two-face edges bend.
 		if ((e + 2 < count && edges[e + 2].low == p->low && edges[e + 2].high == p->high) ||
 		    (e > 0 && edges[e - 1].low == p->low && edges[e - 1].high == p->high))
 			continue;
-		const int *fa = mesh->faces + 3 * p->face, *fb = mesh->faces + 3 * q->face;
-		int vertices[4] = {fa[p->local], fa[(p->local + 1) % 3], fa[(p->local + 2) % 3], fb[(q->local + 2) % 3]};
+		pairs[2 * pair_count] = 3 * p->face + p->local;
+		pairs[2 * pair_count + 1] = 3 * q->face + q->local;
+		++pair_count;
+		++e;
+	}
+	plume_free(edges);
+	*out = pairs;
+	return pair_count;
+}
+
+// The paper's hinges (sim/bending.h): one per plain two-face edge.
+static plume_status build_hinges(plume_sim *sim, const plume_mesh *mesh, const int *pairs, int pair_count,
+                                 plume_error *err)
+{
+	sim->hinges = plume_alloc(sizeof(plume_hinge) * (size_t)(pair_count > 0 ? pair_count : 1));
+	if (sim->hinges == NULL)
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory building hinges");
+	for (int e = 0; e < pair_count; ++e) {
+		int pf = pairs[2 * e] / 3, pk = pairs[2 * e] % 3, qf = pairs[2 * e + 1] / 3, qk = pairs[2 * e + 1] % 3;
+		const int *fa = mesh->faces + 3 * pf, *fb = mesh->faces + 3 * qf;
+		int vertices[4] = {fa[pk], fa[(pk + 1) % 3], fa[(pk + 2) % 3], fb[(qk + 2) % 3]};
 		plume_vec2 reference[4];
 		plume_vec3 rest[4];
 		for (int i = 0; i < 4; ++i) {
@@ -225,18 +252,86 @@ static plume_status build_hinges(plume_sim *sim, const plume_mesh *mesh, plume_e
 			rest[i] = mesh->rest[vertices[i]];
 		}
 		double along_a, across_a, along_b, across_b;
-		bending_moduli(sim->def.materials + mesh->material[p->face], &along_a, &across_a);
-		bending_moduli(sim->def.materials + mesh->material[q->face], &along_b, &across_b);
+		bending_moduli(sim->def.materials + mesh->material[pf], &along_a, &across_a);
+		bending_moduli(sim->def.materials + mesh->material[qf], &along_b, &across_b);
 		// A hinge between two materials (the rachis border) bends where the softer side
 		// bends: the harmonic mean, about twice the softer modulus when they differ a lot.
-		if (plume_hinge_init(sim->hinges + sim->hinge_count, vertices, reference, rest, mesh->barb_angle[p->face],
-		                     mesh->barb_angle[q->face], harmonic_mean(along_a, along_b),
-		                     harmonic_mean(across_a, across_b)))
+		if (plume_hinge_init(sim->hinges + sim->hinge_count, vertices, reference, rest, mesh->barb_angle[pf],
+		                     mesh->barb_angle[qf], harmonic_mean(along_a, along_b), harmonic_mean(across_a, across_b)))
 			++sim->hinge_count;
-		++e;
 	}
-	plume_free(edges);
 	return PLUME_OK;
+}
+
+// The fundamental-form elements (sim/fundamental_form.h): one per face, each with its
+// own material's moduli and barb direction (no averaging across a material border).
+static plume_status build_ff_faces(plume_sim *sim, const plume_mesh *mesh, const int *pairs, int pair_count,
+                                   plume_error *err)
+{
+	int faces = mesh->face_count;
+	int *across = plume_alloc(sizeof(int) * 3 * (size_t)faces);
+	sim->ff_faces = plume_alloc(sizeof(plume_ff_face) * (size_t)faces);
+	if (across == NULL || sim->ff_faces == NULL) {
+		plume_free(across);
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory building the bending elements");
+	}
+	for (int i = 0; i < 3 * faces; ++i)
+		across[i] = -1;
+	for (int e = 0; e < pair_count; ++e) {
+		int p = pairs[2 * e], q = pairs[2 * e + 1];
+		across[p] = mesh->faces[3 * (q / 3) + (q % 3 + 2) % 3];
+		across[q] = mesh->faces[3 * (p / 3) + (p % 3 + 2) % 3];
+	}
+	for (int f = 0; f < faces; ++f) {
+		const int *v = mesh->faces + 3 * f;
+		// Edge k of the face is opposite vertex (k + 2) % 3.
+		int vertices[6] = {v[0], v[1], v[2], across[3 * f + 1], across[3 * f + 2], across[3 * f]};
+		plume_vec2 reference[3] = {mesh->reference[v[0]], mesh->reference[v[1]], mesh->reference[v[2]]};
+		plume_vec3 rest[6];
+		for (int i = 0; i < 6; ++i)
+			rest[i] = vertices[i] >= 0 ? mesh->rest[vertices[i]] : plume_v3(0, 0, 0);
+		double along, across_modulus;
+		bending_moduli(sim->def.materials + mesh->material[f], &along, &across_modulus);
+		if (!plume_ff_face_init(sim->ff_faces + f, vertices, reference, rest, mesh->barb_angle[f], along,
+		                        across_modulus)) {
+			plume_free(across);
+			return plume_error_set(err, PLUME_ERROR_NUMERIC, "mesh face %d is degenerate in the reference plane", f);
+		}
+	}
+	sim->ff_count = faces;
+	// Material borders (fundamental_form.h): each face's share of the edge's angle.
+	for (int e = 0; e < pair_count; ++e) {
+		int side[2] = {pairs[2 * e], pairs[2 * e + 1]};
+		if (mesh->material[side[0] / 3] == mesh->material[side[1] / 3])
+			continue;
+		double modulus[2];
+		for (int k = 0; k < 2; ++k) {
+			int f = side[k] / 3;
+			const int *v = mesh->faces + 3 * f;
+			plume_vec2 reference[3] = {mesh->reference[v[0]], mesh->reference[v[1]], mesh->reference[v[2]]};
+			double along, across_modulus;
+			bending_moduli(sim->def.materials + mesh->material[f], &along, &across_modulus);
+			modulus[k] =
+			    plume_ff_edge_modulus(reference, (side[k] % 3 + 2) % 3, mesh->barb_angle[f], along, across_modulus);
+		}
+		for (int k = 0; k < 2; ++k)
+			plume_ff_face_border(sim->ff_faces + side[k] / 3, (side[k] % 3 + 2) % 3, modulus[k], modulus[1 - k]);
+	}
+	plume_free(across);
+	return PLUME_OK;
+}
+
+static plume_status build_bending(plume_sim *sim, const plume_mesh *mesh, plume_error *err)
+{
+	int *pairs = NULL;
+	int pair_count = pair_face_edges(mesh, &pairs);
+	if (pair_count < 0)
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory building the bending elements");
+	plume_status status = sim->def.bending_model == PLUME_BENDING_PAPER_HINGE
+	                          ? build_hinges(sim, mesh, pairs, pair_count, err)
+	                          : build_ff_faces(sim, mesh, pairs, pair_count, err);
+	plume_free(pairs);
+	return status;
 }
 
 static plume_status build_elements(plume_sim *sim, const plume_mesh *mesh, plume_error *err)
@@ -261,7 +356,7 @@ static plume_status build_elements(plume_sim *sim, const plume_mesh *mesh, plume
 			sim->vertex_area[vertices[i]] += sim->membranes[f].area / 3;
 		}
 	}
-	return build_hinges(sim, mesh, err);
+	return build_bending(sim, mesh, err);
 }
 
 static plume_status copy_groups(plume_sim *sim, const plume_mesh *mesh, plume_error *err)
@@ -317,10 +412,11 @@ static bool allocate_state(plume_sim *sim)
 
 static bool allocate_hinge_buffers(plume_sim *sim)
 {
-	size_t h = (size_t)(sim->hinge_count > 0 ? sim->hinge_count : 1);
+	int size = plume_sim_bending_size(sim);
+	size_t h = (size_t)(plume_sim_bending_count(sim) > 0 ? plume_sim_bending_count(sim) : 1);
 	sim->hinge_energy = plume_alloc(sizeof(double) * h);
-	sim->hinge_gradient = plume_alloc(sizeof(double) * 12 * h);
-	sim->hinge_hessian = plume_alloc(sizeof(double) * 144 * h);
+	sim->hinge_gradient = plume_alloc(sizeof(double) * 3 * (size_t)size * h);
+	sim->hinge_hessian = plume_alloc(sizeof(double) * 9 * (size_t)(size * size) * h);
 	return sim->hinge_energy && sim->hinge_gradient && sim->hinge_hessian;
 }
 
@@ -397,8 +493,9 @@ plume_status plume_sim_create(const plume_mesh *mesh, const plume_sim_def *def, 
 		status = copy_groups(sim, mesh, err);
 	if (status == PLUME_OK)
 		status = plume_kkt_init(&sim->kkt, sim->vertex_count, sim->face_count, sim->faces,
-		                        def->bending ? sim->hinge_count : 0, sim->hinges[0].vertices, sizeof(plume_hinge),
-		                        sim->constraint_count, sim->constraint_vertices, err);
+		                        def->bending ? plume_sim_bending_count(sim) : 0, plume_sim_bending_vertices(sim, 0),
+		                        plume_sim_bending_stride(sim), plume_sim_bending_size(sim), sim->constraint_count,
+		                        sim->constraint_vertices, err);
 	if (status != PLUME_OK) {
 		plume_sim_destroy(sim);
 		return status;
@@ -426,6 +523,7 @@ void plume_sim_destroy(plume_sim *sim)
 	                  sim->face_material,
 	                  sim->membranes,
 	                  sim->hinges,
+	                  sim->ff_faces,
 	                  sim->constraint_vertices,
 	                  sim->constraint_length,
 	                  sim->lambda,
@@ -475,6 +573,20 @@ static const plume_vertex_group *find_group(const plume_sim *sim, const char *na
 	return NULL;
 }
 
+// Fundamental-form faces next to or inside the faces that handles hold (fundamental_form.h).
+static void update_clamps(plume_sim *sim)
+{
+	for (int e = 0; e < sim->ff_count; ++e) {
+		plume_ff_face *face = sim->ff_faces + e;
+		bool held[6];
+		for (int k = 0; k < 6; ++k) {
+			int v = face->vertices[k];
+			held[k] = v >= 0 && sim->fixed[3 * v] && sim->fixed[3 * v + 1] && sim->fixed[3 * v + 2];
+		}
+		plume_ff_face_clamp(face, held);
+	}
+}
+
 int plume_sim_add_handle(plume_sim *sim, const char *group_name, plume_error *err)
 {
 	PLUME_ASSERT_HANDLE(sim);
@@ -519,6 +631,7 @@ int plume_sim_add_handle(plume_sim *sim, const char *group_name, plume_error *er
 		sim->fixed[3 * v] = sim->fixed[3 * v + 1] = sim->fixed[3 * v + 2] = 1;
 		sim->v[v] = plume_v3(0, 0, 0);
 	}
+	update_clamps(sim);
 	return sim->handle_count++;
 }
 
@@ -750,13 +863,8 @@ plume_sim_energies plume_sim_energy(plume_sim *sim)
 		if (element->compression > 0)
 			out.compression += plume_compression_energy(element, local, NULL, NULL);
 	}
-	for (int e = 0; sim->def.bending && e < sim->hinge_count; ++e) {
-		const plume_hinge *hinge = sim->hinges + e;
-		plume_vec3 local[4];
-		for (int i = 0; i < 4; ++i)
-			local[i] = sim->x[hinge->vertices[i]];
-		out.bending += plume_hinge_energy(hinge, local, NULL, NULL);
-	}
+	for (int e = 0; sim->def.bending && e < plume_sim_bending_count(sim); ++e)
+		out.bending += plume_sim_bending_energy(sim, sim->x, e);
 	for (int i = 0; i < sim->vertex_count; ++i) {
 		out.gravity -= sim->mass[i] * plume_v3_dot(sim->def.gravity, sim->x[i]) + plume_v3_dot(sim->load[i], sim->x[i]);
 		out.kinetic += 0.5 * sim->mass[i] * plume_v3_dot(sim->v[i], sim->v[i]);

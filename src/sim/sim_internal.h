@@ -8,6 +8,7 @@
 #include "sim/air.h"
 #include "sim/bending.h"
 #include "sim/integrator.h"
+#include "sim/fundamental_form.h"
 #include "sim/kkt.h"
 #include "sim/membrane.h"
 
@@ -58,8 +59,12 @@ struct plume_sim {
 	int *faces;
 	unsigned char *face_material;
 	plume_membrane_element *membranes;
+	/// The bending elements of def.bending_model: the paper's hinges, or one
+	/// fundamental-form element per face.
 	int hinge_count;
 	plume_hinge *hinges;
+	int ff_count;
+	plume_ff_face *ff_faces;
 
 	/// Barb-aligned edges held at their reference length (constraint rows).
 	int constraint_count;
@@ -88,6 +93,7 @@ struct plume_sim {
 	double *face_energy;
 	double *face_gradient;
 	double *face_hessian;
+	/// Per bending element (hinge: 12 and 144 entries; fundamental-form face: 18 and 324).
 	double *hinge_energy;
 	double *hinge_gradient;
 	double *hinge_hessian;
@@ -123,6 +129,15 @@ struct plume_sim {
 /// potential is not finite.
 double plume_sim_potential(plume_sim *sim, const sim_problem *problem, const plume_vec3 *x, double *gradient,
                            bool hessian, bool project);
+
+/// The bending elements of the sim's model: how many, vertices per element (4 for a
+/// hinge, 6 for a fundamental-form face, -1 entries for absent neighbours), the byte
+/// stride between their vertex lists, element e's vertices and its energy at x.
+int plume_sim_bending_count(const plume_sim *sim);
+int plume_sim_bending_size(const plume_sim *sim);
+int plume_sim_bending_stride(const plume_sim *sim);
+const int *plume_sim_bending_vertices(const plume_sim *sim, int e);
+double plume_sim_bending_energy(const plume_sim *sim, const plume_vec3 *x, int e);
 
 /// Adds C^T lambda, the constraint forces of the current multipliers, to forces (3 n).
 void plume_sim_add_constraint_forces(const plume_sim *sim, const plume_vec3 *x, double *forces);

@@ -1,0 +1,237 @@
+// Fundamental-form bending (see fundamental_form.h for the discretisation and why).
+// The energy is a constant quadratic form in the face's three dihedral angles, so its
+// derivatives are those of the angles (sim/bending.h: exact gradient and Hessian of chi)
+// combined by M.
+#include "sim/fundamental_form.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "sim/bending.h"
+
+static const double PI = 3.14159265358979323846;
+
+double plume_ff_tensor_form(const double a[3], const double b[3], double barb_angle, double along, double across)
+{
+	double c = cos(barb_angle), s = sin(barb_angle);
+	// Components in the barb frame: v = (c, s) along the barb, w = (-s, c) across.
+	double a_vv = c * c * a[0] + s * s * a[1] + 2 * c * s * a[2];
+	double a_ww = s * s * a[0] + c * c * a[1] - 2 * c * s * a[2];
+	double a_vw = c * s * (a[1] - a[0]) + (c * c - s * s) * a[2];
+	double b_vv = c * c * b[0] + s * s * b[1] + 2 * c * s * b[2];
+	double b_ww = s * s * b[0] + c * c * b[1] - 2 * c * s * b[2];
+	double b_vw = c * s * (b[1] - b[0]) + (c * c - s * s) * b[2];
+	return across * a_vv * b_vv + along * a_ww * b_ww + (along + across) * a_vw * b_vw;
+}
+
+// Stencil positions of edge i's hinge in plume_dihedral_angle's order: the edge
+// v_{i+1} -> v_{i+2}, then v_i (so that n_A is the face's own normal for every i) and
+// the vertex across.
+static void hinge_indices(int i, int out[4])
+{
+	out[0] = (i + 1) % 3;
+	out[1] = (i + 2) % 3;
+	out[2] = i;
+	out[3] = 3 + i;
+}
+
+// Removes boundary edge b from the quadratic form by minimising over its angle (the
+// Schur complement); a zero pivot means the edge is not coupled at all.
+static void condense(double M[9], int b)
+{
+	double pivot = M[4 * b];
+	if (pivot > 0)
+		for (int i = 0; i < 3; ++i)
+			for (int j = 0; j < 3; ++j)
+				if (i != b && j != b)
+					M[3 * i + j] -= M[3 * i + b] * M[3 * b + j] / pivot;
+	for (int k = 0; k < 3; ++k)
+		M[3 * k + b] = M[3 * b + k] = 0;
+}
+
+// t t^T of the unit in-plane normal of the edge opposite vertex i, as (xx, yy, xy).
+static void edge_normal_form(const plume_vec2 reference[3], int i, double form[3])
+{
+	plume_vec2 p = reference[(i + 1) % 3], q = reference[(i + 2) % 3];
+	double ex = q.x - p.x, ey = q.y - p.y, length = hypot(ex, ey);
+	double tx = -ey / length, ty = ex / length;
+	form[0] = tx * tx;
+	form[1] = ty * ty;
+	form[2] = tx * ty;
+}
+
+bool plume_ff_face_init(plume_ff_face *face, const int vertices[6], const plume_vec2 reference[3],
+                        const plume_vec3 rest[6], double barb_angle, double along, double across)
+{
+	double area = 0.5 * ((reference[1].x - reference[0].x) * (reference[2].y - reference[0].y) -
+	                     (reference[2].x - reference[0].x) * (reference[1].y - reference[0].y));
+	area = fabs(area);
+	// l_i t_i t_i^T as (xx, yy, xy): t_i is the edge direction turned by 90 degrees, and the
+	// sign of t_i does not matter.
+	double form[3][3], scale = 0;
+	for (int i = 0; i < 3; ++i) {
+		plume_vec2 p = reference[(i + 1) % 3], q = reference[(i + 2) % 3];
+		double length = hypot(q.x - p.x, q.y - p.y);
+		scale = fmax(scale, length * length);
+		if (!(length > 0))
+			return false;
+		edge_normal_form(reference, i, form[i]);
+		for (int k = 0; k < 3; ++k)
+			form[i][k] *= length;
+	}
+	if (!isfinite(area) || !(area > 1e-12 * scale))
+		return false;
+	memcpy(face->vertices, vertices, sizeof face->vertices);
+	for (int i = 0; i < 3; ++i)
+		for (int j = 0; j < 3; ++j)
+			face->stiffness[3 * i + j] = plume_ff_tensor_form(form[i], form[j], barb_angle, along, across) / (4 * area);
+	for (int i = 0; i < 3; ++i) {
+		face->rest_angle[i] = 0;
+		face->edge_scale[i] = face->border_scale[i] = 1;
+		if (vertices[3 + i] < 0) {
+			condense(face->stiffness, i);
+			continue;
+		}
+		int h[4];
+		hinge_indices(i, h);
+		plume_vec3 local[4] = {rest[h[0]], rest[h[1]], rest[h[2]], rest[h[3]]};
+		face->rest_angle[i] = plume_dihedral_angle(local);
+	}
+	return true;
+}
+
+double plume_ff_edge_modulus(const plume_vec2 reference[3], int i, double barb_angle, double along, double across)
+{
+	double form[3];
+	edge_normal_form(reference, i, form);
+	return plume_ff_tensor_form(form, form, barb_angle, along, across);
+}
+
+void plume_ff_face_border(plume_ff_face *face, int i, double own_modulus, double other_modulus)
+{
+	double sum = own_modulus + other_modulus;
+	face->border_scale[i] = face->edge_scale[i] = sum > 0 ? 2 * other_modulus / sum : 1;
+}
+
+void plume_ff_face_clamp(plume_ff_face *face, const bool held[6])
+{
+	bool clamped = held[0] && held[1] && held[2];
+	for (int i = 0; i < 3; ++i) {
+		bool neighbour_clamped = face->vertices[3 + i] >= 0 && held[(i + 1) % 3] && held[(i + 2) % 3] && held[3 + i];
+		face->edge_scale[i] = clamped ? 0 : neighbour_clamped ? 2 : face->border_scale[i];
+	}
+}
+
+// The change of edge i's angle from its rest value, the short way round, times the edge's
+// clamp scale; its gradient (12) and Hessian (144) when asked for. Zero for a boundary edge.
+static double angle_change(const plume_ff_face *face, const plume_vec3 x[6], int i, double gradient[12],
+                           double hessian[144])
+{
+	if (face->vertices[3 + i] < 0) {
+		if (gradient)
+			memset(gradient, 0, 12 * sizeof(double));
+		if (hessian)
+			memset(hessian, 0, 144 * sizeof(double));
+		return 0;
+	}
+	int h[4];
+	hinge_indices(i, h);
+	plume_vec3 local[4] = {x[h[0]], x[h[1]], x[h[2]], x[h[3]]};
+	double delta = plume_dihedral_angle_derivatives(local, gradient, hessian) - face->rest_angle[i];
+	if (delta > PI)
+		delta -= 2 * PI;
+	else if (delta <= -PI)
+		delta += 2 * PI;
+	double s = face->edge_scale[i];
+	if (s != 1) {
+		for (int k = 0; gradient != NULL && k < 12; ++k)
+			gradient[k] *= s;
+		for (int k = 0; hessian != NULL && k < 144; ++k)
+			hessian[k] *= s;
+	}
+	return s * delta;
+}
+
+// Spreads a hinge's 12-gradient into the face stencil's 18.
+static void spread_gradient(int i, const double local[12], double out[18])
+{
+	int h[4];
+	hinge_indices(i, h);
+	memset(out, 0, 18 * sizeof(double));
+	for (int k = 0; k < 4; ++k)
+		for (int a = 0; a < 3; ++a)
+			out[3 * h[k] + a] = local[3 * k + a];
+}
+
+// The three angle changes and their stencil gradients J (3 x 18).
+static void angle_changes(const plume_ff_face *face, const plume_vec3 x[6], double delta[3], double J[54])
+{
+	for (int i = 0; i < 3; ++i) {
+		double local[12];
+		delta[i] = angle_change(face, x, i, J ? local : NULL, NULL);
+		if (J)
+			spread_gradient(i, local, J + 18 * i);
+	}
+}
+
+// J^T M J, symmetric exactly (the solver stores one triangle).
+static void gauss_newton(const double M[9], const double J[54], double hessian[324])
+{
+	for (int r = 0; r < 18; ++r) {
+		double MJ[3]; // (M J)_{:, r}
+		for (int i = 0; i < 3; ++i)
+			MJ[i] = M[3 * i] * J[r] + M[3 * i + 1] * J[18 + r] + M[3 * i + 2] * J[36 + r];
+		for (int c = 0; c < 18; ++c)
+			hessian[18 * r + c] = J[c] * MJ[0] + J[18 + c] * MJ[1] + J[36 + c] * MJ[2];
+	}
+	for (int r = 0; r < 18; ++r)
+		for (int c = r + 1; c < 18; ++c)
+			hessian[18 * c + r] = hessian[18 * r + c] = 0.5 * (hessian[18 * r + c] + hessian[18 * c + r]);
+}
+
+// Energy, gradient (M dchi)^T J and the Gauss-Newton Hessian J^T M J from one pass over
+// the angles; force receives M dchi.
+static double energy_and_gauss_newton(const plume_ff_face *face, const plume_vec3 x[6], double gradient[18],
+                                      double hessian[324], double force[3])
+{
+	double delta[3], J[54];
+	bool derivatives = gradient != NULL || hessian != NULL;
+	angle_changes(face, x, delta, derivatives ? J : NULL);
+	const double *M = face->stiffness;
+	for (int i = 0; i < 3; ++i)
+		force[i] = M[3 * i] * delta[0] + M[3 * i + 1] * delta[1] + M[3 * i + 2] * delta[2];
+	if (gradient)
+		for (int r = 0; r < 18; ++r)
+			gradient[r] = force[0] * J[r] + force[1] * J[18 + r] + force[2] * J[36 + r];
+	if (hessian)
+		gauss_newton(M, J, hessian);
+	return 0.5 * (force[0] * delta[0] + force[1] * delta[1] + force[2] * delta[2]);
+}
+
+double plume_ff_face_energy_gauss_newton(const plume_ff_face *face, const plume_vec3 x[6], double gradient[18],
+                                         double hessian[324])
+{
+	double force[3];
+	return energy_and_gauss_newton(face, x, gradient, hessian, force);
+}
+
+double plume_ff_face_energy(const plume_ff_face *face, const plume_vec3 x[6], double gradient[18], double hessian[324])
+{
+	double force[3];
+	double energy = energy_and_gauss_newton(face, x, gradient, hessian, force);
+	if (hessian) {
+		// J^T M J + sum_i (M dchi)_i Hess chi_i.
+		for (int i = 0; i < 3; ++i) {
+			if (force[i] == 0 || face->vertices[3 + i] < 0)
+				continue;
+			double local[144];
+			angle_change(face, x, i, NULL, local);
+			int h[4];
+			hinge_indices(i, h);
+			for (int a = 0; a < 12; ++a)
+				for (int b = 0; b < 12; ++b)
+					hessian[18 * (3 * h[a / 3] + a % 3) + 3 * h[b / 3] + b % 3] += force[i] * local[12 * a + b];
+		}
+	}
+	return energy;
+}
