@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "../core/alloc.h"
+#include "../core/vec_inline.h"
 #include "feather_internal.h"
 
 plume_feather *plume_feather_create_empty(void)
@@ -124,7 +125,7 @@ void plume_feather_measure_curve(plume_feather *feather, plume_curve_range range
 	double *arc = feather->arc_length + range.first;
 	arc[0] = 0.0;
 	for (int i = 1; i < range.count; ++i)
-		arc[i] = arc[i - 1] + plume_v3_distance(points[i - 1], points[i]);
+		arc[i] = arc[i - 1] + core_v3_distance(points[i - 1], points[i]);
 	double total = arc[range.count - 1];
 	plume_vec2 *uv = feather->uv + range.first;
 	for (int i = 0; i < range.count; ++i)
