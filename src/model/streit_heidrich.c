@@ -560,7 +560,7 @@ static plume_status build_barb(plume_feather *feather, sh_builder *b, plume_side
 		points = PLUME_BEZIER_MAX_POINTS;
 	sh_elevate_to(cvs, count, points);
 
-	int first = plume_feather_add_points(feather, points);
+	int first = plume_feather_append_points(feather, points);
 	if (first < 0)
 		return PLUME_ERROR_MEMORY;
 	double rachis_t = (b->calamus_length + rachis_arc_length) / b->shaft_length;

@@ -22,6 +22,7 @@
 #include <string.h>
 
 #include "../core/alloc.h"
+#include "../core/vec_inline.h"
 #include "zhang_kanai_internal.h"
 
 static plume_vec3 frame_apply(const zk_frame *f, plume_vec3 local)
@@ -30,15 +31,28 @@ static plume_vec3 frame_apply(const zk_frame *f, plume_vec3 local)
 	                    plume_v3_scale(f->b, local.z));
 }
 
-/// Eq. 11-12 in the vertex's own frame (t, n, b): the same vector for any
-/// rotation of the frame, so snapping can rotate frames and keep barbules.
-static plume_vec3 barbule_local(double growth_speed, double emitter_speed, double ridge, double theta, double azimuth,
-                                double dir)
+/// The angles of one barbule of eq. 12 on one vane: tan theta and the cosine and sine of its turn phi'
+/// about the ramus, taken once for every vertex of the vane.
+typedef struct barbule_angles {
+	double tan_theta, cos_azimuth, sin_azimuth;
+	double dir;
+} barbule_angles;
+
+static barbule_angles make_angles(double theta, double azimuth, double dir)
 {
-	plume_vec3 r = plume_v3(emitter_speed, 0.0, growth_speed); // (t, n, b) components
-	plume_vec3 axis = plume_v3_normalize(r);
-	plume_vec3 v = plume_v3_add(plume_v3_scale(axis, ridge / tan(theta)), plume_v3(0.0, dir * ridge, 0.0));
-	return plume_m3_apply(plume_m3_rotation(axis, azimuth), v);
+	return (barbule_angles){
+	    .tan_theta = tan(theta), .cos_azimuth = cos(azimuth), .sin_azimuth = sin(azimuth), .dir = dir};
+}
+
+/// Eq. 12 about the unit ramus axis r/|r| of eq. 11, in the vertex's own frame
+/// (t, n, b): the same vector for any rotation of the frame, so snapping can
+/// rotate frames and keep barbules.
+static plume_vec3 barbule_local(plume_vec3 axis, double ridge, const barbule_angles *angles)
+{
+	plume_vec3 v =
+	    plume_v3_add(plume_v3_scale(axis, ridge / angles->tan_theta), plume_v3(0.0, angles->dir * ridge, 0.0));
+	plume_mat3 turn = core_m3_rotation_cs(axis, angles->cos_azimuth, angles->sin_azimuth);
+	return core_m3_apply(&turn, v);
 }
 
 bool zk_sphere_polyline(plume_vec3 centre, double radius, const plume_vec3 *line, int count, plume_vec3 *hit)
@@ -68,25 +82,27 @@ bool zk_sphere_polyline(plume_vec3 centre, double radius, const plume_vec3 *line
 static plume_mat3 rotation_between(plume_vec3 a, plume_vec3 b)
 {
 	plume_vec3 axis = plume_v3_cross(a, b);
-	double s = plume_v3_length(axis), c = plume_v3_dot(a, b);
+	double s = core_v3_length(axis), c = plume_v3_dot(a, b);
 	if (s < 1e-300) {
 		if (c > 0.0)
 			return plume_m3_identity();
 		plume_vec3 other = fabs(a.x) < 0.9 ? plume_v3(1.0, 0.0, 0.0) : plume_v3(0.0, 1.0, 0.0);
-		return plume_m3_rotation(plume_v3_normalize(plume_v3_cross(a, other)), 3.14159265358979323846);
+		return plume_m3_rotation(core_v3_normalize(plume_v3_cross(a, other)), 3.14159265358979323846);
 	}
-	return plume_m3_rotation(plume_v3_scale(axis, 1.0 / s), atan2(s, c));
+	double angle = atan2(s, c);
+	return core_m3_rotation_cs(plume_v3_scale(axis, 1.0 / s), cos(angle), sin(angle));
 }
 
 /// Rotates vertex j's frame by q about its position, carrying every vertex after it.
-static void rotate_from(plume_vec3 *p, zk_frame *frame, int count, int j, plume_mat3 q)
+static void rotate_from(plume_vec3 *p, zk_frame *frame, int count, int j, const plume_mat3 *q)
 {
+	plume_vec3 pivot = p[j];
 	for (int k = j; k < count; ++k) {
 		if (k > j)
-			p[k] = plume_v3_add(p[j], plume_m3_apply(q, plume_v3_sub(p[k], p[j])));
-		frame[k].t = plume_m3_apply(q, frame[k].t);
-		frame[k].n = plume_m3_apply(q, frame[k].n);
-		frame[k].b = plume_m3_apply(q, frame[k].b);
+			p[k] = plume_v3_add(pivot, core_m3_apply(q, plume_v3_sub(p[k], pivot)));
+		frame[k].t = core_m3_apply(q, frame[k].t);
+		frame[k].n = core_m3_apply(q, frame[k].n);
+		frame[k].b = core_m3_apply(q, frame[k].b);
 	}
 }
 
@@ -138,13 +154,13 @@ static int snap_pair(const expand_ctx *ctx, const zk_barb *a, const zk_barb *b)
 	for (int j = 0; j < b->count; ++j) {
 		int v = b->first + j;
 		plume_vec3 barbule = world_barbule(ctx, ctx->local_distal, v);
-		double radius = plume_v3_length(barbule);
+		double radius = core_v3_length(barbule);
 		plume_vec3 hit;
 		if (!(radius > 0.0) || !zk_sphere_polyline(shape->p[v], radius, line, line_count, &hit))
 			break;
 		plume_vec3 to = plume_v3_scale(plume_v3_sub(hit, shape->p[v]), 1.0 / radius);
-		plume_mat3 q = rotation_between(plume_v3_scale(barbule, 1.0 / radius), plume_v3_normalize(to));
-		rotate_from(shape->p + b->first, shape->frame + b->first, b->count, j, q);
+		plume_mat3 q = rotation_between(plume_v3_scale(barbule, 1.0 / radius), core_v3_normalize(to));
+		rotate_from(shape->p + b->first, shape->frame + b->first, b->count, j, &q);
 		++n;
 	}
 	return n;
@@ -156,7 +172,7 @@ static void apply_split(zk_shape *shape, const zk_barb *barb, const plume_zk_spl
 	int j = (int)lround(split->at * (barb->count - 1));
 	// A positive angle about n turns t towards -b: n x t = -b (the frame is right-handed).
 	plume_mat3 q = plume_m3_rotation(shape->frame[barb->first + j].n, split->angle);
-	rotate_from(shape->p + barb->first, shape->frame + barb->first, barb->count, j, q);
+	rotate_from(shape->p + barb->first, shape->frame + barb->first, barb->count, j, &q);
 }
 
 plume_status zk_expand(const plume_zk_def *def, const zk_growth *growth, zk_shape *shape, zk_barbules *barbules)
@@ -190,15 +206,21 @@ plume_status zk_expand(const plume_zk_def *def, const zk_growth *growth, zk_shap
 	zk_curve ve, ridge;
 	zk_curve_init(&ve, &def->emitter_speed);
 	zk_curve_init(&ridge, &def->ridge_height);
+	barbule_angles angles[2][2]; // [side][distal, proximal]
+	for (int side = 0; side < 2; ++side) {
+		double dir = side == PLUME_SIDE_LEFT ? -1.0 : 1.0;
+		angles[side][0] = make_angles(def->theta_distal, dir * def->azimuth, dir);
+		angles[side][1] = make_angles(def->theta_proximal, -dir * def->azimuth, dir);
+	}
 	for (int i = 0; i < growth->barb_count; ++i) {
 		const zk_barb *barb = growth->barbs + i;
-		double dir = barb->side == PLUME_SIDE_LEFT ? -1.0 : 1.0;
+		const barbule_angles *side = angles[barb->side];
 		for (int j = 0; j < barb->count; ++j) {
 			int v = barb->first + j;
 			double s = shape->locus[v], vs = zk_curve_eval(&ve, s), l = zk_curve_eval(&ridge, s);
-			ctx.local_distal[v] = barbule_local(def->growth_speed, vs, l, def->theta_distal, dir * def->azimuth, dir);
-			ctx.local_proximal[v] =
-			    barbule_local(def->growth_speed, vs, l, def->theta_proximal, -dir * def->azimuth, dir);
+			plume_vec3 axis = core_v3_normalize(plume_v3(vs, 0.0, def->growth_speed)); // eq. 11 in (t, n, b)
+			ctx.local_distal[v] = barbule_local(axis, l, side + 0);
+			ctx.local_proximal[v] = barbule_local(axis, l, side + 1);
 		}
 	}
 	// Splits first ("bend a chosen barb before snapping").
