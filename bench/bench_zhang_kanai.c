@@ -47,6 +47,7 @@ int main(void)
 	printf("  snapping: %d full, %d partial, %d unsnapped\n", report.snapped_count, report.partial_count,
 	       report.unsnapped_count);
 	double generate_median = bench_median(times, RUNS), cpu_median = bench_median(cpu, RUNS);
+	double fresh_cpu = cpu_median;
 	printf("generate            median %8.3f ms wall, %8.3f ms CPU (min %.3f ms wall, %d runs, one thread)\n",
 	       1e3 * generate_median, 1e3 * cpu_median, 1e3 * times[0], RUNS);
 
@@ -66,6 +67,10 @@ int main(void)
 	       1e3 * generate_median, 1e3 * cpu_median, 1e3 * times[0], RUNS);
 	plume_feather_destroy(feather);
 	plume_zk_report_free(&report);
+	// Issue 15's target. The fresh heap's figure includes the kernel mapping and zeroing the feather's
+	// 15 MiB of new pages (about 4,000 page faults), which no change to the generator removes.
+	printf("target <= 10 ms CPU on one core: %s with the heap kept, %s on a fresh heap\n",
+	       cpu_median <= 0.010 ? "met" : "missed", fresh_cpu <= 0.010 ? "met" : "missed");
 
 	def.keep_barbules = false;
 	double start = bench_now(), cpu_start = bench_cpu_now();
