@@ -55,25 +55,78 @@ static plume_vec3 barbule_local(plume_vec3 axis, double ridge, const barbule_ang
 	return core_m3_apply(&turn, v);
 }
 
+/// The most distal point where the sphere meets segment i of the line, if any.
+static bool sphere_segment(plume_vec3 centre, double radius, const plume_vec3 *line, int i, plume_vec3 *hit)
+{
+	plume_vec3 d = plume_v3_sub(line[i + 1], line[i]), f = plume_v3_sub(line[i], centre);
+	double a = plume_v3_dot(d, d);
+	if (!(a > 0.0))
+		return false;
+	double b = 2.0 * plume_v3_dot(f, d), c = plume_v3_dot(f, f) - radius * radius;
+	double disc = b * b - 4.0 * a * c;
+	if (disc < 0.0)
+		return false;
+	double root = sqrt(disc);
+	double u = (-b + root) / (2.0 * a); // the larger root first: the more distal point
+	if (!(u >= 0.0 && u <= 1.0))
+		u = (-b - root) / (2.0 * a);
+	if (u >= 0.0 && u <= 1.0) {
+		*hit = plume_v3_mad(line[i], u, d);
+		return true;
+	}
+	return false;
+}
+
 bool zk_sphere_polyline(plume_vec3 centre, double radius, const plume_vec3 *line, int count, plume_vec3 *hit)
 {
-	for (int i = count - 2; i >= 0; --i) {
-		plume_vec3 d = plume_v3_sub(line[i + 1], line[i]), f = plume_v3_sub(line[i], centre);
-		double a = plume_v3_dot(d, d);
-		if (!(a > 0.0))
-			continue;
-		double b = 2.0 * plume_v3_dot(f, d), c = plume_v3_dot(f, f) - radius * radius;
-		double disc = b * b - 4.0 * a * c;
-		if (disc < 0.0)
-			continue;
-		double root = sqrt(disc);
-		double u = (-b + root) / (2.0 * a); // the larger root first: the more distal point
-		if (!(u >= 0.0 && u <= 1.0))
-			u = (-b - root) / (2.0 * a);
-		if (u >= 0.0 && u <= 1.0) {
-			*hit = plume_v3_mad(line[i], u, d);
+	for (int i = count - 2; i >= 0; --i)
+		if (sphere_segment(centre, radius, line, i, hit))
 			return true;
+	return false;
+}
+
+/// Segments per bounding ball of a snapping boundary.
+enum { BLOCK = 8 };
+
+/// A ball around the points of each block of BLOCK segments of the line (count points): blocks[k] holds
+/// segments [k BLOCK, (k + 1) BLOCK).
+typedef struct ball {
+	plume_vec3 centre;
+	double radius;
+} ball;
+
+static void bound_blocks(const plume_vec3 *line, int count, ball *blocks)
+{
+	for (int first = 0, k = 0; first + 1 < count; first += BLOCK, ++k) {
+		int last = first + BLOCK < count - 1 ? first + BLOCK : count - 1; // its last point
+		plume_vec3 lo = line[first], hi = line[first];
+		for (int i = first + 1; i <= last; ++i) {
+			lo = plume_v3(fmin(lo.x, line[i].x), fmin(lo.y, line[i].y), fmin(lo.z, line[i].z));
+			hi = plume_v3(fmax(hi.x, line[i].x), fmax(hi.y, line[i].y), fmax(hi.z, line[i].z));
 		}
+		blocks[k].centre = plume_v3_scale(plume_v3_add(lo, hi), 0.5);
+		blocks[k].radius = 0.0;
+		for (int i = first; i <= last; ++i)
+			blocks[k].radius = fmax(blocks[k].radius, core_v3_distance(line[i], blocks[k].centre));
+	}
+}
+
+/// zk_sphere_polyline's answer, bit for bit, without testing the segments of a block whose ball lies
+/// wholly outside or wholly inside the sphere (none of them can meet its surface). The margin, a
+/// millionth of the sizes, is far above the rounding of the segment test, so no block that test would
+/// find a point in is skipped.
+static bool sphere_polyline_blocks(plume_vec3 centre, double radius, const plume_vec3 *line, int count,
+                                   const ball *blocks, plume_vec3 *hit)
+{
+	for (int k = (count - 2) / BLOCK; k >= 0 && count >= 2; --k) {
+		double distance = core_v3_distance(centre, blocks[k].centre), r = blocks[k].radius;
+		double margin = 1e-6 * (radius + r);
+		if (distance > radius + r + margin || distance + r < radius - margin)
+			continue;
+		int first = k * BLOCK, last = first + BLOCK < count - 1 ? first + BLOCK - 1 : count - 2; // segments
+		for (int i = last; i >= first; --i)
+			if (sphere_segment(centre, radius, line, i, hit))
+				return true;
 	}
 	return false;
 }
@@ -121,6 +174,7 @@ typedef struct expand_ctx {
 	zk_shape *shape;
 	plume_vec3 *local_distal, *local_proximal; ///< per vertex, in its frame
 	plume_vec3 *boundary;                      ///< scratch, max vertices + 1
+	ball *blocks;                              ///< scratch: the boundary's blocks
 } expand_ctx;
 
 static plume_vec3 world_barbule(const expand_ctx *ctx, const plume_vec3 *local, int vertex)
@@ -150,13 +204,14 @@ static int snap_pair(const expand_ctx *ctx, const zk_barb *a, const zk_barb *b)
 	}
 	const plume_vec3 *line = ctx->boundary + start;
 	int line_count = a->count + 1 - start;
+	bound_blocks(line, line_count, ctx->blocks);
 	// 3-4) each vertex of B from the root: turn its distal barbule onto the boundary.
 	for (int j = 0; j < b->count; ++j) {
 		int v = b->first + j;
 		plume_vec3 barbule = world_barbule(ctx, ctx->local_distal, v);
 		double radius = core_v3_length(barbule);
 		plume_vec3 hit;
-		if (!(radius > 0.0) || !zk_sphere_polyline(shape->p[v], radius, line, line_count, &hit))
+		if (!(radius > 0.0) || !sphere_polyline_blocks(shape->p[v], radius, line, line_count, ctx->blocks, &hit))
 			break;
 		plume_vec3 to = plume_v3_scale(plume_v3_sub(hit, shape->p[v]), 1.0 / radius);
 		plume_mat3 q = rotation_between(plume_v3_scale(barbule, 1.0 / radius), core_v3_normalize(to));
@@ -188,6 +243,7 @@ plume_status zk_expand(const plume_zk_def *def, const zk_growth *growth, zk_shap
 	ctx.local_distal = plume_alloc(n * sizeof *ctx.local_distal);
 	ctx.local_proximal = plume_alloc(n * sizeof *ctx.local_proximal);
 	ctx.boundary = plume_alloc((size_t)(longest + 1) * sizeof *ctx.boundary);
+	ctx.blocks = plume_alloc((size_t)(longest / BLOCK + 1) * sizeof *ctx.blocks);
 	barbules->snap = plume_calloc(nb, sizeof *barbules->snap);
 	barbules->snapped = plume_calloc(nb, sizeof *barbules->snapped);
 	if (def->expansion) {
@@ -195,8 +251,9 @@ plume_status zk_expand(const plume_zk_def *def, const zk_growth *growth, zk_shap
 		barbules->proximal = plume_alloc(n * sizeof *barbules->proximal);
 	}
 	plume_status status = PLUME_OK;
-	if (ctx.local_distal == NULL || ctx.local_proximal == NULL || ctx.boundary == NULL || barbules->snap == NULL ||
-	    barbules->snapped == NULL || (def->expansion && (barbules->distal == NULL || barbules->proximal == NULL))) {
+	if (ctx.local_distal == NULL || ctx.local_proximal == NULL || ctx.boundary == NULL || ctx.blocks == NULL ||
+	    barbules->snap == NULL || barbules->snapped == NULL ||
+	    (def->expansion && (barbules->distal == NULL || barbules->proximal == NULL))) {
 		status = PLUME_ERROR_MEMORY;
 		goto done;
 	}
@@ -257,6 +314,7 @@ done:
 	plume_free(ctx.local_distal);
 	plume_free(ctx.local_proximal);
 	plume_free(ctx.boundary);
+	plume_free(ctx.blocks);
 	if (status != PLUME_OK)
 		zk_barbules_free(barbules);
 	return status;

@@ -90,7 +90,8 @@ typedef struct path_points {
 	double *locus, *time;
 	int first, capacity;
 	bool grows;
-	bool full; ///< a point did not fit (out of memory or the bound): the pathline's points are incomplete
+	bool full;          ///< a point did not fit: the pathline's points are incomplete
+	bool out_of_memory; ///< full because growing failed (else the bound was reached)
 } path_points;
 
 /// The bound on points kept for reuse (64 MiB): a runaway spec integrates
@@ -113,6 +114,7 @@ static void keep_point(path_points *points, int at, double s, double t)
 		double *time = locus == NULL ? NULL : plume_realloc(points->time, capacity * sizeof *time);
 		if (time == NULL) {
 			points->full = true;
+			points->out_of_memory = capacity <= MAX_KEPT_POINTS;
 			return;
 		}
 		points->time = time;
@@ -266,6 +268,8 @@ static plume_status add_emission(vane_run *run)
 		plume_status status = pathline(&run->vane, e->s0, e->t0, INFINITY, &run->kept, &e->end);
 		if (status != PLUME_OK)
 			return status;
+		if (run->kept.out_of_memory)
+			return PLUME_ERROR_MEMORY;
 		if (!run->kept.full) {
 			e->point_first = run->kept_count;
 			run->kept_count += e->end.count;
