@@ -1,6 +1,7 @@
 // Benchmark: feather coats (Streit & Heidrich 4.4). The paper's Figure 15 (64
 // feathers, "computed in real time" on a 2002 PC) and a 10,000-feather coat,
-// built with OpenMP over the follicles. Prints medians.
+// built with OpenMP over the follicles. Prints medians; the 64-feather coat
+// also with the heap kept, as a long-running program sees it.
 //
 // Usage: bench_coat [THREADS]   (default: OpenMP's choice)
 #define _GNU_SOURCE
@@ -14,8 +15,13 @@
 #include "plume/plume.h"
 #include "bench_support.h"
 
+/// Median seconds, wall-clock and CPU.
+typedef struct coat_time {
+	double wall, cpu;
+} coat_time;
+
 /// Median seconds to build the coat of spec over runs; prints its size.
-static double time_coat(const char *name, const char *spec, int runs)
+static coat_time time_coat(const char *name, const char *spec, int runs)
 {
 	double times[32], cpu[32];
 	int feathers = 0;
@@ -43,7 +49,7 @@ static double time_coat(const char *name, const char *spec, int runs)
 	// CPU time (all threads) tells what the cores did when other processes share them.
 	printf("%-30s %6d feathers %9lld barb points  median %8.2f ms wall, %8.2f ms CPU (%d runs)\n", name, feathers,
 	       points, 1e3 * median, 1e3 * cpu[runs / 2], runs);
-	return median;
+	return (coat_time){median, cpu[runs / 2]};
 }
 
 int main(int argc, char **argv)
@@ -51,7 +57,8 @@ int main(int argc, char **argv)
 	if (argc > 1)
 		omp_set_num_threads(atoi(argv[1]));
 	printf("bench_coat: %d OpenMP threads\n", omp_get_max_threads());
-	double small = time_coat("Figure 15 (64 feathers)", PLUME_SOURCE_DIR "/examples/coats/figure15-hexagonal.json", 21);
+	coat_time small =
+	    time_coat("Figure 15 (64 feathers)", PLUME_SOURCE_DIR "/examples/coats/figure15-hexagonal.json", 21);
 
 	// 10,000 feathers: a 100 x 100 hexagonal patch of the same key feathers, at the paper's low level of
 	// detail for a coat this size (four control vertices per barb, Figure 8).
@@ -79,10 +86,16 @@ int main(int argc, char **argv)
 	        " \"lift_deg\": 20, \"lod\": {\"barb_elevations\": 0, \"rachis_elevations\": 4}}\n",
 	        width, height, s, keys, width, keys, width, height, keys, height, keys);
 	fclose(file);
-	double large = time_coat("100 x 100 hexagonal (10,000)", spec, 3);
+	coat_time large = time_coat("100 x 100 hexagonal (10,000)", spec, 3);
 	remove(spec);
 	rmdir(dir);
-	printf("targets: 64 feathers < 20 ms (%s), 10,000 < 3 s (%s)\n", small < 0.020 ? "met" : "missed",
-	       large < 3.0 ? "met" : "missed");
+	// Last, as it changes the process: a coat's 6 MiB of points then come from a kept heap instead of pages
+	// the kernel maps and zeroes afresh for every coat (see bench_keep_heap).
+	bench_keep_heap();
+	time_coat("Figure 15, heap kept", PLUME_SOURCE_DIR "/examples/coats/figure15-hexagonal.json", 21);
+	// Issue 15: the 64-feather coat in 10 ms of one core (CPU time, which other processes on the machine do
+	// not inflate as they do wall time); the 10,000-feather coat in 3 s wall.
+	printf("targets: 64 feathers <= 10 ms CPU (%s), 10,000 < 3 s wall (%s)\n", small.cpu <= 0.010 ? "met" : "missed",
+	       large.wall < 3.0 ? "met" : "missed");
 	return 0;
 }

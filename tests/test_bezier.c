@@ -3,6 +3,7 @@
 #include <math.h>
 #include <unistd.h>
 
+#include "core/vec_inline.h"
 #include "support.h"
 
 static void test_eval_matches_bernstein_cubic(void **state)
@@ -54,6 +55,38 @@ static void test_derivative_of_quintic_against_closed_form(void **state)
 		assert_close(plume_bezier_derivative(p, 6, 1, t).y, 5 * pow(t, 4), 1e-13);
 		assert_close(plume_bezier_derivative(p, 6, 2, t).y, 20 * pow(t, 3), 1e-12);
 		assert_close(plume_bezier_derivative(p, 6, 1, t).x, 1.0, 1e-13);
+	}
+}
+
+/// The elevation weights the compiler folded are the quotients the elevation divided at run time: the
+/// generators' outputs depend on every bit of them.
+static void test_elevation_weights_are_the_quotients(void **state)
+{
+	(void)state;
+	volatile double numerator, denominator; // divided here at run time, not folded
+	for (int c = 1; c < PLUME_BEZIER_MAX_POINTS; ++c)
+		for (int i = 0; i < c; ++i) {
+			numerator = i;
+			denominator = c;
+			double quotient = numerator / denominator;
+			assert_memory_equal(&core_elevation_weight[c][i], &quotient, sizeof quotient);
+		}
+	plume_rng rng = plume_rng_seed(7);
+	for (int count = 2; count <= PLUME_BEZIER_MAX_POINTS - 1; ++count) {
+		plume_vec3 p[PLUME_BEZIER_MAX_POINTS], fast[PLUME_BEZIER_MAX_POINTS], slow[PLUME_BEZIER_MAX_POINTS];
+		for (int i = 0; i < count; ++i)
+			p[i] = plume_v3(plume_rng_range(&rng, -1, 1), plume_rng_range(&rng, -1, 1), plume_rng_range(&rng, -1, 1));
+		core_bezier_elevate(p, count, fast);
+		// The formula of the header's comment, divided at run time.
+		slow[0] = p[0];
+		slow[count] = p[count - 1];
+		for (int i = 1; i < count; ++i) {
+			numerator = i;
+			denominator = count;
+			double a = numerator / denominator;
+			slow[i] = plume_v3_add(plume_v3_scale(p[i - 1], a), plume_v3_scale(p[i], 1.0 - a));
+		}
+		assert_memory_equal(fast, slow, (size_t)(count + 1) * sizeof *fast);
 	}
 }
 
@@ -166,6 +199,7 @@ int main(void)
 	    cmocka_unit_test(test_eval_matches_bernstein_cubic),
 	    cmocka_unit_test(test_eval_quadratic_is_parabola),
 	    cmocka_unit_test(test_derivative_of_quintic_against_closed_form),
+	    cmocka_unit_test(test_elevation_weights_are_the_quotients),
 	    cmocka_unit_test(test_degree_elevation_keeps_curve),
 	    cmocka_unit_test(test_split_halves_cover_curve),
 	    cmocka_unit_test(test_length_of_line_and_quarter_circle),

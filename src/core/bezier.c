@@ -11,25 +11,15 @@
 
 #include "asserts.h"
 #include "plume/core.h"
+#include "vec_inline.h"
 
 plume_vec3 plume_bezier_eval(const plume_vec3 *points, int count, double t)
 {
 	PLUME_ASSERT(count >= 1 && count <= PLUME_BEZIER_MAX_POINTS);
-	if (count == 4) {
-		// The cubic is every barb's curve: Bernstein form without the triangle.
-		double s = 1.0 - t;
-		double b0 = s * s * s, b1 = 3.0 * s * s * t, b2 = 3.0 * s * t * t, b3 = t * t * t;
-		return (plume_vec3){b0 * points[0].x + b1 * points[1].x + b2 * points[2].x + b3 * points[3].x,
-		                    b0 * points[0].y + b1 * points[1].y + b2 * points[2].y + b3 * points[3].y,
-		                    b0 * points[0].z + b1 * points[1].z + b2 * points[2].z + b3 * points[3].z};
-	}
-	if (count == 3) { // the hodograph of a cubic, in every arc-length quadrature
-		double s = 1.0 - t;
-		double b0 = s * s, b1 = 2.0 * s * t, b2 = t * t;
-		return (plume_vec3){b0 * points[0].x + b1 * points[1].x + b2 * points[2].x,
-		                    b0 * points[0].y + b1 * points[1].y + b2 * points[2].y,
-		                    b0 * points[0].z + b1 * points[1].z + b2 * points[2].z};
-	}
+	if (count == 4) // the cubic is every barb's curve: Bernstein form without the triangle
+		return core_bezier_cubic(points, t);
+	if (count == 3) // the hodograph of a cubic, in every arc-length quadrature
+		return core_bezier_quadratic(points, t);
 	plume_vec3 work[PLUME_BEZIER_MAX_POINTS];
 	memcpy(work, points, (size_t)count * sizeof *points);
 	for (int level = count - 1; level > 0; --level)
@@ -60,20 +50,28 @@ plume_vec3 plume_bezier_derivative(const plume_vec3 *points, int count, int orde
 	return plume_bezier_eval(work, count, t);
 }
 
+// core_elevation_weight[c][i] = i / c, each a constant expression that the compiler rounds as the
+// division would at run time (row 0 and the entries i >= c are never read).
+#define ELEVATION_WEIGHT(c, i) ((double)(i) / (double)((c) > 0 ? (c) : 1))
+#define ELEVATION_8(c, i)                                                                                              \
+	ELEVATION_WEIGHT(c, i), ELEVATION_WEIGHT(c, i + 1), ELEVATION_WEIGHT(c, i + 2), ELEVATION_WEIGHT(c, i + 3),        \
+	    ELEVATION_WEIGHT(c, i + 4), ELEVATION_WEIGHT(c, i + 5), ELEVATION_WEIGHT(c, i + 6), ELEVATION_WEIGHT(c, i + 7)
+#define ELEVATION_ROW(c)                                                                                               \
+	{                                                                                                                  \
+		ELEVATION_8(c, 0), ELEVATION_8(c, 8), ELEVATION_8(c, 16), ELEVATION_8(c, 24), ELEVATION_8(c, 32),              \
+		    ELEVATION_8(c, 40), ELEVATION_8(c, 48), ELEVATION_8(c, 56)                                                 \
+	}
+#define ELEVATION_ROWS_8(c)                                                                                            \
+	ELEVATION_ROW(c), ELEVATION_ROW(c + 1), ELEVATION_ROW(c + 2), ELEVATION_ROW(c + 3), ELEVATION_ROW(c + 4),          \
+	    ELEVATION_ROW(c + 5), ELEVATION_ROW(c + 6), ELEVATION_ROW(c + 7)
+
+const double core_elevation_weight[PLUME_BEZIER_MAX_POINTS][PLUME_BEZIER_MAX_POINTS] = {
+    ELEVATION_ROWS_8(0),  ELEVATION_ROWS_8(8),  ELEVATION_ROWS_8(16), ELEVATION_ROWS_8(24),
+    ELEVATION_ROWS_8(32), ELEVATION_ROWS_8(40), ELEVATION_ROWS_8(48), ELEVATION_ROWS_8(56)};
+
 void plume_bezier_elevate(const plume_vec3 *points, int count, plume_vec3 *out)
 {
-	// q_0 = p_0, q_{n+1} = p_n, q_i = (i / (n+1)) p_{i-1} + (1 - i / (n+1)) p_i.
-	int n = count - 1;
-	plume_vec3 last = points[n];
-	plume_vec3 previous = points[0];
-	out[0] = points[0];
-	for (int i = 1; i <= n; ++i) {
-		plume_vec3 current = points[i];
-		double a = (double)i / (double)(n + 1);
-		out[i] = plume_v3_add(plume_v3_scale(previous, a), plume_v3_scale(current, 1.0 - a));
-		previous = current;
-	}
-	out[n + 1] = last;
+	core_bezier_elevate(points, count, out);
 }
 
 void plume_bezier_split(const plume_vec3 *points, int count, double t, plume_vec3 *left, plume_vec3 *right)
@@ -98,7 +96,7 @@ static const double gl8_weights[4] = {0.3626837833783620, 0.3137066458778873, 0.
 // The speed |B'(t)| is the length of the hodograph, evaluated by de Casteljau.
 static double speed_at(const plume_vec3 *hodograph, int count, double t)
 {
-	return plume_v3_length(plume_bezier_eval(hodograph, count, t));
+	return core_v3_length(plume_bezier_eval(hodograph, count, t));
 }
 
 static double gauss8(const plume_vec3 *hodograph, int count, double a, double b)
@@ -144,7 +142,7 @@ static double control_polygon_length(const plume_vec3 *points, int count)
 {
 	double length = 0.0;
 	for (int i = 0; i + 1 < count; ++i)
-		length += plume_v3_distance(points[i], points[i + 1]);
+		length += core_v3_distance(points[i], points[i + 1]);
 	return length;
 }
 

@@ -2,16 +2,13 @@
 #include <math.h>
 
 #include "plume/core.h"
+#include "vec_inline.h"
 
-double plume_v3_length(plume_vec3 a) { return sqrt(plume_v3_dot(a, a)); }
+double plume_v3_length(plume_vec3 a) { return core_v3_length(a); }
 
-double plume_v3_distance(plume_vec3 a, plume_vec3 b) { return plume_v3_length(plume_v3_sub(a, b)); }
+double plume_v3_distance(plume_vec3 a, plume_vec3 b) { return core_v3_distance(a, b); }
 
-plume_vec3 plume_v3_normalize(plume_vec3 a)
-{
-	double length = plume_v3_length(a);
-	return length > 0.0 ? plume_v3_scale(a, 1.0 / length) : a;
-}
+plume_vec3 plume_v3_normalize(plume_vec3 a) { return core_v3_normalize(a); }
 
 plume_mat3 plume_m3_identity(void) { return (plume_mat3){{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}}; }
 
@@ -33,12 +30,7 @@ plume_mat3 plume_m3_transpose(plume_mat3 a)
 	return t;
 }
 
-plume_vec3 plume_m3_apply(plume_mat3 a, plume_vec3 v)
-{
-	return (plume_vec3){a.m[0][0] * v.x + a.m[0][1] * v.y + a.m[0][2] * v.z,
-	                    a.m[1][0] * v.x + a.m[1][1] * v.y + a.m[1][2] * v.z,
-	                    a.m[2][0] * v.x + a.m[2][1] * v.y + a.m[2][2] * v.z};
-}
+plume_vec3 plume_m3_apply(plume_mat3 a, plume_vec3 v) { return core_m3_apply(&a, v); }
 
 double plume_m3_det(plume_mat3 a)
 {
@@ -49,10 +41,5 @@ double plume_m3_det(plume_mat3 a)
 
 plume_mat3 plume_m3_rotation(plume_vec3 axis, double angle)
 {
-	// R = cos I + sin [k]x + (1 - cos) k k^T
-	double c = cos(angle), s = sin(angle), v = 1.0 - c;
-	double x = axis.x, y = axis.y, z = axis.z;
-	return (plume_mat3){{{c + v * x * x, v * x * y - s * z, v * x * z + s * y},
-	                     {v * x * y + s * z, c + v * y * y, v * y * z - s * x},
-	                     {v * x * z - s * y, v * y * z + s * x, c + v * z * z}}};
+	return core_m3_rotation_cs(axis, cos(angle), sin(angle));
 }

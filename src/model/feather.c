@@ -4,6 +4,7 @@
 
 #include "../core/asserts.h"
 #include "../core/alloc.h"
+#include "../core/vec_inline.h"
 #include "feather_internal.h"
 
 plume_feather *plume_feather_create_empty(void)
@@ -88,7 +89,7 @@ int plume_feather_reserve_points(plume_feather *feather, int capacity)
 	return 0;
 }
 
-int plume_feather_add_points(plume_feather *feather, int count)
+int plume_feather_append_points(plume_feather *feather, int count)
 {
 	int needed = feather->point_count + count;
 	if (count == 0)
@@ -101,12 +102,20 @@ int plume_feather_add_points(plume_feather *feather, int count)
 			return -1;
 	}
 	int first = feather->point_count;
+	feather->point_count = needed;
+	return first;
+}
+
+int plume_feather_add_points(plume_feather *feather, int count)
+{
+	int first = plume_feather_append_points(feather, count);
+	if (first < 0 || count == 0)
+		return first;
 	memset(feather->points + first, 0, (size_t)count * sizeof *feather->points);
 	memset(feather->normals + first, 0, (size_t)count * sizeof *feather->normals);
 	memset(feather->arc_length + first, 0, (size_t)count * sizeof *feather->arc_length);
 	memset(feather->widths + first, 0, (size_t)count * sizeof *feather->widths);
 	memset(feather->uv + first, 0, (size_t)count * sizeof *feather->uv);
-	feather->point_count = needed;
 	return first;
 }
 
@@ -120,23 +129,12 @@ int plume_feather_add_barb(plume_feather *feather, const plume_barb_record *barb
 
 int plume_feather_add_barbule(plume_feather *feather, const plume_barbule_record *barbule)
 {
-	if (PLUME_GROW(feather->barbules, feather->barbule_capacity, feather->barbule_count + 1) != 0)
+	// A builder that reserved its records (Zhang-Kanai: 60,000 of them) skips the call.
+	if (feather->barbule_count >= feather->barbule_capacity &&
+	    PLUME_GROW(feather->barbules, feather->barbule_capacity, feather->barbule_count + 1) != 0)
 		return -1;
 	feather->barbules[feather->barbule_count] = *barbule;
 	return feather->barbule_count++;
-}
-
-void plume_feather_measure_curve(plume_feather *feather, plume_curve_range range)
-{
-	const plume_vec3 *points = feather->points + range.first;
-	double *arc = feather->arc_length + range.first;
-	arc[0] = 0.0;
-	for (int i = 1; i < range.count; ++i)
-		arc[i] = arc[i - 1] + plume_v3_distance(points[i - 1], points[i]);
-	double total = arc[range.count - 1];
-	plume_vec2 *uv = feather->uv + range.first;
-	for (int i = 0; i < range.count; ++i)
-		uv[i].x = total > 0.0 ? arc[i] / total : (range.count > 1 ? (double)i / (range.count - 1) : 0.0);
 }
 
 // ---------------------------------------------------------------------------

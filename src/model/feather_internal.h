@@ -8,6 +8,8 @@
 
 #include "plume/feather.h"
 
+#include "../core/vec_inline.h"
+
 typedef struct plume_curve_range {
 	int first;
 	int count;
@@ -68,6 +70,10 @@ int plume_feather_reserve_points(plume_feather *feather, int capacity);
 /// Appends count pool points (zeroed); returns the index of the first, or -1.
 int plume_feather_add_points(plume_feather *feather, int count);
 
+/// plume_feather_add_points without the zeroing, for a builder that writes every field of every point
+/// (position, normal, width, uv, and arc length through plume_feather_measure_curve).
+int plume_feather_append_points(plume_feather *feather, int count);
+
 /// Appends a barb record; returns its index or -1.
 int plume_feather_add_barb(plume_feather *feather, const plume_barb_record *barb);
 
@@ -79,7 +85,19 @@ int plume_feather_add_barbule(plume_feather *feather, const plume_barbule_record
 int plume_feather_set_summary(plume_feather *feather, const char *json);
 
 /// Fills arc_length for a range of the pool from its points, and uv.s as the
-/// arc-length fraction (0 at the first point, 1 at the last).
-void plume_feather_measure_curve(plume_feather *feather, plume_curve_range range);
+/// arc-length fraction (0 at the first point, 1 at the last). Inline: the
+/// generators measure every barb and barbule, most of a few points.
+static inline void plume_feather_measure_curve(plume_feather *feather, plume_curve_range range)
+{
+	const plume_vec3 *points = feather->points + range.first;
+	double *arc = feather->arc_length + range.first;
+	arc[0] = 0.0;
+	for (int i = 1; i < range.count; ++i)
+		arc[i] = arc[i - 1] + core_v3_distance(points[i - 1], points[i]);
+	double total = arc[range.count - 1];
+	plume_vec2 *uv = feather->uv + range.first;
+	for (int i = 0; i < range.count; ++i)
+		uv[i].x = total > 0.0 ? arc[i] / total : (range.count > 1 ? (double)i / (range.count - 1) : 0.0);
+}
 
 #endif

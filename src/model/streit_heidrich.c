@@ -22,6 +22,7 @@
 
 #include "../core/asserts.h"
 #include "../core/alloc.h"
+#include "../core/vec_inline.h"
 #include "feather_internal.h"
 #include "streit_heidrich_internal.h"
 
@@ -55,27 +56,32 @@ static plume_sh_length_profile ovate_profile(double longest)
 	return profile;
 }
 
-plume_sh_params plume_sh_default_afterfeather(const plume_sh_params *main)
+void sh_default_afterfeather(const plume_sh_params *main, plume_sh_params *after)
 {
-	plume_sh_params after;
-	memset(&after, 0, sizeof after);
-	after.calamus_length = 0.0;
-	after.calamus_width_ratio = 1.0;
-	after.rachis_length = 0.4 * main->rachis_length;
-	after.rachis_width = 0.4 * main->rachis_width;
-	after.rachis_side_curvature = 0.0;
-	after.rachis_front_curvature = 0.0;
+	memset(after, 0, sizeof *after);
+	after->calamus_length = 0.0;
+	after->calamus_width_ratio = 1.0;
+	after->rachis_length = 0.4 * main->rachis_length;
+	after->rachis_width = 0.4 * main->rachis_width;
+	after->rachis_side_curvature = 0.0;
+	after->rachis_front_curvature = 0.0;
 	for (int side = 0; side < 2; ++side) {
 		double longest = 0.0;
 		for (int i = 0; i < main->barb_length[side].count; ++i)
 			longest = fmax(longest, main->barb_length[side].length[i]);
-		after.barb_length[side] = ovate_profile(0.5 * longest);
-		after.barb_angle[side][0] = main->barb_angle[side][0];
-		after.barb_angle[side][1] = main->barb_angle[side][1];
+		after->barb_length[side] = ovate_profile(0.5 * longest);
+		after->barb_angle[side][0] = main->barb_angle[side][0];
+		after->barb_angle[side][1] = main->barb_angle[side][1];
 	}
-	after.spacing_base = main->spacing_base;
-	after.spacing_tip = main->spacing_tip;
-	after.key_barb_count = 0; // afterfeathers are always plumulaceous (3.2)
+	after->spacing_base = main->spacing_base;
+	after->spacing_tip = main->spacing_tip;
+	after->key_barb_count = 0; // afterfeathers are always plumulaceous (3.2)
+}
+
+plume_sh_params plume_sh_default_afterfeather(const plume_sh_params *main)
+{
+	plume_sh_params after;
+	sh_default_afterfeather(main, &after);
 	return after;
 }
 
@@ -102,7 +108,7 @@ plume_sh_def plume_sh_default_def(void)
 	p->key_barbs[0] = straight_key(0.3, 0.12, -0.05);
 	p->key_barbs[1] = straight_key(0.9, 0.04, -0.02);
 	def.has_afterfeather = false;
-	def.afterfeather = plume_sh_default_afterfeather(p);
+	sh_default_afterfeather(p, &def.afterfeather);
 	def.barb_width_base = 1e-4;
 	def.barb_width_tip = 2.5e-5;
 	def.texture_mode = PLUME_SH_TEXTURE_BARB;
@@ -316,7 +322,8 @@ static double stage_angle(const sh_stage *s, plume_side side, double rp)
 
 /// Positions (arc length from the rachis base) of the barbs of a rachis of length L whose spacing grows
 /// linearly from spb to spt: barb k sits where the barb density 1 / spacing integrates to k + 1/2, and
-/// the count is that integral over the whole rachis, rounded. Returns the count (at most max).
+/// the count is that integral over the whole rachis, rounded. Returns the count, or -1 when it is above
+/// max; writes the positions when out is not NULL.
 static int barb_positions(double length, double spb, double spt, double *out, int max)
 {
 	double slope = (spt - spb) / length;
@@ -324,7 +331,7 @@ static int barb_positions(double length, double spb, double spt, double *out, in
 	int count = (int)floor(total + 0.5);
 	if (count > max)
 		return -1;
-	for (int k = 0; k < count; ++k) {
+	for (int k = 0; k < count && out != NULL; ++k) {
 		double n = k + 0.5;
 		out[k] = fabs(slope) < 1e-12 ? n * spb : spb * expm1(slope * n) / slope;
 	}
@@ -350,7 +357,7 @@ typedef struct rachis_arc {
 
 static double rachis_speed(const rachis_arc *arc, double t)
 {
-	return plume_v3_length(plume_bezier_eval(arc->hodograph, 3, t));
+	return core_v3_length(core_bezier_quadratic(arc->hodograph, t));
 }
 
 /// Length between t0 and t1 by 8-point Gauss-Legendre.
@@ -420,10 +427,16 @@ typedef struct sh_builder {
 
 static const plume_vec3 front = {0.0, 0.0, 1.0};
 
+/// Unit tangent of the rachis at parameter u: the normalized hodograph (the rachis arc's own copy of it).
+static plume_vec3 rachis_tangent(const sh_builder *b, double u)
+{
+	return core_v3_normalize(core_bezier_quadratic(b->rachis_arc.hodograph, u));
+}
+
 /// Unit front normal at a shaft point: +z made perpendicular to the tangent.
 static plume_vec3 front_normal(plume_vec3 tangent)
 {
-	plume_vec3 n = plume_v3_normalize(plume_v3_mad(front, -plume_v3_dot(front, tangent), tangent));
+	plume_vec3 n = core_v3_normalize(plume_v3_mad(front, -plume_v3_dot(front, tangent), tangent));
 	return n.x == 0.0 && n.y == 0.0 && n.z == 0.0 ? plume_v3(1.0, 0.0, 0.0) : n;
 }
 
@@ -457,11 +470,11 @@ static plume_status build_shaft(plume_feather *feather, sh_builder *b)
 	for (int i = 1; i < rachis; ++i) {
 		plume_shaft_sample *s = shaft + calamus - 1 + i;
 		s->position = polygon[i];
-		s->tangent = plume_v3_normalize(plume_bezier_derivative(b->rachis, 4, 1, (double)i / (rachis - 1)));
+		s->tangent = rachis_tangent(b, (double)i / (rachis - 1));
 		double f = rachis_run > 0.0 ? run[i] / rachis_run : 1.0;
 		s->width = (1.0 - f) * b->rachis_width; // the rachis tip forms a point (4.1)
 	}
-	shaft[calamus - 1].tangent = plume_v3_normalize(plume_bezier_derivative(b->rachis, 4, 1, 0.0));
+	shaft[calamus - 1].tangent = rachis_tangent(b, 0.0);
 	double total = 0.0;
 	for (int i = 0; i < count; ++i) {
 		plume_shaft_sample *s = shaft + i;
@@ -486,18 +499,33 @@ static void tilt_into_plane(plume_vec3 *cvs, int count)
 	plume_vec3 d = cvs[n - 2 >= 1 ? n - 2 : n];
 	plume_vec3 flat = plume_v3(d.x, d.y, 0.0);
 	plume_vec3 axis = plume_v3_cross(d, flat);
-	double axis_length = plume_v3_length(axis);
-	if (!(axis_length > 1e-15) || plume_v3_length(flat) == 0.0)
+	double axis_length = core_v3_length(axis);
+	if (!(axis_length > 1e-15) || core_v3_length(flat) == 0.0)
 		return;
 	double angle = atan2(axis_length, plume_v3_dot(d, flat));
-	plume_mat3 rotation = plume_m3_rotation(plume_v3_scale(axis, 1.0 / axis_length), angle);
+	plume_mat3 rotation = core_m3_rotation_cs(plume_v3_scale(axis, 1.0 / axis_length), cos(angle), sin(angle));
 	for (int i = 1; i < count; ++i)
-		cvs[i] = plume_m3_apply(rotation, cvs[i]);
+		cvs[i] = core_m3_apply(&rotation, cvs[i]);
 }
 
-/// Appends the barb at arc length s along the rachis on one side.
+/// The frame where a barb meets the rachis: T along the rachis, N to the front, B = N x T towards the left
+/// vane. Both vanes' barbs k share it.
+typedef struct sh_root {
+	plume_vec3 position, tangent, normal, binormal;
+} sh_root;
+
+static sh_root root_at(const sh_builder *b, double rp)
+{
+	double u = rachis_arc_param(&b->rachis_arc, rp);
+	sh_root r = {.position = core_bezier_cubic(b->rachis, u), .tangent = rachis_tangent(b, u)};
+	r.normal = front_normal(r.tangent);
+	r.binormal = plume_v3_cross(r.normal, r.tangent);
+	return r;
+}
+
+/// Appends the barb at arc length s along the rachis on one side, rooted at r (at rp).
 static plume_status build_barb(plume_feather *feather, sh_builder *b, plume_side side, double rp, int index,
-                               double rachis_arc_length)
+                               double rachis_arc_length, const sh_root *r)
 {
 	const plume_sh_params *p = b->params;
 	double length = b->stage.barb_scale * sh_profile_eval(&p->barb_length[side], rp);
@@ -518,12 +546,7 @@ static plume_status build_barb(plume_feather *feather, sh_builder *b, plume_side
 		cvs[i] = plume_v3_sub(cvs[i], origin);
 	tilt_into_plane(cvs, count);
 
-	// The barb frame at the root: T along the rachis, N to the front, B = N x T towards the left vane.
-	double u = rachis_arc_param(&b->rachis_arc, rp);
-	plume_vec3 root = plume_bezier_eval(b->rachis, 4, u);
-	plume_vec3 tangent = plume_v3_normalize(plume_bezier_derivative(b->rachis, 4, 1, u));
-	plume_vec3 normal = front_normal(tangent);
-	plume_vec3 binormal = plume_v3_cross(normal, tangent);
+	plume_vec3 root = r->position, tangent = r->tangent, normal = r->normal, binormal = r->binormal;
 	double angle = stage_angle(&b->stage, side, rp);
 	double outward = side == PLUME_SIDE_LEFT ? 1.0 : -1.0;
 	plume_vec3 along =
@@ -540,7 +563,7 @@ static plume_status build_barb(plume_feather *feather, sh_builder *b, plume_side
 		points = PLUME_BEZIER_MAX_POINTS;
 	sh_elevate_to(cvs, count, points);
 
-	int first = plume_feather_add_points(feather, points);
+	int first = plume_feather_append_points(feather, points);
 	if (first < 0)
 		return PLUME_ERROR_MEMORY;
 	double rachis_t = (b->calamus_length + rachis_arc_length) / b->shaft_length;
@@ -603,10 +626,11 @@ static plume_status build_feather(const plume_sh_def *def, const plume_sh_params
 {
 	*out = NULL;
 	sh_builder *b = plume_alloc(sizeof *b);
-	double *positions = plume_alloc(PLUME_SH_MAX_BARBS * sizeof *positions);
+	double *positions = NULL;
+	sh_root *roots = NULL;
 	plume_feather *feather = plume_feather_create_empty();
 	plume_status status = PLUME_OK;
-	if (b == NULL || positions == NULL || feather == NULL) {
+	if (b == NULL || feather == NULL) {
 		status = plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory while generating a feather");
 		goto done;
 	}
@@ -635,7 +659,7 @@ static plume_status build_feather(const plume_sh_def *def, const plume_sh_params
 			b->longest_barb = fmax(b->longest_barb, b->stage.barb_scale * params->barb_length[side].length[i]);
 
 	int count =
-	    barb_positions(b->rachis_arc.length, params->spacing_base, params->spacing_tip, positions, PLUME_SH_MAX_BARBS);
+	    barb_positions(b->rachis_arc.length, params->spacing_base, params->spacing_tip, NULL, PLUME_SH_MAX_BARBS);
 	if (count < 0) {
 		status = plume_error_set(err, PLUME_ERROR_SPEC,
 		                         "the barb spacing (spacing_base %g m, spacing_tip %g m) puts more than %d barbs on a "
@@ -656,14 +680,21 @@ static plume_status build_feather(const plume_sh_def *def, const plume_sh_params
 	points_per_barb += lod->barb_elevations;
 	if (points_per_barb > PLUME_BEZIER_MAX_POINTS)
 		points_per_barb = PLUME_BEZIER_MAX_POINTS;
-	if (plume_feather_reserve_points(feather, 2 * count * points_per_barb) != 0 ||
+	// Barb k of either vane sits at positions[k] along the rachis, on roots[k].
+	positions = plume_alloc((size_t)(count > 0 ? count : 1) * sizeof *positions);
+	roots = plume_alloc((size_t)(count > 0 ? count : 1) * sizeof *roots);
+	if (positions == NULL || roots == NULL || plume_feather_reserve_points(feather, 2 * count * points_per_barb) != 0 ||
 	    build_shaft(feather, b) != PLUME_OK) {
 		status = plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory while generating a feather");
 		goto done;
 	}
+	barb_positions(b->rachis_arc.length, params->spacing_base, params->spacing_tip, positions, count);
+	for (int k = 0; k < count; ++k)
+		roots[k] = root_at(b, positions[k] / b->rachis_arc.length);
 	for (int side = 0; side < 2 && status == PLUME_OK; ++side)
 		for (int k = 0; k < count && status == PLUME_OK; ++k)
-			status = build_barb(feather, b, (plume_side)side, positions[k] / b->rachis_arc.length, k, positions[k]);
+			status = build_barb(feather, b, (plume_side)side, positions[k] / b->rachis_arc.length, k, positions[k],
+			                    roots + k);
 	if (status != PLUME_OK) {
 		status = plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory while generating a feather");
 		goto done;
@@ -674,6 +705,7 @@ static plume_status build_feather(const plume_sh_def *def, const plume_sh_params
 	feather = NULL;
 done:
 	plume_feather_destroy(feather);
+	plume_free(roots);
 	plume_free(positions);
 	plume_free(b);
 	return status;

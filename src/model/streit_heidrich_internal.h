@@ -37,6 +37,10 @@ int sh_barb_cvs(const sh_key_list *list, const sh_bdf1_table *table, double rp, 
 /// target <= PLUME_BEZIER_MAX_POINTS) in place; cvs must hold target points.
 void sh_elevate_to(plume_vec3 *cvs, int count, int target);
 
+/// plume_sh_default_afterfeather written into after (a different object than main), without the copy of
+/// returning it.
+void sh_default_afterfeather(const plume_sh_params *main, plume_sh_params *after);
+
 /// Barb length of a profile at rp, m.
 double sh_profile_eval(const plume_sh_length_profile *profile, double rp);
 

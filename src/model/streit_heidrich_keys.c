@@ -7,6 +7,7 @@
 
 #include "../core/asserts.h"
 #include "../core/alloc.h"
+#include "../core/vec_inline.h"
 #include "streit_heidrich_internal.h"
 
 /// Most feathers one blend takes.
@@ -97,7 +98,7 @@ void sh_elevate_to(plume_vec3 *cvs, int count, int target)
 {
 	// Degree elevation n -> n + 1 (4.2.1, NOTES.md) as often as needed; the curve does not move.
 	for (int c = count; c < target; ++c)
-		plume_bezier_elevate(cvs, c, cvs);
+		core_bezier_elevate(cvs, c, cvs);
 }
 
 /// Index i of the interval [keys[i], keys[i + 1]] holding rp.
@@ -263,9 +264,10 @@ static void blend_profiles(const plume_sh_length_profile *const *profiles, const
 	}
 }
 
-/// Weighted sum of the parameters of count feathers (weights normalized, >= 0). Returns -1 when memory
-/// runs out.
-static int blend_params(const plume_sh_params *const *params, const double *weights, int count, plume_sh_params *out)
+/// Weighted sum of the parameters of count feathers (weights normalized, >= 0); lists is scratch for count
+/// key lists.
+static void blend_params(const plume_sh_params *const *params, const double *weights, int count, sh_key_list *lists,
+                         plume_sh_params *out)
 {
 	memset(out, 0, sizeof *out);
 #define BLEND(field)                                                                                                   \
@@ -297,9 +299,6 @@ static int blend_params(const plume_sh_params *const *params, const double *weig
 
 	// Key barbs: complete with the defaults, inflate to a common count, blend pairwise by order.
 	static const int max_keys = PLUME_SH_MAX_KEY_BARBS;
-	sh_key_list *lists = plume_alloc((size_t)count * sizeof *lists);
-	if (lists == NULL)
-		return -1;
 	int target = 0;
 	for (int f = 0; f < count; ++f) {
 		sh_key_list_build(params[f], &lists[f]);
@@ -330,8 +329,6 @@ static int blend_params(const plume_sh_params *const *params, const double *weig
 		key->position = fmin(fmax(key->position, 0.0), 1.0);
 		key->plumulaceous = fmin(fmax(key->plumulaceous, 0.0), 1.0);
 	}
-	plume_free(lists);
-	return 0;
 }
 
 plume_status plume_sh_def_blend(const plume_sh_def *const *defs, const double *weights, int count, plume_sh_def *out,
@@ -366,19 +363,30 @@ plume_status plume_sh_def_blend(const plume_sh_def *const *defs, const double *w
 		if (weights[f] > weights[heaviest])
 			heaviest = f;
 	}
-	plume_sh_def result;
+	// The blend is written straight into out (a definition is tens of kilobytes: a coat blends one per
+	// feather), through a copy only when out is one of the definitions it reads.
+	bool aliased = false;
+	for (int f = 0; f < count; ++f)
+		aliased = aliased || defs[f] == out;
+	plume_sh_def *result = aliased ? plume_alloc(sizeof *result) : out;
+	sh_key_list *lists = plume_alloc((size_t)count * sizeof *lists);
+	if (result == NULL || lists == NULL) {
+		if (aliased)
+			plume_free(result);
+		plume_free(lists);
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "blend: out of memory");
+	}
 	const plume_sh_params *params[MAX_BLEND];
 	for (int f = 0; f < count; ++f)
 		params[f] = &defs[f]->main;
-	if (blend_params(params, normalized, count, &result.main) != 0)
-		return plume_error_set(err, PLUME_ERROR_MEMORY, "blend: out of memory");
+	blend_params(params, normalized, count, lists, &result->main);
 
 	// Afterfeathers blend among the feathers that have one, and the result has one when they weigh at least half.
 	double after_weight = 0.0;
 	for (int f = 0; f < count; ++f)
 		if (defs[f]->has_afterfeather)
 			after_weight += normalized[f];
-	result.has_afterfeather = after_weight >= 0.5;
+	result->has_afterfeather = after_weight >= 0.5;
 	if (after_weight > 0.0) {
 		double after_weights[MAX_BLEND];
 		int n = 0;
@@ -387,20 +395,23 @@ plume_status plume_sh_def_blend(const plume_sh_def *const *defs, const double *w
 				params[n] = &defs[f]->afterfeather;
 				after_weights[n++] = normalized[f] / after_weight;
 			}
-		if (blend_params(params, after_weights, n, &result.afterfeather) != 0)
-			return plume_error_set(err, PLUME_ERROR_MEMORY, "blend: out of memory");
+		blend_params(params, after_weights, n, lists, &result->afterfeather);
 	} else {
-		result.afterfeather = plume_sh_default_afterfeather(&result.main);
+		sh_default_afterfeather(&result->main, &result->afterfeather);
 	}
-	result.barb_width_base = 0.0;
-	result.barb_width_tip = 0.0;
+	result->barb_width_base = 0.0;
+	result->barb_width_tip = 0.0;
 	for (int f = 0; f < count; ++f) {
-		result.barb_width_base += normalized[f] * defs[f]->barb_width_base;
-		result.barb_width_tip += normalized[f] * defs[f]->barb_width_tip;
+		result->barb_width_base += normalized[f] * defs[f]->barb_width_base;
+		result->barb_width_tip += normalized[f] * defs[f]->barb_width_tip;
 	}
-	result.texture_mode = defs[heaviest]->texture_mode;
-	result.cookie = PLUME_DEF_COOKIE;
-	*out = result;
+	result->texture_mode = defs[heaviest]->texture_mode;
+	result->cookie = PLUME_DEF_COOKIE;
+	if (aliased) {
+		*out = *result;
+		plume_free(result);
+	}
+	plume_free(lists);
 	return PLUME_OK;
 }
 

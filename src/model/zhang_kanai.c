@@ -258,13 +258,12 @@ static plume_status build_shaft(plume_feather *feather, const zk_result *r, doub
 	return PLUME_OK;
 }
 
-static plume_status add_barbule(plume_feather *feather, int barb_index, plume_vec3 from, plume_vec3 vector,
+/// Fills the two pool points from first (added already) with a barbule from `from` along vector, and
+/// records it.
+static plume_status add_barbule(plume_feather *feather, int first, int barb_index, plume_vec3 from, plume_vec3 vector,
                                 plume_vec3 normal, double barb_s, double rachis_t, plume_barbule_kind kind,
                                 double width)
 {
-	int first = plume_feather_add_points(feather, 2);
-	if (first < 0)
-		return PLUME_ERROR_MEMORY;
 	feather->points[first] = from;
 	feather->points[first + 1] = plume_v3_add(from, vector);
 	for (int k = 0; k < 2; ++k) {
@@ -284,7 +283,7 @@ static plume_status build_barb(plume_feather *feather, const zk_result *r, int g
 	const zk_barb *barb = r->growth->barbs + g;
 	double dir = barb->side == PLUME_SIDE_LEFT ? -1.0 : 1.0;
 	double rachis_t = y1 > y0 ? (root_y(r, g) - y0) / (y1 - y0) : 0.0;
-	int first = plume_feather_add_points(feather, barb->count);
+	int first = plume_feather_append_points(feather, barb->count);
 	if (first < 0)
 		return PLUME_ERROR_MEMORY;
 	for (int j = 0; j < barb->count; ++j) {
@@ -313,15 +312,18 @@ static plume_status build_barb(plume_feather *feather, const zk_result *r, int g
 		return PLUME_ERROR_MEMORY;
 	if (!barbules)
 		return PLUME_OK;
-	// Two barbules per vertex, distal then proximal.
+	// Two barbules per vertex, distal then proximal, after the barb in the pool.
+	int pool = plume_feather_append_points(feather, 4 * barb->count);
+	if (pool < 0)
+		return PLUME_ERROR_MEMORY;
 	for (int j = 0; j < barb->count; ++j) {
 		int v = barb->first + j;
 		plume_vec3 p = feather->points[first + j], normal = feather->normals[first + j];
 		double s = feather->uv[first + j].x;
 		plume_status status;
-		if ((status = add_barbule(feather, index, p, r->barbules->distal[v], normal, s, rachis_t, PLUME_BARBULE_DISTAL,
-		                          def->barbule_width)) != PLUME_OK ||
-		    (status = add_barbule(feather, index, p, r->barbules->proximal[v], normal, s, rachis_t,
+		if ((status = add_barbule(feather, pool + 4 * j, index, p, r->barbules->distal[v], normal, s, rachis_t,
+		                          PLUME_BARBULE_DISTAL, def->barbule_width)) != PLUME_OK ||
+		    (status = add_barbule(feather, pool + 4 * j + 2, index, p, r->barbules->proximal[v], normal, s, rachis_t,
 		                          PLUME_BARBULE_PROXIMAL, def->barbule_width)) != PLUME_OK)
 			return status;
 	}
@@ -356,7 +358,10 @@ static plume_status build_feather(const zk_result *r, plume_feather **out)
 		return PLUME_ERROR_MEMORY;
 	long points = (long)growth->vertex_count * (barbules ? 5 : 1);
 	plume_status status = PLUME_ERROR_MEMORY;
+	// Every record in one allocation: a feather of 2 x 400 barbs has 60,000 barbules.
 	if (points > 0x7fffffffL || plume_feather_reserve_points(feather, (int)points) != 0 ||
+	    PLUME_GROW(feather->barbs, feather->barb_capacity, growth->barb_count) != 0 ||
+	    (barbules && PLUME_GROW(feather->barbules, feather->barbule_capacity, 2 * growth->vertex_count) != 0) ||
 	    (status = build_shaft(feather, r, y0, y1, y_low)) != PLUME_OK)
 		goto fail;
 	for (int k = 0; k < growth->barb_count; ++k)

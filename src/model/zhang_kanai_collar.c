@@ -70,24 +70,23 @@ static int locate(const zk_collar *collar, double s, double *u)
 	return lo;
 }
 
-plume_vec3 zk_collar_point(const zk_collar *collar, double s)
+void zk_collar_frame(const zk_collar *collar, double s, plume_vec3 *point, plume_vec3 *tangent)
 {
 	if (collar->kind == PLUME_ZK_COLLAR_CIRCLE) {
-		double a = two_pi * s;
-		return plume_v3(collar->radius * sin(a), 0.0, -collar->radius * cos(a));
+		double a = two_pi * s, c = cos(a), sn = sin(a);
+		*point = plume_v3(collar->radius * sn, 0.0, -collar->radius * c);
+		*tangent = plume_v3(c, 0.0, sn);
+		return;
 	}
 	double u;
 	int k = locate(collar, s, &u);
-	return plume_bezier_eval(collar->segments[k], 4, u);
+	*point = plume_bezier_eval(collar->segments[k], 4, u);
+	*tangent = plume_v3_normalize(plume_bezier_derivative(collar->segments[k], 4, 1, u));
 }
 
-plume_vec3 zk_collar_tangent(const zk_collar *collar, double s)
+plume_vec3 zk_collar_point(const zk_collar *collar, double s)
 {
-	if (collar->kind == PLUME_ZK_COLLAR_CIRCLE) {
-		double a = two_pi * s;
-		return plume_v3(cos(a), 0.0, sin(a));
-	}
-	double u;
-	int k = locate(collar, s, &u);
-	return plume_v3_normalize(plume_bezier_derivative(collar->segments[k], 4, 1, u));
+	plume_vec3 point, tangent;
+	zk_collar_frame(collar, s, &point, &tangent);
+	return point;
 }

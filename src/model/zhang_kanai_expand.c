@@ -22,6 +22,7 @@
 #include <string.h>
 
 #include "../core/alloc.h"
+#include "../core/vec_inline.h"
 #include "zhang_kanai_internal.h"
 
 static plume_vec3 frame_apply(const zk_frame *f, plume_vec3 local)
@@ -30,36 +31,102 @@ static plume_vec3 frame_apply(const zk_frame *f, plume_vec3 local)
 	                    plume_v3_scale(f->b, local.z));
 }
 
-/// Eq. 11-12 in the vertex's own frame (t, n, b): the same vector for any
-/// rotation of the frame, so snapping can rotate frames and keep barbules.
-static plume_vec3 barbule_local(double growth_speed, double emitter_speed, double ridge, double theta, double azimuth,
-                                double dir)
+/// The angles of one barbule of eq. 12 on one vane: tan theta and the cosine and sine of its turn phi'
+/// about the ramus, taken once for every vertex of the vane.
+typedef struct barbule_angles {
+	double tan_theta, cos_azimuth, sin_azimuth;
+	double dir;
+} barbule_angles;
+
+static barbule_angles make_angles(double theta, double azimuth, double dir)
 {
-	plume_vec3 r = plume_v3(emitter_speed, 0.0, growth_speed); // (t, n, b) components
-	plume_vec3 axis = plume_v3_normalize(r);
-	plume_vec3 v = plume_v3_add(plume_v3_scale(axis, ridge / tan(theta)), plume_v3(0.0, dir * ridge, 0.0));
-	return plume_m3_apply(plume_m3_rotation(axis, azimuth), v);
+	return (barbule_angles){
+	    .tan_theta = tan(theta), .cos_azimuth = cos(azimuth), .sin_azimuth = sin(azimuth), .dir = dir};
+}
+
+/// Eq. 12 about the unit ramus axis r/|r| of eq. 11, in the vertex's own frame
+/// (t, n, b): the same vector for any rotation of the frame, so snapping can
+/// rotate frames and keep barbules.
+static plume_vec3 barbule_local(plume_vec3 axis, double ridge, const barbule_angles *angles)
+{
+	plume_vec3 v =
+	    plume_v3_add(plume_v3_scale(axis, ridge / angles->tan_theta), plume_v3(0.0, angles->dir * ridge, 0.0));
+	plume_mat3 turn = core_m3_rotation_cs(axis, angles->cos_azimuth, angles->sin_azimuth);
+	return core_m3_apply(&turn, v);
+}
+
+/// The most distal point where the sphere meets segment i of the line, if any.
+static bool sphere_segment(plume_vec3 centre, double radius, const plume_vec3 *line, int i, plume_vec3 *hit)
+{
+	plume_vec3 d = plume_v3_sub(line[i + 1], line[i]), f = plume_v3_sub(line[i], centre);
+	double a = plume_v3_dot(d, d);
+	if (!(a > 0.0))
+		return false;
+	double b = 2.0 * plume_v3_dot(f, d), c = plume_v3_dot(f, f) - radius * radius;
+	double disc = b * b - 4.0 * a * c;
+	if (disc < 0.0)
+		return false;
+	double root = sqrt(disc);
+	double u = (-b + root) / (2.0 * a); // the larger root first: the more distal point
+	if (!(u >= 0.0 && u <= 1.0))
+		u = (-b - root) / (2.0 * a);
+	if (u >= 0.0 && u <= 1.0) {
+		*hit = plume_v3_mad(line[i], u, d);
+		return true;
+	}
+	return false;
 }
 
 bool zk_sphere_polyline(plume_vec3 centre, double radius, const plume_vec3 *line, int count, plume_vec3 *hit)
 {
-	for (int i = count - 2; i >= 0; --i) {
-		plume_vec3 d = plume_v3_sub(line[i + 1], line[i]), f = plume_v3_sub(line[i], centre);
-		double a = plume_v3_dot(d, d);
-		if (!(a > 0.0))
-			continue;
-		double b = 2.0 * plume_v3_dot(f, d), c = plume_v3_dot(f, f) - radius * radius;
-		double disc = b * b - 4.0 * a * c;
-		if (disc < 0.0)
-			continue;
-		double root = sqrt(disc);
-		double u = (-b + root) / (2.0 * a); // the larger root first: the more distal point
-		if (!(u >= 0.0 && u <= 1.0))
-			u = (-b - root) / (2.0 * a);
-		if (u >= 0.0 && u <= 1.0) {
-			*hit = plume_v3_mad(line[i], u, d);
+	for (int i = count - 2; i >= 0; --i)
+		if (sphere_segment(centre, radius, line, i, hit))
 			return true;
+	return false;
+}
+
+/// Segments per bounding ball of a snapping boundary.
+enum { BLOCK = 8 };
+
+/// A ball around the points of each block of BLOCK segments of the line (count points): blocks[k] holds
+/// segments [k BLOCK, (k + 1) BLOCK).
+typedef struct ball {
+	plume_vec3 centre;
+	double radius;
+} ball;
+
+static void bound_blocks(const plume_vec3 *line, int count, ball *blocks)
+{
+	for (int first = 0, k = 0; first + 1 < count; first += BLOCK, ++k) {
+		int last = first + BLOCK < count - 1 ? first + BLOCK : count - 1; // its last point
+		plume_vec3 lo = line[first], hi = line[first];
+		for (int i = first + 1; i <= last; ++i) {
+			lo = plume_v3(fmin(lo.x, line[i].x), fmin(lo.y, line[i].y), fmin(lo.z, line[i].z));
+			hi = plume_v3(fmax(hi.x, line[i].x), fmax(hi.y, line[i].y), fmax(hi.z, line[i].z));
 		}
+		blocks[k].centre = plume_v3_scale(plume_v3_add(lo, hi), 0.5);
+		blocks[k].radius = 0.0;
+		for (int i = first; i <= last; ++i)
+			blocks[k].radius = fmax(blocks[k].radius, core_v3_distance(line[i], blocks[k].centre));
+	}
+}
+
+/// zk_sphere_polyline's answer, bit for bit, without testing the segments of a block whose ball lies
+/// wholly outside or wholly inside the sphere (none of them can meet its surface). The margin, a
+/// millionth of the sizes, is far above the rounding of the segment test, so no block that test would
+/// find a point in is skipped.
+static bool sphere_polyline_blocks(plume_vec3 centre, double radius, const plume_vec3 *line, int count,
+                                   const ball *blocks, plume_vec3 *hit)
+{
+	for (int k = (count - 2) / BLOCK; k >= 0 && count >= 2; --k) {
+		double distance = core_v3_distance(centre, blocks[k].centre), r = blocks[k].radius;
+		double margin = 1e-6 * (radius + r);
+		if (distance > radius + r + margin || distance + r < radius - margin)
+			continue;
+		int first = k * BLOCK, last = first + BLOCK < count - 1 ? first + BLOCK - 1 : count - 2; // segments
+		for (int i = last; i >= first; --i)
+			if (sphere_segment(centre, radius, line, i, hit))
+				return true;
 	}
 	return false;
 }
@@ -68,25 +135,27 @@ bool zk_sphere_polyline(plume_vec3 centre, double radius, const plume_vec3 *line
 static plume_mat3 rotation_between(plume_vec3 a, plume_vec3 b)
 {
 	plume_vec3 axis = plume_v3_cross(a, b);
-	double s = plume_v3_length(axis), c = plume_v3_dot(a, b);
+	double s = core_v3_length(axis), c = plume_v3_dot(a, b);
 	if (s < 1e-300) {
 		if (c > 0.0)
 			return plume_m3_identity();
 		plume_vec3 other = fabs(a.x) < 0.9 ? plume_v3(1.0, 0.0, 0.0) : plume_v3(0.0, 1.0, 0.0);
-		return plume_m3_rotation(plume_v3_normalize(plume_v3_cross(a, other)), 3.14159265358979323846);
+		return plume_m3_rotation(core_v3_normalize(plume_v3_cross(a, other)), 3.14159265358979323846);
 	}
-	return plume_m3_rotation(plume_v3_scale(axis, 1.0 / s), atan2(s, c));
+	double angle = atan2(s, c);
+	return core_m3_rotation_cs(plume_v3_scale(axis, 1.0 / s), cos(angle), sin(angle));
 }
 
 /// Rotates vertex j's frame by q about its position, carrying every vertex after it.
-static void rotate_from(plume_vec3 *p, zk_frame *frame, int count, int j, plume_mat3 q)
+static void rotate_from(plume_vec3 *p, zk_frame *frame, int count, int j, const plume_mat3 *q)
 {
+	plume_vec3 pivot = p[j];
 	for (int k = j; k < count; ++k) {
 		if (k > j)
-			p[k] = plume_v3_add(p[j], plume_m3_apply(q, plume_v3_sub(p[k], p[j])));
-		frame[k].t = plume_m3_apply(q, frame[k].t);
-		frame[k].n = plume_m3_apply(q, frame[k].n);
-		frame[k].b = plume_m3_apply(q, frame[k].b);
+			p[k] = plume_v3_add(pivot, core_m3_apply(q, plume_v3_sub(p[k], pivot)));
+		frame[k].t = core_m3_apply(q, frame[k].t);
+		frame[k].n = core_m3_apply(q, frame[k].n);
+		frame[k].b = core_m3_apply(q, frame[k].b);
 	}
 }
 
@@ -105,6 +174,7 @@ typedef struct expand_ctx {
 	zk_shape *shape;
 	plume_vec3 *local_distal, *local_proximal; ///< per vertex, in its frame
 	plume_vec3 *boundary;                      ///< scratch, max vertices + 1
+	ball *blocks;                              ///< scratch: the boundary's blocks
 } expand_ctx;
 
 static plume_vec3 world_barbule(const expand_ctx *ctx, const plume_vec3 *local, int vertex)
@@ -134,17 +204,18 @@ static int snap_pair(const expand_ctx *ctx, const zk_barb *a, const zk_barb *b)
 	}
 	const plume_vec3 *line = ctx->boundary + start;
 	int line_count = a->count + 1 - start;
+	bound_blocks(line, line_count, ctx->blocks);
 	// 3-4) each vertex of B from the root: turn its distal barbule onto the boundary.
 	for (int j = 0; j < b->count; ++j) {
 		int v = b->first + j;
 		plume_vec3 barbule = world_barbule(ctx, ctx->local_distal, v);
-		double radius = plume_v3_length(barbule);
+		double radius = core_v3_length(barbule);
 		plume_vec3 hit;
-		if (!(radius > 0.0) || !zk_sphere_polyline(shape->p[v], radius, line, line_count, &hit))
+		if (!(radius > 0.0) || !sphere_polyline_blocks(shape->p[v], radius, line, line_count, ctx->blocks, &hit))
 			break;
 		plume_vec3 to = plume_v3_scale(plume_v3_sub(hit, shape->p[v]), 1.0 / radius);
-		plume_mat3 q = rotation_between(plume_v3_scale(barbule, 1.0 / radius), plume_v3_normalize(to));
-		rotate_from(shape->p + b->first, shape->frame + b->first, b->count, j, q);
+		plume_mat3 q = rotation_between(plume_v3_scale(barbule, 1.0 / radius), core_v3_normalize(to));
+		rotate_from(shape->p + b->first, shape->frame + b->first, b->count, j, &q);
 		++n;
 	}
 	return n;
@@ -156,7 +227,7 @@ static void apply_split(zk_shape *shape, const zk_barb *barb, const plume_zk_spl
 	int j = (int)lround(split->at * (barb->count - 1));
 	// A positive angle about n turns t towards -b: n x t = -b (the frame is right-handed).
 	plume_mat3 q = plume_m3_rotation(shape->frame[barb->first + j].n, split->angle);
-	rotate_from(shape->p + barb->first, shape->frame + barb->first, barb->count, j, q);
+	rotate_from(shape->p + barb->first, shape->frame + barb->first, barb->count, j, &q);
 }
 
 plume_status zk_expand(const plume_zk_def *def, const zk_growth *growth, zk_shape *shape, zk_barbules *barbules)
@@ -172,6 +243,7 @@ plume_status zk_expand(const plume_zk_def *def, const zk_growth *growth, zk_shap
 	ctx.local_distal = plume_alloc(n * sizeof *ctx.local_distal);
 	ctx.local_proximal = plume_alloc(n * sizeof *ctx.local_proximal);
 	ctx.boundary = plume_alloc((size_t)(longest + 1) * sizeof *ctx.boundary);
+	ctx.blocks = plume_alloc((size_t)(longest / BLOCK + 1) * sizeof *ctx.blocks);
 	barbules->snap = plume_calloc(nb, sizeof *barbules->snap);
 	barbules->snapped = plume_calloc(nb, sizeof *barbules->snapped);
 	if (def->expansion) {
@@ -179,8 +251,9 @@ plume_status zk_expand(const plume_zk_def *def, const zk_growth *growth, zk_shap
 		barbules->proximal = plume_alloc(n * sizeof *barbules->proximal);
 	}
 	plume_status status = PLUME_OK;
-	if (ctx.local_distal == NULL || ctx.local_proximal == NULL || ctx.boundary == NULL || barbules->snap == NULL ||
-	    barbules->snapped == NULL || (def->expansion && (barbules->distal == NULL || barbules->proximal == NULL))) {
+	if (ctx.local_distal == NULL || ctx.local_proximal == NULL || ctx.boundary == NULL || ctx.blocks == NULL ||
+	    barbules->snap == NULL || barbules->snapped == NULL ||
+	    (def->expansion && (barbules->distal == NULL || barbules->proximal == NULL))) {
 		status = PLUME_ERROR_MEMORY;
 		goto done;
 	}
@@ -190,15 +263,21 @@ plume_status zk_expand(const plume_zk_def *def, const zk_growth *growth, zk_shap
 	zk_curve ve, ridge;
 	zk_curve_init(&ve, &def->emitter_speed);
 	zk_curve_init(&ridge, &def->ridge_height);
+	barbule_angles angles[2][2]; // [side][distal, proximal]
+	for (int side = 0; side < 2; ++side) {
+		double dir = side == PLUME_SIDE_LEFT ? -1.0 : 1.0;
+		angles[side][0] = make_angles(def->theta_distal, dir * def->azimuth, dir);
+		angles[side][1] = make_angles(def->theta_proximal, -dir * def->azimuth, dir);
+	}
 	for (int i = 0; i < growth->barb_count; ++i) {
 		const zk_barb *barb = growth->barbs + i;
-		double dir = barb->side == PLUME_SIDE_LEFT ? -1.0 : 1.0;
+		const barbule_angles *side = angles[barb->side];
 		for (int j = 0; j < barb->count; ++j) {
 			int v = barb->first + j;
 			double s = shape->locus[v], vs = zk_curve_eval(&ve, s), l = zk_curve_eval(&ridge, s);
-			ctx.local_distal[v] = barbule_local(def->growth_speed, vs, l, def->theta_distal, dir * def->azimuth, dir);
-			ctx.local_proximal[v] =
-			    barbule_local(def->growth_speed, vs, l, def->theta_proximal, -dir * def->azimuth, dir);
+			plume_vec3 axis = core_v3_normalize(plume_v3(vs, 0.0, def->growth_speed)); // eq. 11 in (t, n, b)
+			ctx.local_distal[v] = barbule_local(axis, l, side + 0);
+			ctx.local_proximal[v] = barbule_local(axis, l, side + 1);
 		}
 	}
 	// Splits first ("bend a chosen barb before snapping").
@@ -235,6 +314,7 @@ done:
 	plume_free(ctx.local_distal);
 	plume_free(ctx.local_proximal);
 	plume_free(ctx.boundary);
+	plume_free(ctx.blocks);
 	if (status != PLUME_OK)
 		zk_barbules_free(barbules);
 	return status;

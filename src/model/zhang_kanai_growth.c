@@ -83,18 +83,56 @@ typedef struct path_end {
 	int count;    ///< points kept after downsampling
 } path_end;
 
+/// Where a pathline writes its points: arrays of the pathline's size (grows
+/// false), or arrays that keep the points of many pathlines one after the
+/// other, each from first on, and grow up to MAX_KEPT_POINTS in all.
+typedef struct path_points {
+	double *locus, *time;
+	int first, capacity;
+	bool grows;
+	bool full;          ///< a point did not fit: the pathline's points are incomplete
+	bool out_of_memory; ///< full because growing failed (else the bound was reached)
+} path_points;
+
+/// The bound on points kept for reuse (64 MiB): a runaway spec integrates
+/// again instead of holding every step it took.
+enum { MAX_KEPT_POINTS = 1 << 22 };
+
+/// Stores point `at` of the pathline being written.
+static void keep_point(path_points *points, int at, double s, double t)
+{
+	if (points == NULL || points->full)
+		return;
+	int index = points->first + at;
+	if (points->grows && index >= points->capacity) {
+		int capacity = points->capacity > 0 ? points->capacity : 1024;
+		while (capacity <= index && capacity <= MAX_KEPT_POINTS)
+			capacity *= 2;
+		double *locus = capacity > MAX_KEPT_POINTS ? NULL : plume_realloc(points->locus, capacity * sizeof *locus);
+		if (locus != NULL)
+			points->locus = locus;
+		double *time = locus == NULL ? NULL : plume_realloc(points->time, capacity * sizeof *time);
+		if (time == NULL) {
+			points->full = true;
+			points->out_of_memory = capacity <= MAX_KEPT_POINTS;
+			return;
+		}
+		points->time = time;
+		points->capacity = capacity;
+	}
+	points->locus[index] = s;
+	points->time[index] = t;
+}
+
 /// Integrates a barb from (s0, t0) towards I_A until it arrives or t_stop.
-/// Keeps every f-th step and the last point; writes them when locus is not NULL.
-static plume_status pathline(const zk_vane *vane, double s0, double t0, double t_stop, double *locus, double *time,
+/// Keeps every f-th step and the last point; writes them when points is not NULL.
+static plume_status pathline(const zk_vane *vane, double s0, double t0, double t_stop, path_points *points,
                              path_end *end)
 {
 	const double h = vane->h, target = vane->s_anterior;
 	const double sigma = vane->barb.scale > 0.0 ? 1.0 : -1.0;
 	int count = 0;
-	if (locus != NULL) {
-		locus[0] = s0;
-		time[0] = t0;
-	}
+	keep_point(points, 0, s0, t0);
 	count = 1;
 	double s = s0;
 	long kept = 0; // the last step whose point was kept
@@ -120,19 +158,13 @@ static plume_status pathline(const zk_vane *vane, double s0, double t0, double t
 			// An end a rounding error away from a kept step point replaces it
 			// instead of making a segment of zero length.
 			int at = (tail <= 1e-9 * h && kept == k && count > 1) ? count - 1 : count;
-			if (locus != NULL) {
-				locus[at] = reached ? target : next;
-				time[at] = reached ? tk + tail : t_stop;
-			}
+			keep_point(points, at, reached ? target : next, reached ? tk + tail : t_stop);
 			*end = (path_end){.steps = k, .tail = tail, .reached = reached, .count = at + 1};
 			return PLUME_OK;
 		}
 		s = next;
 		if ((k + 1) % vane->f == 0) {
-			if (locus != NULL) {
-				locus[count] = s;
-				time[count] = t0 + (double)(k + 1) * h;
-			}
+			keep_point(points, count, s, t0 + (double)(k + 1) * h);
 			++count;
 			kept = k + 1;
 		}
@@ -203,6 +235,7 @@ static void emit(zk_vane *vane, emitter *em, double *t0, double *s0)
 typedef struct emission {
 	double t0, s0, mature_time;
 	path_end end;
+	int point_first; ///< its pathline's points in the vane's kept points, or -1 when not kept
 } emission;
 
 typedef struct vane_run {
@@ -212,6 +245,10 @@ typedef struct vane_run {
 	int count, capacity;
 	bool have_cache; ///< the pathline from I_P, integrated once
 	path_end cache;
+	/// The points of every pathline integrated to its end: the barbs that mature copy them instead of
+	/// integrating their pathline a second time.
+	path_points kept;
+	int kept_count;
 } vane_run;
 
 static plume_status add_emission(vane_run *run)
@@ -222,12 +259,21 @@ static plume_status add_emission(vane_run *run)
 		return PLUME_ERROR_MEMORY;
 	emission *e = run->list + run->count;
 	emit(&run->vane, &run->em, &e->t0, &e->s0);
+	e->point_first = -1;
 	if (e->s0 == run->vane.s_posterior && run->have_cache) {
 		e->end = run->cache;
 	} else {
-		plume_status status = pathline(&run->vane, e->s0, e->t0, INFINITY, NULL, NULL, &e->end);
+		run->kept.first = run->kept_count;
+		run->kept.full = false;
+		plume_status status = pathline(&run->vane, e->s0, e->t0, INFINITY, &run->kept, &e->end);
 		if (status != PLUME_OK)
 			return status;
+		if (run->kept.out_of_memory)
+			return PLUME_ERROR_MEMORY;
+		if (!run->kept.full) {
+			e->point_first = run->kept_count;
+			run->kept_count += e->end.count;
+		}
 		if (e->s0 == run->vane.s_posterior) {
 			run->cache = e->end;
 			run->have_cache = true;
@@ -260,6 +306,14 @@ static void vane_setup(vane_run *run, const plume_zk_def *def, const zk_collar *
 	};
 	run->em.s = run->vane.s_anterior;
 	run->em.clamp_time = INFINITY;
+	run->kept.grows = true;
+}
+
+static void vane_free(vane_run *run)
+{
+	plume_free(run->list);
+	plume_free(run->kept.locus);
+	plume_free(run->kept.time);
 }
 
 void zk_growth_free(zk_growth *growth)
@@ -353,7 +407,7 @@ plume_status zk_grow(const plume_zk_def *def, const zk_collar *collar, uint64_t 
 			if (!mature && final)
 				continue; // IV-A Termination: developing barbs are discarded
 			path_end end = e->end;
-			if (!mature && (status = pathline(&run->vane, e->s0, e->t0, t_curr, NULL, NULL, &end)) != PLUME_OK)
+			if (!mature && (status = pathline(&run->vane, e->s0, e->t0, t_curr, NULL, &end)) != PLUME_OK)
 				goto fail;
 			zk_barb *barb = growth->barbs + growth->barb_count++;
 			*barb = (zk_barb){
@@ -396,19 +450,26 @@ plume_status zk_grow(const plume_zk_def *def, const zk_collar *collar, uint64_t 
 			time[barb->count - 1] = barb->mature_time;
 			continue;
 		}
-		path_end end;
-		double stop = barb->mature ? INFINITY : t_curr;
-		if ((status = pathline(&run->vane, barb->emit_locus, barb->emit_time, stop, locus, time, &end)) != PLUME_OK)
-			goto fail;
+		const emission *e = run->list + barb->index;
+		if (barb->mature && e->point_first >= 0) { // the same pathline as add_emission's: the same points
+			memcpy(locus, run->kept.locus + e->point_first, (size_t)barb->count * sizeof *locus);
+			memcpy(time, run->kept.time + e->point_first, (size_t)barb->count * sizeof *time);
+		} else {
+			path_end end;
+			path_points points = {.locus = locus, .time = time};
+			double stop = barb->mature ? INFINITY : t_curr;
+			if ((status = pathline(&run->vane, barb->emit_locus, barb->emit_time, stop, &points, &end)) != PLUME_OK)
+				goto fail;
+		}
 		if (barb->mature && barb->emit_locus == run->vane.s_posterior)
 			cached[barb->side] = b;
 	}
 	for (int side = 0; side < 2; ++side)
-		plume_free(runs[side].list);
+		vane_free(runs + side);
 	return PLUME_OK;
 fail:
 	for (int side = 0; side < 2; ++side)
-		plume_free(runs[side].list);
+		vane_free(runs + side);
 	zk_growth_free(growth);
 	return fail_runaway(status, err);
 }

@@ -35,8 +35,8 @@ plume_status zk_collar_init(zk_collar *collar, const plume_zk_def *def);
 void zk_collar_free(zk_collar *collar);
 /// C(s), s taken modulo 1.
 plume_vec3 zk_collar_point(const zk_collar *collar, double s);
-/// dC/ds / |dC/ds|: the unit direction of increasing s.
-plume_vec3 zk_collar_tangent(const zk_collar *collar, double s);
+/// C(s) and dC/ds / |dC/ds|, the unit direction of increasing s (one lookup for both).
+void zk_collar_frame(const zk_collar *collar, double s, plume_vec3 *point, plume_vec3 *tangent);
 
 /// One barb after the helical growth stage: its downsampled pathline, tip
 /// (emission point) first, as loci and times.

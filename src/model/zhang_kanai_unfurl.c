@@ -123,11 +123,13 @@ plume_status zk_unfurl(const plume_zk_def *def, const zk_collar *collar, const z
 			// Growth stored the tip first; forward kinematics wants the root first.
 			int from = barb->first + barb->count - 1 - j, to = barb->first + j;
 			double s = growth->locus[from];
-			plume_vec3 c = plume_v3_sub(zk_collar_point(collar, s), shape->origin);
+			plume_vec3 on_collar, tangent;
+			zk_collar_frame(collar, s, &on_collar, &tangent);
+			plume_vec3 c = plume_v3_sub(on_collar, shape->origin);
 			c.y = def->growth_speed * (growth->t_curr - growth->time[from]); // eq. 5
 			shape->p[to] = c;
 			shape->locus[to] = s;
-			plume_vec3 t = plume_v3_scale(zk_collar_tangent(collar, s), dir);                   // eq. 6
+			plume_vec3 t = plume_v3_scale(tangent, dir);                                        // eq. 6
 			shape->frame[to] = (zk_frame){.t = t, .n = {t.z, 0.0, -t.x}, .b = {0.0, 1.0, 0.0}}; // eq. 7-8
 		}
 		double w = barb_weight(def, shape->p[barb->first].y);
