@@ -142,7 +142,7 @@ typedef struct plume_lab_material {
 	plume_lab_model model;
 	/// Macroscale moduli, Pa, > 0. Defaults: thesis Table 5.2, E_vv = 3.60e8, E_ww = 4.80e4,
 	/// E_vw = E_ww = 4.80e4 (the locking and conditioning studies use it; the calibrated value,
-	/// 1.02e4 with the barb constraint, is in docs/lab.md).
+	/// 1.99e4 Pa with the barb constraint under the calibration protocol, is in docs/lab.md).
 	double E_vv;
 	double E_ww;
 	double E_vw;
