@@ -16,9 +16,13 @@ static void calibrations(void)
 {
 	static const double phis[3] = {0.12, 0.14, 0.16}, E_b[3] = {4.04e4, 3.92e4, 3.79e4},
 	                    E_B[3] = {2.8e9, 2.57e9, 2.25e9};
-	printf("calibration (thesis Table 5.1 -> Table 5.2), default meshes, barb constraint on:\n");
-	printf("%6s %12s %12s %12s %10s %8s %8s\n", "Phi_B", "E_vv [Pa]", "E_ww [Pa]", "E_vw [Pa]", "seconds", "tests",
-	       "solves");
+	plume_calibration_def protocol = plume_calibration_default_def();
+	printf("calibration (thesis Table 5.1 -> Table 5.2), protocol \"%s\" (tilted eps_max %g, kappa %g Pa, "
+	       "barb constraint %s), moduli +- total spread (Pa):\n",
+	       plume_calibration_protocol_name(&protocol), protocol.tilted_strain_max,
+	       protocol.mesoscale.compression_coefficient, protocol.barb_constraint ? "on" : "off");
+	printf("%6s %22s %20s %20s %9s %9s %9s %9s %7s %7s\n", "Phi_B", "E_vv", "E_ww", "E_vw", "vw phase", "vw width",
+	       "vw mesh", "sensitiv", "seconds", "solves");
 	for (int k = 0; k < 3; ++k) {
 		plume_calibration_def def = plume_calibration_default_def();
 		def.mesoscale.bands.barb_fraction = phis[k];
@@ -28,8 +32,9 @@ static void calibrations(void)
 		plume_error err = {0};
 		double t0 = bench_now();
 		bench_check("bench_lab", plume_lab_calibrate(&def, &r, &err), &err);
-		printf("%6.2f %12.5g %12.5g %12.5g %10.2f %8d %8d\n", phis[k], r.E_vv, r.E_ww, r.E_vw, bench_now() - t0,
-		       r.traction_count, r.solve_count);
+		printf("%6.2f %12.5g +- %-7.2g %10.5g +- %-7.2g %10.5g +- %-7.2g %9.3g %9.3g %9.3g %9.4f %7.1f %7d\n", phis[k],
+		       r.E_vv, r.spread_vv.total, r.E_ww, r.spread_ww.total, r.E_vw, r.spread_vw.total, r.spread_vw.phase,
+		       r.spread_vw.width, r.spread_vw.mesh, r.sensitivity, bench_now() - t0, r.solve_count);
 		fflush(stdout);
 	}
 }

@@ -26,8 +26,9 @@ void cli_help_lab(void)
 	     "  stress, displacement, Newton iterations, convergence), DIR/traction.json (the\n"
 	     "  slope) and the stress-strain plot DIR/traction.png and DIR/traction.svg.\n"
 	     "\n"
-	     "calibrate: prints JSON with E_vv, E_ww, E_vw (Pa), the slopes it matched and\n"
-	     "  the number of solves.\n"
+	     "calibrate: prints JSON with E_vv, E_ww, E_vw (Pa), the spread of each (band phase,\n"
+	     "  sample width, mesh), the sensitivity of the tilted slope to E_vw, the slopes it\n"
+	     "  matched, the protocol and the number of solves (docs/lab.md).\n"
 	     "  --phi PHI              barb fraction Phi_B, in (0, 1) (required)\n"
 	     "  --Eb PA                barbule modulus E_b, Pa (required)\n"
 	     "  --EB PA                barb modulus E_B, Pa (required)\n"
@@ -37,7 +38,12 @@ void cli_help_lab(void)
 	     "  --elements N           mesoscale tilted mesh size (default 4000)\n"
 	     "  --phases K             band phases the tilted slope is averaged over (default 4)\n"
 	     "  --macro-elements N     macroscale tilted mesh size (default 2000)\n"
-	     "  --unconstrained        fit E_vw without the barb constraint\n"
+	     "  --unconstrained        fit E_vw without the barb constraint (on quadratic triangles)\n"
+	     "  --tilted-strain EPS    eps_max of the tilted test, the fit of E_vw (default 0.1)\n"
+	     "  --compression KAPPA    Kikuuwe's coefficient in both lab models, Pa (default 0:\n"
+	     "                         the thesis's chapter-5 materials; the simulator's is 5.04e7)\n"
+	     "  --linear-macro         unconstrained fit on the simulator's linear triangles\n"
+	     "  --no-uncertainty       skip the spreads and the sensitivity (eleven traction tests)\n"
 	     "  -o DIR                 also write DIR/calibration.json (the printed JSON),\n"
 	     "                         DIR/slopes.csv (each matched slope, Pa), DIR/curves.csv\n"
 	     "                         (the stress-strain curves matched) and their plots\n"
@@ -183,12 +189,26 @@ static int run_traction(int argc, char **argv)
 // ---------------------------------------------------------------------------
 // calibrate
 
-/// The calibration's JSON: moduli, the slopes matched, the inputs and the counts.
+static void print_spread(FILE *out, const char *name, const plume_modulus_spread *p, bool last)
+{
+	fprintf(out, "    \"%s\": {\"phase\": %.4g, \"width\": %.4g, \"mesh\": %.4g, \"total\": %.4g}%s\n", name, p->phase,
+	        p->width, p->mesh, p->total, last ? "" : ",");
+}
+
+/// The calibration's JSON: moduli with their spreads, the slopes matched, the protocol that
+/// produced them (docs/lab.md) and the counts.
 static void print_calibration(FILE *out, const plume_calibration_def *d, const plume_calibration_result *result)
 {
 	const plume_calibration_def def = *d;
 	const plume_calibration_result r = *result;
 	fprintf(out, "{\n  \"E_vv\": %.6g,\n  \"E_ww\": %.6g,\n  \"E_vw\": %.6g,\n", r.E_vv, r.E_ww, r.E_vw);
+	if (def.uncertainty) {
+		fprintf(out, "  \"spread\": {\n");
+		print_spread(out, "E_vv", &r.spread_vv, false);
+		print_spread(out, "E_ww", &r.spread_ww, false);
+		print_spread(out, "E_vw", &r.spread_vw, true);
+		fprintf(out, "  },\n  \"sensitivity\": %.4g,\n", r.sensitivity);
+	}
 	fprintf(out,
 	        "  \"slopes\": {\"longitudinal\": %.8g, \"transverse\": %.8g, \"tilted_mesoscale\": %.8g, "
 	        "\"tilted_macroscale\": %.8g},\n",
@@ -198,6 +218,17 @@ static void print_calibration(FILE *out, const plume_calibration_def *d, const p
 	        "  \"phases\": %d,\n",
 	        def.mesoscale.bands.barb_fraction, def.mesoscale.E_b, def.mesoscale.E_B, def.aspect_ratio,
 	        def.mesoscale.bands.period, def.phase_count);
+	bool quadratic = !def.barb_constraint && def.macroscale_quadratic;
+	fprintf(out,
+	        "  \"protocol\": {\"name\": \"%s\", \"longitudinal_strain_max\": %.6g, \"transverse_strain_max\": %.6g, "
+	        "\"tilted_strain_max\": %.6g, \"steps\": %d, \"compression_coefficient\": %.6g, \"barb_constraint\": %s, "
+	        "\"macroscale_elements\": \"%s\", \"macroscale_element_count\": %d, \"mesoscale_element_count\": %d, "
+	        "\"width\": %.6g, \"barbs_across\": %.6g, \"aspect\": %.6g, \"phases\": %d},\n",
+	        plume_calibration_protocol_name(&def), def.longitudinal_strain_max, def.transverse_strain_max,
+	        def.tilted_strain_max, def.steps, def.mesoscale.compression_coefficient,
+	        def.barb_constraint ? "true" : "false", quadratic ? "quadratic" : "linear", def.macroscale_elements,
+	        def.sample.element_count, def.sample.width, def.sample.width / def.mesoscale.bands.period, def.aspect_ratio,
+	        def.phase_count);
 	fprintf(
 	    out,
 	    "  \"barb_constraint\": %s,\n  \"traction_tests\": %d,\n  \"solves\": %d,\n  \"bisection_iterations\": %d\n}\n",
@@ -307,6 +338,10 @@ static int run_calibrate(int argc, char **argv)
 	    {"macro-elements", required_argument, NULL, 'm'},
 	    {"phases", required_argument, NULL, 'k'},
 	    {"unconstrained", no_argument, NULL, 'u'},
+	    {"tilted-strain", required_argument, NULL, 't'},
+	    {"compression", required_argument, NULL, 'c'},
+	    {"linear-macro", no_argument, NULL, 'l'},
+	    {"no-uncertainty", no_argument, NULL, 'n'},
 	    {"output", required_argument, NULL, 'o'},
 	    {"help", no_argument, NULL, 'h'},
 	    {NULL, 0, NULL, 0},
@@ -339,6 +374,10 @@ static int run_calibrate(int argc, char **argv)
 		case 'm': ok = parse_int("--macro-elements", optarg, &def.macroscale_elements); break;
 		case 'k': ok = parse_int("--phases", optarg, &def.phase_count); break;
 		case 'u': def.barb_constraint = false; break;
+		case 't': ok = parse_double("--tilted-strain", optarg, &def.tilted_strain_max); break;
+		case 'c': ok = parse_double("--compression", optarg, &def.mesoscale.compression_coefficient); break;
+		case 'l': def.macroscale_quadratic = false; break;
+		case 'n': def.uncertainty = false; break;
 		case 'o': output_dir = optarg; break;
 		case 'h': cli_help_lab(); return CLI_EXIT_OK;
 		case ':': return cli_usage_error("lab", "option '%s' needs a value", argv[optind - 1]);

@@ -146,12 +146,18 @@ typedef struct plume_lab_material {
 	plume_lab_model model;
 	/// Macroscale moduli, Pa, > 0. Defaults: thesis Table 5.2, E_vv = 3.60e8, E_ww = 4.80e4,
 	/// E_vw = E_ww = 4.80e4 (the locking and conditioning studies use it; the calibrated value,
-	/// 1.02e4 with the barb constraint, is in docs/lab.md).
+	/// 1.99e4 Pa with the barb constraint under the calibration protocol, is in docs/lab.md).
 	double E_vv;
 	double E_ww;
 	double E_vw;
 	/// Inextensible barbs (paper section 6): needs an aligned mesh. Default false.
 	bool barb_constraint;
+	/// Macroscale model only: solve it on quadratic (six-node) triangles instead of the
+	/// simulator's linear ones. Without the barb constraint the tilted test on linear
+	/// triangles converges slowly and unevenly (E_vv / E_ww = 7500); quadratic ones converge
+	/// to 0.5 % at a few hundred elements (docs/lab.md). Not with barb_constraint. The
+	/// mesoscale model is always quadratic. Default false (the simulator's elements).
+	bool quadratic;
 	/// Mesoscale moduli, Pa, > 0. Defaults: thesis Table 5.1 at Phi_B = 0.14, E_B = 2.57e9, E_b = 3.92e4.
 	double E_B;
 	double E_b;
@@ -251,21 +257,35 @@ plume_status plume_lab_spec_load(const char *path, plume_lab_spec *spec, plume_e
 // ---------------------------------------------------------------------------
 // Calibration (thesis 5.2-5.3)
 
+/// The calibration's protocol (docs/lab.md, "The protocol"): what is fitted where. The
+/// defaults are the protocol docs/lab.md justifies with measurements; a result says whether
+/// it followed them (plume_calibration_protocol_name).
 typedef struct plume_calibration_def {
-	/// The mesoscale model: E_B, E_b, Phi_B and the band period.
+	/// The mesoscale model: E_B, E_b, Phi_B and the band period. Its compression_coefficient
+	/// (Kikuuwe's kappa) applies to both lab models. Default: Table 5.1 at Phi_B = 0.14 with
+	/// kappa = 0, the thesis's chapter-5 materials (the term is chapter 6's, for whole
+	/// feathers; plume_lab_material_default gives the simulator's kappa instead).
 	plume_lab_material mesoscale;
-	/// Sample of the tilted test: width and thickness; the height is aspect_ratio * width.
+	/// Sample of the tilted test: width (default 4e-3 m, N = W / T = 10 barbs), thickness and
+	/// element_count (mesoscale mesh, default 4000); the height is aspect_ratio * width.
 	plume_sample_def sample;
 	/// a = H / W of the tilted test, > 0. Default 1.3 (thesis 5.3).
 	double aspect_ratio;
-	/// eps_max of the longitudinal test. Default 0.01 (thesis 3.2).
+	/// eps_max of the longitudinal test (E_vv). Default 0.01 (thesis 3.2).
 	double longitudinal_strain_max;
-	/// eps_max of the transverse and tilted tests. Default 0.4 (thesis 3.2).
+	/// eps_max of the transverse test (E_ww). Default 0.4 (thesis 3.2; eq. 5.5 and Table 5.2).
 	double transverse_strain_max;
+	/// eps_max of the tilted test, the fit of E_vw, in (0, 10]. Default 0.1: the chapter-5
+	/// model has no solution past eps ~ 0.2 (barbule cells collapse), and at 0.1 the tilted
+	/// slope responds to E_vw with a relative sensitivity of about 0.8 (0.3 at 0.4).
+	double tilted_strain_max;
 	/// Load steps of every test. Default 10.
 	int steps;
 	/// Fit E_vw with the barb constraint (the simulator's vane model). Default true.
 	bool barb_constraint;
+	/// Without the barb constraint, solve the macroscale tilted test on quadratic triangles
+	/// (converged, docs/lab.md) instead of the simulator's linear ones. Default true.
+	bool macroscale_quadratic;
 	/// Relative width of the final bisection bracket on E_vw. Default 1e-4.
 	double tolerance;
 	/// Target number of triangles of the macroscale tilted sample. Default 2000.
@@ -273,6 +293,9 @@ typedef struct plume_calibration_def {
 	/// Band phases (k / phase_count, k = 0 .. phase_count - 1) the mesoscale tilted slope is
 	/// averaged over, [1, 64]. Default 4.
 	int phase_count;
+	/// Estimate each modulus's spread (band phase, sample width, mesh resolution) and the
+	/// sensitivity of the tilted slope to E_vw: eight more traction tests. Default true.
+	bool uncertainty;
 	/// Called after each traction test (a mesoscale mean counts one per phase); total is an
 	/// estimate while E_vw is searched. Default NULL (none).
 	plume_progress_fn *progress;
@@ -286,6 +309,26 @@ typedef struct plume_calibration_def {
 
 plume_calibration_def plume_calibration_default_def(void);
 
+/// "chapter-5" when def's protocol fields (strain ranges, kappa, barb constraint, element
+/// kind, sample width and period, aspect ratio, phases, meshes) are the defaults, else "custom".
+const char *plume_calibration_protocol_name(const plume_calibration_def *def);
+
+/// How far a calibrated modulus moves with the choices a calibration has to make, Pa, each
+/// >= 0 (docs/lab.md, "Uncertainty"). E_vw's are first order: the mesoscale tilted slope's
+/// change carried to E_vw through the sensitivity of the macroscale slope.
+typedef struct plume_modulus_spread {
+	/// Half the range over the band phases (the tilted test: the calibration's phase_count
+	/// phases; the straight ones: phases 0 and 1/2).
+	double phase;
+	/// Change when the sample is twice as wide and high (twice the barbs across, same aspect
+	/// ratio, twice the elements; band phase 0 against band phase 0).
+	double width;
+	/// Change when the meshes are twice as fine (both models; band phase 0).
+	double mesh;
+	/// sqrt(phase^2 + width^2 + mesh^2).
+	double total;
+} plume_modulus_spread;
+
 typedef struct plume_calibration_result {
 	/// Macroscale moduli, Pa.
 	double E_vv;
@@ -297,6 +340,12 @@ typedef struct plume_calibration_result {
 	double slope_tilted;
 	/// Slope of the macroscale model with the fitted E_vw on the tilted test, Pa.
 	double slope_tilted_macroscale;
+	/// With def->uncertainty: the spreads, and d ln(slope) / d ln(E_vw) of the macroscale
+	/// tilted test at the fitted E_vw (central difference over E_vw +- 5 %). Zero otherwise.
+	plume_modulus_spread spread_vv;
+	plume_modulus_spread spread_ww;
+	plume_modulus_spread spread_vw;
+	double sensitivity;
 	/// Traction tests run (mesoscale and macroscale) and static solves in all.
 	int traction_count;
 	int solve_count;

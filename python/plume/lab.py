@@ -58,13 +58,18 @@ def calibrate(*, barb_fraction: Optional[float] = None, E_B: Optional[float] = N
               aspect_ratio: Optional[float] = None, steps: Optional[int] = None,
               barb_constraint: Optional[bool] = None, tolerance: Optional[float] = None,
               macroscale_elements: Optional[int] = None, phase_count: Optional[int] = None,
-              element_count: Optional[int] = None) -> dict:
+              element_count: Optional[int] = None, tilted_strain_max: Optional[float] = None,
+              compression_coefficient: Optional[float] = None, macroscale_quadratic: Optional[bool] = None,
+              uncertainty: Optional[bool] = None) -> dict:
     """Calibrates the macroscale moduli E_vv, E_ww, E_vw (Pa) from the mesoscale model (thesis 5.2-5.3).
 
     Keywords override plume_calibration_default_def(): barb_fraction is Phi_B, E_B and E_b the
     barb and barbule moduli (Pa), period the band period T (m), width/thickness the tilted sample's
-    (m), element_count the mesoscale sample's target triangles. Returns the result's fields and
-    "curves": the four stress-strain curves matched, name -> (strain, stress Pa) arrays."""
+    (m), element_count the mesoscale sample's target triangles, compression_coefficient Kikuuwe's
+    kappa in both lab models (Pa, default 0: the protocol of docs/lab.md). Returns the result's
+    fields, "protocol" (plume_calibration_protocol_name), "spread" (E_vv, E_ww, E_vw -> phase,
+    width, mesh, total in Pa) and "curves": the four stress-strain curves matched, name ->
+    (strain, stress Pa) arrays."""
     d = ffi.new("plume_calibration_def *", lib.plume_calibration_default_def())
     if barb_fraction is not None:
         d.mesoscale.bands.barb_fraction = barb_fraction
@@ -80,9 +85,12 @@ def calibrate(*, barb_fraction: Optional[float] = None, E_B: Optional[float] = N
         d.sample.thickness = thickness
     if element_count is not None:
         d.sample.element_count = element_count
+    if compression_coefficient is not None:
+        d.mesoscale.compression_coefficient = compression_coefficient
     for name, value in (("aspect_ratio", aspect_ratio), ("steps", steps), ("barb_constraint", barb_constraint),
                         ("tolerance", tolerance), ("macroscale_elements", macroscale_elements),
-                        ("phase_count", phase_count)):
+                        ("phase_count", phase_count), ("tilted_strain_max", tilted_strain_max),
+                        ("macroscale_quadratic", macroscale_quadratic), ("uncertainty", uncertainty)):
         if value is not None:
             setattr(d, name, value)
     d.keep_curves = True
@@ -91,7 +99,10 @@ def calibrate(*, barb_fraction: Optional[float] = None, E_B: Optional[float] = N
     check(lib.plume_lab_calibrate(d, r, err), err)
     result = {name: getattr(r, name) for name in (
         "E_vv", "E_ww", "E_vw", "slope_longitudinal", "slope_transverse", "slope_tilted",
-        "slope_tilted_macroscale", "traction_count", "solve_count", "bisection_iterations")}
+        "slope_tilted_macroscale", "sensitivity", "traction_count", "solve_count", "bisection_iterations")}
+    result["protocol"] = ffi.string(lib.plume_calibration_protocol_name(d)).decode()
+    result["spread"] = {name: {k: getattr(getattr(r, field), k) for k in ("phase", "width", "mesh", "total")}
+                        for name, field in (("E_vv", "spread_vv"), ("E_ww", "spread_ww"), ("E_vw", "spread_vw"))}
     # The stress-strain curves matched (plume lab calibrate -o's curves.csv), copied out of the
     # result before it is freed: name -> (strain, stress in Pa).
     n = r.curve_samples

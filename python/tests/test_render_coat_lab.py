@@ -78,6 +78,12 @@ def test_calibrate_is_the_cli_calibration(cli, tmp_path):
         assert f"{result[key]:.6g}" == f"{expected[key]:.6g}", key
     assert result["slope_tilted"] == pytest.approx(expected["slopes"]["tilted_mesoscale"], rel=1e-7)
     assert result["solve_count"] == expected["solves"]
+    assert result["protocol"] == expected["protocol"]["name"] == "custom"
+    for key in ("E_vv", "E_ww", "E_vw"):
+        for part in ("phase", "width", "mesh", "total"):
+            assert result["spread"][key][part] >= 0
+            assert f"{result['spread'][key][part]:.4g}" == f"{expected['spread'][key][part]:.4g}", (key, part)
+    assert result["sensitivity"] == pytest.approx(expected["sensitivity"], rel=1e-3)
     # The curves are the CLI's curves.csv, column by column (written with %.17g).
     table = np.loadtxt(tmp_path / "cal" / "curves.csv", delimiter=",", skiprows=1)
     for c, name in enumerate(("longitudinal", "transverse", "tilted_mesoscale", "tilted_macroscale")):

@@ -12,11 +12,12 @@ static const char *const top_keys[] = {"sample", "material", "traction", "descri
 static const char *const sample_keys[] = {"width", "height",   "thickness", "barb_angle_deg",
                                           "mesh",  "elements", "seed",      NULL};
 static const char *const material_keys[] = {
-    "model", "E_vv",          "E_ww",        "E_vw",           "barb_constraint",   "E_B",
-    "E_b",   "barb_fraction", "band_period", "barb_divisions", "barbule_divisions", "compression_coefficient", "band_phase", NULL};
+    "model",      "E_vv",          "E_ww",        "E_vw",           "barb_constraint",   "E_B",
+    "E_b",        "barb_fraction", "band_period", "barb_divisions", "barbule_divisions", "compression_coefficient",
+    "band_phase", "elements",      NULL};
 static const char *const traction_keys[] = {
-    "strain_max",          "steps",           "tolerance", "max_iterations", "max_substep_halvings",
-    "require_convergence", "accept_residual", "compression", NULL};
+    "strain_max",      "steps",       "tolerance", "max_iterations", "max_substep_halvings", "require_convergence",
+    "accept_residual", "compression", NULL};
 
 static void read_sample(plume_spec_reader *reader, const json_t *object, plume_sample_def *sample)
 {
@@ -68,6 +69,13 @@ static void read_material(plume_spec_reader *reader, const json_t *object, plume
 	plume_spec_int(reader, object, "$.material", "barb_divisions", &material->bands.barb_divisions);
 	plume_spec_int(reader, object, "$.material", "barbule_divisions", &material->bands.barbule_divisions);
 	plume_spec_number(reader, object, "$.material", "compression_coefficient", &material->compression_coefficient);
+	const char *elements = NULL;
+	if (plume_spec_string(reader, object, "$.material", "elements", &elements)) {
+		if (strcmp(elements, "linear") == 0 || strcmp(elements, "quadratic") == 0)
+			material->quadratic = strcmp(elements, "quadratic") == 0;
+		else
+			plume_spec_fail(reader, "$.material.elements", "is \"%s\", allowed \"linear\" or \"quadratic\"", elements);
+	}
 }
 
 static void read_traction(plume_spec_reader *reader, const json_t *object, plume_traction_def *traction)

@@ -22,6 +22,8 @@ plume_calibration_def plume_calibration_default_def(void)
 	plume_calibration_def def;
 	memset(&def, 0, sizeof def);
 	def.mesoscale = plume_lab_material_default(PLUME_LAB_MESOSCALE);
+	// The thesis's chapter-5 materials: St-Venant-Kirchhoff bands without Kikuuwe's term.
+	def.mesoscale.compression_coefficient = 0.0;
 	def.sample = plume_sample_default_def();
 	// A 4 mm wide tilted sample (thesis Table 3.1c: 3 to 16 mm) holds 10 barb periods of
 	// 0.4 mm: small enough for the mesoscale model to be solved in seconds.
@@ -30,13 +32,30 @@ plume_calibration_def plume_calibration_default_def(void)
 	def.aspect_ratio = 1.3;
 	def.longitudinal_strain_max = 0.01;
 	def.transverse_strain_max = 0.4;
+	def.tilted_strain_max = 0.1;
 	def.steps = 10;
 	def.barb_constraint = true;
+	def.macroscale_quadratic = true;
 	def.tolerance = 1e-4;
 	def.macroscale_elements = 2000;
 	def.phase_count = 4;
+	def.uncertainty = true;
 	def.cookie = PLUME_DEF_COOKIE;
 	return def;
+}
+
+const char *plume_calibration_protocol_name(const plume_calibration_def *def)
+{
+	plume_calibration_def d = plume_calibration_default_def();
+	bool same = def->mesoscale.compression_coefficient == d.mesoscale.compression_coefficient &&
+	            def->mesoscale.bands.period == d.mesoscale.bands.period && def->sample.width == d.sample.width &&
+	            def->sample.element_count == d.sample.element_count && def->aspect_ratio == d.aspect_ratio &&
+	            def->longitudinal_strain_max == d.longitudinal_strain_max &&
+	            def->transverse_strain_max == d.transverse_strain_max &&
+	            def->tilted_strain_max == d.tilted_strain_max && def->steps == d.steps &&
+	            def->barb_constraint == d.barb_constraint && def->macroscale_quadratic == d.macroscale_quadratic &&
+	            def->macroscale_elements == d.macroscale_elements && def->phase_count == d.phase_count;
+	return same ? "chapter-5" : "custom";
 }
 
 static plume_status check(const plume_calibration_def *def, plume_error *err)
@@ -56,10 +75,12 @@ static plume_status check(const plume_calibration_def *def, plume_error *err)
 		return plume_error_set(err, PLUME_ERROR_SPEC,
 		                       "band period %g m is larger than the %g x %g m sample: it holds no whole barb",
 		                       def->mesoscale.bands.period, s->width, height);
-	if (!(def->longitudinal_strain_max > 0.0) || !(def->transverse_strain_max > 0.0))
+	if (!(def->longitudinal_strain_max > 0.0 && def->longitudinal_strain_max <= 10.0) ||
+	    !(def->transverse_strain_max > 0.0 && def->transverse_strain_max <= 10.0) ||
+	    !(def->tilted_strain_max > 0.0 && def->tilted_strain_max <= 10.0))
 		return plume_error_set(err, PLUME_ERROR_SPEC,
-		                       "strain_max is %g (longitudinal) and %g (transverse), allowed > 0",
-		                       def->longitudinal_strain_max, def->transverse_strain_max);
+		                       "strain_max is %g (longitudinal), %g (transverse) and %g (tilted), allowed in (0, 10]",
+		                       def->longitudinal_strain_max, def->transverse_strain_max, def->tilted_strain_max);
 	if (def->steps < 2)
 		return plume_error_set(err, PLUME_ERROR_SPEC, "steps is %d, allowed >= 2", def->steps);
 	if (!(def->tolerance > 0.0 && def->tolerance < 1.0))
@@ -78,8 +99,8 @@ static plume_status check(const plume_calibration_def *def, plume_error *err)
 // and returns its slope; keeps its curve as result's curve (0..3) when the result holds curves
 // and curve >= 0.
 static plume_status slope_of(const plume_lab_material *material, const plume_sample_def *sample, double strain_max,
-                             int steps, int phase_count, plume_calibration_result *result, double *slope, int curve,
-                             plume_lab_progress *progress, plume_error *err)
+                             int steps, int phase_count, plume_calibration_result *result, double *slope,
+                             double *phase_slopes, int curve, plume_lab_progress *progress, plume_error *err)
 {
 	plume_traction_def traction = plume_traction_default_def();
 	traction.strain_max = strain_max;
@@ -94,7 +115,7 @@ static plume_status slope_of(const plume_lab_material *material, const plume_sam
 	traction.accept_residual = 1e-3;
 	int solves = 0;
 	bool keep = curve >= 0 && result->curve_samples > 0;
-	plume_status status = lab_mean_curve(material, sample, &traction, phase_count, slope, &solves,
+	plume_status status = lab_mean_curve(material, sample, &traction, phase_count, slope, phase_slopes, &solves,
 	                                     keep ? result->curve_strain[curve] : NULL,
 	                                     keep ? result->curve_stress[curve] : NULL, progress, err);
 	if (status != PLUME_OK) {
@@ -139,6 +160,104 @@ void plume_calibration_result_free(plume_calibration_result *result)
 	result->curve_samples = 0;
 }
 
+// Half the range of count values.
+static double half_range(const double *values, int count)
+{
+	double lo = values[0], hi = values[0];
+	for (int k = 1; k < count; ++k)
+		lo = fmin(lo, values[k]), hi = fmax(hi, values[k]);
+	return 0.5 * (hi - lo);
+}
+
+static void finish_spread(plume_modulus_spread *spread)
+{
+	spread->total = sqrt(spread->phase * spread->phase + spread->width * spread->width + spread->mesh * spread->mesh);
+}
+
+// The spread of E_vv or E_ww: the straight test (of the given strain range and slope) at
+// band phase 1/2, on a sample twice as wide and high, and on a mesh twice as fine.
+static plume_status straight_spread(const plume_lab_material *meso, const plume_sample_def *straight, double strain_max,
+                                    double slope, int steps, plume_calibration_result *result,
+                                    plume_modulus_spread *spread, plume_lab_progress *progress, plume_error *err)
+{
+	plume_lab_material shifted = *meso;
+	shifted.bands.phase = 0.5;
+	double probe[2] = {slope, 0.0};
+	plume_status status =
+	    slope_of(&shifted, straight, strain_max, steps, 1, result, &probe[1], NULL, -1, progress, err);
+	spread->phase = half_range(probe, 2);
+	plume_sample_def wide = *straight;
+	wide.width *= 2.0, wide.height *= 2.0, wide.element_count *= 2;
+	double other = 0.0;
+	if (status == PLUME_OK)
+		status = slope_of(meso, &wide, strain_max, steps, 1, result, &other, NULL, -1, progress, err);
+	spread->width = fabs(other - slope);
+	plume_sample_def fine = *straight;
+	fine.element_count *= 2;
+	if (status == PLUME_OK)
+		status = slope_of(meso, &fine, strain_max, steps, 1, result, &other, NULL, -1, progress, err);
+	spread->mesh = fabs(other - slope);
+	finish_spread(spread);
+	return status;
+}
+
+// E_vw to first order when the mesoscale target changes by the factor ratio: the macroscale
+// slope goes as E_vw^sensitivity near the fit.
+static double moved_E_vw(double E_vw, double ratio, double sensitivity) { return E_vw * pow(ratio, 1.0 / sensitivity); }
+
+// The sensitivity of the macroscale tilted slope to E_vw at the fit, and E_vw's spread:
+// over the band phases (each phase's target), on a sample twice as wide and high (twice the
+// barbs, twice the elements) and on meshes twice as fine (both models), the last two at
+// band phase 0 against band phase 0. macro holds the fitted E_vw; tilted the macroscale mesh.
+static plume_status shear_spread(const plume_calibration_def *def, const plume_lab_material *meso,
+                                 plume_lab_material macro, const plume_sample_def *tilted, const double *phase_slopes,
+                                 plume_calibration_result *result, plume_lab_progress *progress, plume_error *err)
+{
+	double E_vw = macro.E_vw, up = 0.0, down = 0.0, strain_max = def->tilted_strain_max;
+	int steps = def->steps;
+	macro.E_vw = 1.05 * E_vw;
+	plume_status status = slope_of(&macro, tilted, strain_max, steps, 1, result, &up, NULL, -1, progress, err);
+	macro.E_vw = 0.95 * E_vw;
+	if (status == PLUME_OK)
+		status = slope_of(&macro, tilted, strain_max, steps, 1, result, &down, NULL, -1, progress, err);
+	macro.E_vw = E_vw;
+	if (status != PLUME_OK)
+		return status;
+	double S = log(up / down) / log(1.05 / 0.95);
+	result->sensitivity = S;
+	if (!(S > 0.0))
+		return plume_error_set(
+		    err, PLUME_ERROR_NUMERIC,
+		    "the macroscale tilted slope does not grow with E_vw at %g Pa (%g at +5 %%, %g at -5 %%)", E_vw, up, down);
+	double phase_E_vw[64] = {0.0};
+	for (int k = 0; k < def->phase_count; ++k)
+		phase_E_vw[k] = moved_E_vw(E_vw, phase_slopes[k] / result->slope_tilted, S);
+	result->spread_vw.phase = half_range(phase_E_vw, def->phase_count);
+
+	plume_lab_material phase0 = *meso;
+	phase0.bands.phase = 0.0;
+	double macro_fine = 0.0, meso_fine = 0.0, meso_wide = 0.0;
+	plume_sample_def fine = *tilted;
+	fine.element_count = 2 * def->macroscale_elements;
+	status = slope_of(&macro, &fine, strain_max, steps, 1, result, &macro_fine, NULL, -1, progress, err);
+	fine.element_count = 2 * def->sample.element_count;
+	if (status == PLUME_OK)
+		status = slope_of(&phase0, &fine, strain_max, steps, 1, result, &meso_fine, NULL, -1, progress, err);
+	plume_sample_def wide = *tilted;
+	wide.width *= 2.0, wide.height *= 2.0, wide.element_count = 2 * def->sample.element_count;
+	if (status == PLUME_OK)
+		status = slope_of(&phase0, &wide, strain_max, steps, 1, result, &meso_wide, NULL, -1, progress, err);
+	if (status != PLUME_OK)
+		return status;
+	double base = phase_slopes[0];
+	result->spread_vw.mesh =
+	    fabs(moved_E_vw(E_vw, (meso_fine / base) / (macro_fine / result->slope_tilted_macroscale), S) - E_vw);
+	// The macroscale model is homogeneous: its slope does not depend on the sample's size.
+	result->spread_vw.width = fabs(moved_E_vw(E_vw, meso_wide / base, S) - E_vw);
+	finish_spread(&result->spread_vw);
+	return PLUME_OK;
+}
+
 plume_status plume_lab_calibrate(const plume_calibration_def *def, plume_calibration_result *result, plume_error *err)
 {
 	PLUME_ASSERT_DEF(def);
@@ -172,20 +291,22 @@ plume_status plume_lab_calibrate(const plume_calibration_def *def, plume_calibra
 	straight.element_count = 200;
 	straight.barb_angle = 0.0;
 	status = slope_of(&meso, &straight, def->longitudinal_strain_max, def->steps, 1, result,
-	                  &result->slope_longitudinal, 0, &progress, err);
+	                  &result->slope_longitudinal, NULL, 0, &progress, err);
+	plume_sample_def straight_longitudinal = straight;
 	if (status == PLUME_OK) {
 		straight.barb_angle = 0.5 * PI;
 		status = slope_of(&meso, &straight, def->transverse_strain_max, def->steps, 1, result,
-		                  &result->slope_transverse, 1, &progress, err);
+		                  &result->slope_transverse, NULL, 1, &progress, err);
 	}
+	double phase_slopes[64] = {0.0};
 	plume_sample_def tilted = def->sample;
 	tilted.height = height;
 	tilted.barb_angle = 0.25 * PI;
 	// The tilted slope of a sample a few barbs wide depends on where the bands meet its
 	// corners: the target is its mean over band phases.
 	if (status == PLUME_OK)
-		status = slope_of(&meso, &tilted, def->transverse_strain_max, def->steps, def->phase_count, result,
-		                  &result->slope_tilted, 2, &progress, err);
+		status = slope_of(&meso, &tilted, def->tilted_strain_max, def->steps, def->phase_count, result,
+		                  &result->slope_tilted, phase_slopes, 2, &progress, err);
 	if (status != PLUME_OK) {
 		plume_error_prefix(err, "calibration");
 		plume_calibration_result_free(result);
@@ -196,6 +317,8 @@ plume_status plume_lab_calibrate(const plume_calibration_def *def, plume_calibra
 	macro.E_vv = result->slope_longitudinal;
 	macro.E_ww = result->slope_transverse;
 	macro.barb_constraint = def->barb_constraint;
+	macro.quadratic = !def->barb_constraint && def->macroscale_quadratic;
+	macro.compression_coefficient = meso.compression_coefficient;
 	tilted.element_count = def->macroscale_elements;
 	double target = result->slope_tilted;
 
@@ -215,7 +338,7 @@ plume_status plume_lab_calibrate(const plume_calibration_def *def, plume_calibra
 	double log_max = log(fmin(E_VW_RANGE_HIGH * macro.E_ww, macro.E_vv));
 	double lo = fmin(fmax(log(0.25 * macro.E_ww), log_min), log_max), hi = lo, f_lo = 0.0, f_hi = 0.0, slope = 0.0;
 	macro.E_vw = exp(lo);
-	status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, 1, result, &slope, -1,
+	status = slope_of(&macro, &tilted, def->tilted_strain_max, def->steps, 1, result, &slope, NULL, -1,
 	                  search_progress(&progress), err);
 	f_lo = f_hi = slope - target;
 	double step = log(2.0);
@@ -225,14 +348,14 @@ plume_status plume_lab_calibrate(const plume_calibration_def *def, plume_calibra
 			break; // the end of the range: the target is out of reach
 		double x = down ? fmax(lo - step, log_min) : fmin(hi + step, log_max);
 		macro.E_vw = exp(x);
-		status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, 1, result, &slope, -1,
+		status = slope_of(&macro, &tilted, def->tilted_strain_max, def->steps, 1, result, &slope, NULL, -1,
 		                  search_progress(&progress), err);
 		// Newton may fail on a very stiff trial: step out by half as far and try again.
 		for (int retry = 0; retry < 4 && status == PLUME_ERROR_NUMERIC; ++retry) {
 			step *= 0.5;
 			x = down ? fmax(lo - step, log_min) : fmin(hi + step, log_max);
 			macro.E_vw = exp(x);
-			status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, 1, result, &slope, -1,
+			status = slope_of(&macro, &tilted, def->tilted_strain_max, def->steps, 1, result, &slope, NULL, -1,
 			                  search_progress(&progress), err);
 		}
 		if (down) {
@@ -257,7 +380,7 @@ plume_status plume_lab_calibrate(const plume_calibration_def *def, plume_calibra
 			if (retry > 0)
 				far_x = 0.5 * (far_x + from);
 			macro.E_vw = exp(far_x);
-			far_status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, 1, result, &far_slope, -1,
+			far_status = slope_of(&macro, &tilted, def->tilted_strain_max, def->steps, 1, result, &far_slope, NULL, -1,
 			                      search_progress(&progress), err);
 		}
 		if (far_status == PLUME_ERROR_NUMERIC)
@@ -283,7 +406,7 @@ plume_status plume_lab_calibrate(const plume_calibration_def *def, plume_calibra
 		if (!(x > lo && x < hi))
 			x = 0.5 * (lo + hi);
 		macro.E_vw = exp(x);
-		status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, 1, result, &slope, -1,
+		status = slope_of(&macro, &tilted, def->tilted_strain_max, def->steps, 1, result, &slope, NULL, -1,
 		                  search_progress(&progress), err);
 		double f = slope - target;
 		result->bisection_iterations += 1;
@@ -306,7 +429,7 @@ plume_status plume_lab_calibrate(const plume_calibration_def *def, plume_calibra
 			// Slow progress: bisect once.
 			double mid = 0.5 * (lo + hi);
 			macro.E_vw = exp(mid);
-			status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, 1, result, &slope, -1,
+			status = slope_of(&macro, &tilted, def->tilted_strain_max, def->steps, 1, result, &slope, NULL, -1,
 			                  search_progress(&progress), err);
 			result->bisection_iterations += 1;
 			if ((slope - target > 0.0) == (f_hi > 0.0))
@@ -327,12 +450,27 @@ plume_status plume_lab_calibrate(const plume_calibration_def *def, plume_calibra
 		x = 0.5 * (lo + hi);
 	macro.E_vw = exp(x);
 	progress.total = progress.done + 1;
-	status = slope_of(&macro, &tilted, def->transverse_strain_max, def->steps, 1, result,
-	                  &result->slope_tilted_macroscale, 3, &progress, err);
+	status = slope_of(&macro, &tilted, def->tilted_strain_max, def->steps, 1, result, &result->slope_tilted_macroscale,
+	                  NULL, 3, &progress, err);
 	if (status != PLUME_OK) {
 		plume_error_prefix(err, "calibration");
 		plume_calibration_result_free(result);
 		return status;
+	}
+	if (def->uncertainty) {
+		progress.total = progress.done + 6 + 5;
+		status = straight_spread(&meso, &straight_longitudinal, def->longitudinal_strain_max,
+		                         result->slope_longitudinal, def->steps, result, &result->spread_vv, &progress, err);
+		if (status == PLUME_OK)
+			status = straight_spread(&meso, &straight, def->transverse_strain_max, result->slope_transverse, def->steps,
+			                         result, &result->spread_ww, &progress, err);
+		if (status == PLUME_OK)
+			status = shear_spread(def, &meso, macro, &tilted, phase_slopes, result, &progress, err);
+		if (status != PLUME_OK) {
+			plume_error_prefix(err, "calibration: uncertainty");
+			plume_calibration_result_free(result);
+			return status;
+		}
 	}
 	result->E_vv = macro.E_vv;
 	result->E_ww = macro.E_ww;

@@ -1,14 +1,18 @@
 // The mesoscale band model on quadratic (six-node) triangles: why, in quadratic.h.
 //
 // Per element the energy is the integral of the plane St-Venant-Kirchhoff density
-//   psi = (k / 2) (E11^2 + E22^2 + 2 E12^2),   k = thickness * Young's modulus,
-// (zero Poisson ratio, thesis 5.2), E = (F^T F - I) / 2 the Green strain. F is linear over
-// a quadratic element, psi of degree four: the six-point rule of degree four (Dunavant
-// 1985) integrates it exactly. With S = k E (the second Piola-Kirchhoff stress times
-// the thickness) and g_a the reference gradient of shape function a:
+//   psi = (1 / 2) e^T C e,   e = (E11, E22, 2 E12),
+// E = (F^T F - I) / 2 the Green strain and C the element's Voigt tensor times the
+// thickness: the mesoscale bands' isotropic one with zero Poisson ratio (thesis 5.2),
+// C = k diag(1, 1, 1/2), or the macroscale vane's orthotropic one rotated to the barbs
+// (thesis eq. 4.1, paper eq. 5), which the caller takes from sim/membrane.h so that both
+// solvers hold the same material. F is linear over a quadratic element, psi of degree
+// four: the six-point rule of degree four (Dunavant 1985) integrates it exactly. With
+// s = C e (the second Piola-Kirchhoff stress times the thickness, S = [[s0, s2], [s2, s1]])
+// and g_a the reference gradient of shape function a:
 //   dW/dx_a      = F S g_a
 //   d2W/dx_a dx_b = B_a^T C B_b + (g_a . S g_b) I,
-// B_a the 3x2 derivative of (E11, E22, 2 E12) with respect to x_a, C = k diag(1, 1, 1/2).
+// B_a the 3x2 derivative of e with respect to x_a.
 // Kikuuwe's compression term (thesis eq. 6.6) is added on J = det F (element_evaluate).
 // Where the barbules are compressed the Hessian can be indefinite; Newton then shifts
 // it by mu diag(H) (factor_newton_matrix).
@@ -40,8 +44,8 @@ struct plume_quadratic {
 	/// Per element and quadrature point: area * weight, and the six shape gradients (x, y).
 	double *weight;
 	double *gradients;
-	/// thickness * Young's modulus and thickness * Kikuuwe coefficient per element, Pa m.
-	double *modulus;
+	/// thickness * Voigt tensor (9, row-major) and thickness * Kikuuwe coefficient per element, Pa m.
+	double *stiffness;
 	double *compression;
 	/// Per node: 0 free, 1 bottom clamp, 2 top clamp.
 	unsigned char *clamp;
@@ -114,7 +118,8 @@ static double element_evaluate(const plume_quadratic *m, int e, const double *x,
 		local[2 * a] = x[2 * nodes[a]];
 		local[2 * a + 1] = x[2 * nodes[a] + 1];
 	}
-	double k = m->modulus[e], c = m->compression[e] / 12.0, energy = 0.0;
+	const double *C = m->stiffness + 9 * (size_t)e;
+	double c = m->compression[e] / 12.0, energy = 0.0;
 	if (gradient != NULL)
 		memset(gradient, 0, sizeof(double) * DOFS);
 	if (hessian != NULL)
@@ -130,10 +135,12 @@ static double element_evaluate(const plume_quadratic *m, int e, const double *x,
 			f2[0] += local[2 * a] * g[2 * a + 1];
 			f2[1] += local[2 * a + 1] * g[2 * a + 1];
 		}
-		double E11 = 0.5 * (f1[0] * f1[0] + f1[1] * f1[1] - 1.0);
-		double E22 = 0.5 * (f2[0] * f2[0] + f2[1] * f2[1] - 1.0);
-		double E12 = 0.5 * (f1[0] * f2[0] + f1[1] * f2[1]);
-		energy += w * 0.5 * k * (E11 * E11 + E22 * E22 + 2.0 * E12 * E12);
+		double strain[3] = {0.5 * (f1[0] * f1[0] + f1[1] * f1[1] - 1.0), 0.5 * (f2[0] * f2[0] + f2[1] * f2[1] - 1.0),
+		                    f1[0] * f2[0] + f1[1] * f2[1]};
+		double stress[3];
+		for (int i = 0; i < 3; ++i)
+			stress[i] = C[3 * i] * strain[0] + C[3 * i + 1] * strain[1] + C[3 * i + 2] * strain[2];
+		energy += w * 0.5 * (stress[0] * strain[0] + stress[1] * strain[1] + stress[2] * strain[2]);
 		// Kikuuwe's term (thesis eq. 6.6) on the signed area ratio J = det F, so that an
 		// inverted element costs more than a flat one: c ((1 - J) / 6)^3 for J < 1.
 		double J = f1[0] * f2[1] - f1[1] * f2[0], dpsi_c = 0.0, d2psi_c = 0.0;
@@ -145,7 +152,7 @@ static double element_evaluate(const plume_quadratic *m, int e, const double *x,
 		}
 		if (gradient == NULL)
 			continue;
-		double S11 = k * E11, S22 = k * E22, S12 = k * E12;
+		double S11 = stress[0], S22 = stress[1], S12 = stress[2];
 		// dJ/dx_a = (g_a1 f2y - g_a2 f1y, g_a2 f1x - g_a1 f2x).
 		double dJ[DOFS];
 		for (int a = 0; a < NODES; ++a) {
@@ -166,6 +173,12 @@ static double element_evaluate(const plume_quadratic *m, int e, const double *x,
 				B[a][1][d] = g[2 * a + 1] * f2[d];
 				B[a][2][d] = g[2 * a + 1] * f1[d] + g[2 * a] * f2[d];
 			}
+		// CB_b = C B_b.
+		double CB[NODES][3][2];
+		for (int b = 0; b < NODES; ++b)
+			for (int r = 0; r < 3; ++r)
+				for (int d = 0; d < 2; ++d)
+					CB[b][r][d] = C[3 * r] * B[b][0][d] + C[3 * r + 1] * B[b][1][d] + C[3 * r + 2] * B[b][2][d];
 		for (int a = 0; a < NODES; ++a)
 			for (int b = a; b < NODES; ++b) {
 				double geometric = g[2 * a] * (S11 * g[2 * b] + S12 * g[2 * b + 1]) +
@@ -174,9 +187,8 @@ static double element_evaluate(const plume_quadratic *m, int e, const double *x,
 				double twist = dpsi_c * (g[2 * a] * g[2 * b + 1] - g[2 * a + 1] * g[2 * b]);
 				for (int i = 0; i < 2; ++i)
 					for (int j = 0; j < 2; ++j) {
-						double value =
-						    k * (B[a][0][i] * B[b][0][j] + B[a][1][i] * B[b][1][j] + 0.5 * B[a][2][i] * B[b][2][j]) +
-						    d2psi_c * dJ[2 * a + i] * dJ[2 * b + j];
+						double value = B[a][0][i] * CB[b][0][j] + B[a][1][i] * CB[b][1][j] + B[a][2][i] * CB[b][2][j] +
+						               d2psi_c * dJ[2 * a + i] * dJ[2 * b + j];
 						if (i == j)
 							value += geometric;
 						else
@@ -265,15 +277,15 @@ static plume_status build_nodes(plume_quadratic *m, const plume_mesh *mesh, plum
 	return PLUME_OK;
 }
 
-static plume_status build_quadrature(plume_quadratic *m, const plume_mesh *mesh, double E_b, double E_B, double kappa,
+static plume_status build_quadrature(plume_quadratic *m, const plume_mesh *mesh, const double *voigt, double kappa,
                                      double thickness, plume_error *err)
 {
 	int count = m->element_count;
 	m->weight = plume_alloc(sizeof(double) * POINTS * (size_t)count);
 	m->gradients = plume_alloc(sizeof(double) * POINTS * NODES * 2 * (size_t)count);
-	m->modulus = plume_alloc(sizeof(double) * (size_t)count);
+	m->stiffness = plume_alloc(sizeof(double) * 9 * (size_t)count);
 	m->compression = plume_alloc(sizeof(double) * (size_t)count);
-	if (m->weight == NULL || m->gradients == NULL || m->modulus == NULL || m->compression == NULL)
+	if (m->weight == NULL || m->gradients == NULL || m->stiffness == NULL || m->compression == NULL)
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory building quadratic elements");
 	for (int e = 0; e < count; ++e) {
 		plume_vec2 p[3];
@@ -293,7 +305,8 @@ static plume_status build_quadrature(plume_quadratic *m, const plume_mesh *mesh,
 			memcpy(m->gradients + ((size_t)e * POINTS + q) * NODES * 2, g, sizeof g);
 			m->weight[(size_t)e * POINTS + q] = area * rule_w[group];
 		}
-		m->modulus[e] = thickness * (mesh->material[e] == PLUME_BAND_BARB ? E_B : E_b);
+		for (int i = 0; i < 9; ++i)
+			m->stiffness[9 * (size_t)e + i] = thickness * voigt[9 * (size_t)e + i];
 		m->compression[e] = thickness * kappa;
 	}
 	return PLUME_OK;
@@ -576,7 +589,7 @@ void plume_quadratic_positions(const plume_quadratic *m, plume_vec3 *out)
 // ---------------------------------------------------------------------------
 // Lifetime
 
-plume_status plume_quadratic_create(const plume_mesh *mesh, double E_b, double E_B, double kappa, double thickness,
+plume_status plume_quadratic_create(const plume_mesh *mesh, const double *voigt, double kappa, double thickness,
                                     const plume_solver_def *solver, plume_quadratic **out, plume_error *err)
 {
 	*out = NULL;
@@ -591,7 +604,7 @@ plume_status plume_quadratic_create(const plume_mesh *mesh, double E_b, double E
 	m->height = top;
 	plume_status status = build_nodes(m, mesh, err);
 	if (status == PLUME_OK)
-		status = build_quadrature(m, mesh, E_b, E_B, kappa, thickness, err);
+		status = build_quadrature(m, mesh, voigt, kappa, thickness, err);
 	if (status == PLUME_OK) {
 		size_t dofs = 2 * (size_t)m->node_count;
 		m->free_index = plume_alloc(sizeof(int) * dofs);
@@ -641,7 +654,7 @@ void plume_quadratic_destroy(plume_quadratic *m)
 	plume_free(m->reference);
 	plume_free(m->weight);
 	plume_free(m->gradients);
-	plume_free(m->modulus);
+	plume_free(m->stiffness);
 	plume_free(m->compression);
 	plume_free(m->clamp);
 	plume_free(m->free_index);

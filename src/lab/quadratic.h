@@ -1,4 +1,5 @@
-// Private: the mesoscale band model (Jouve thesis 5.2) on quadratic triangles.
+// Private: plane St-Venant-Kirchhoff samples on quadratic triangles: the mesoscale band
+// model (Jouve thesis 5.2) and, for a converged tilted test, the macroscale vane (4.1).
 //
 // The barb bands are 6.5e4 times stiffer than the barbule bands and only one or two
 // element rows wide. In the tilted test the barbs clamped at one end must bend in plane
@@ -6,10 +7,12 @@
 // shearing (shear locking): their tilted slope fell from 11.2 to 5.1 E_b between 500 and
 // 8000 triangles and was still falling. Quadratic triangles hold a strain that varies
 // linearly across the band, which is pure bending, so the band model converges at a
-// few thousand elements. This solver is planar (two unknowns per node), clamps the
-// sample's "bottom" and "top" groups and minimises the St-Venant-Kirchhoff energy of
-// isotropic bands with zero Poisson ratio by Newton's method on CHOLMOD's simplicial
-// Cholesky factorisation.
+// few thousand elements. The macroscale vane without the barb constraint has the same
+// trouble in the tilted test on linear triangles (E_vv / E_ww = 7500): its slope fell
+// by 3 % from 2000 to 16000 triangles and rose again at 32000 (docs/lab.md). This solver
+// is planar (two unknowns per node), clamps the sample's "bottom" and "top" groups and
+// minimises a St-Venant-Kirchhoff energy with a Voigt tensor per element (and Kikuuwe's
+// term) by Newton's method on CHOLMOD's simplicial Cholesky factorisation.
 #ifndef PLUME_LAB_QUADRATIC_H
 #define PLUME_LAB_QUADRATIC_H
 
@@ -29,10 +32,11 @@ typedef struct plume_quadratic_report {
 	double force;
 } plume_quadratic_report;
 
-/// Builds the quadratic model of a band sample (plume_sample_mesh with bands): edge
-/// midpoints become nodes; face material PLUME_BAND_BARBULE gets E_b, PLUME_BAND_BARB E_B; both
-/// get Kikuuwe's compression term with coefficient kappa (Pa, 0 for none).
-plume_status plume_quadratic_create(const plume_mesh *mesh, double E_b, double E_B, double kappa, double thickness,
+/// Builds the quadratic model of a sample mesh (plume_sample_mesh): edge midpoints become
+/// nodes; face f has the plane Voigt tensor voigt[9 f .. 9 f + 8] (Pa, (xx, yy, 2xy),
+/// row-major, as plume_isotropic_tensor and plume_orthotropic_tensor give it) and every face
+/// Kikuuwe's compression term with coefficient kappa (Pa, 0 for none).
+plume_status plume_quadratic_create(const plume_mesh *mesh, const double *voigt, double kappa, double thickness,
                                     const plume_solver_def *solver, plume_quadratic **out, plume_error *err);
 void plume_quadratic_destroy(plume_quadratic *model);
 

@@ -10,6 +10,7 @@
 #include "lab/quadratic.h"
 #include "plume/lab.h"
 #include "lab/lab_internal.h"
+#include "sim/membrane.h"
 
 plume_lab_material plume_lab_material_default(plume_lab_model model)
 {
@@ -19,6 +20,7 @@ plume_lab_material plume_lab_material_default(plume_lab_model model)
 	    .E_ww = 4.80e4,
 	    .E_vw = 4.80e4,
 	    .barb_constraint = false,
+	    .quadratic = false,
 	    .E_B = 2.57e9,
 	    .E_b = 3.92e4,
 	    .bands = plume_band_default_def(),
@@ -85,6 +87,9 @@ plume_status plume_lab_validate(const plume_lab_material *material, const plume_
 			        "material.E_vv is %g Pa, allowed > 0 (or barb_constraint true)", material->E_vv);
 			REQUIRE(!material->barb_constraint || sample == NULL || sample->mesh == PLUME_SAMPLE_ALIGNED, "%s",
 			        "material.barb_constraint needs an aligned mesh (sample.mesh \"aligned\")");
+			REQUIRE(!material->barb_constraint || !material->quadratic, "%s",
+			        "material.elements is quadratic, but the barb constraint needs the simulator's linear elements "
+			        "(material.elements \"linear\")");
 		} else if (material->model == PLUME_LAB_MESOSCALE) {
 			REQUIRE(positive(material->E_B), "material.E_B is %g Pa, allowed > 0", material->E_B);
 			REQUIRE(positive(material->E_b), "material.E_b is %g Pa, allowed > 0", material->E_b);
@@ -192,9 +197,25 @@ static plume_status solver_create(const plume_lab_material *material, const plum
                                   const plume_solver_def *solver_def, traction_solver *solver, plume_error *err)
 {
 	memset(solver, 0, sizeof *solver);
-	if (material->model == PLUME_LAB_MESOSCALE)
-		return plume_quadratic_create(mesh, material->E_b, material->E_B, material->compression_coefficient, thickness,
-		                              solver_def, &solver->bands, err);
+	if (material->model == PLUME_LAB_MESOSCALE || material->quadratic) {
+		// The same constitutive laws as the simulator's membrane (sim/membrane.h): isotropic
+		// bands with zero Poisson ratio, or the orthotropic vane rotated to each face's barbs.
+		double *voigt = plume_alloc(sizeof(double) * 9 * (size_t)(mesh->face_count > 0 ? mesh->face_count : 1));
+		if (voigt == NULL)
+			return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory for the sample's materials");
+		for (int f = 0; f < mesh->face_count; ++f) {
+			if (material->model == PLUME_LAB_MESOSCALE)
+				plume_isotropic_tensor(mesh->material[f] == PLUME_BAND_BARB ? material->E_B : material->E_b, 0.0,
+				                       voigt + 9 * (size_t)f);
+			else
+				plume_orthotropic_tensor(material->E_vv, material->E_ww, material->E_vw, mesh->barb_angle[f],
+				                         voigt + 9 * (size_t)f);
+		}
+		plume_status status = plume_quadratic_create(mesh, voigt, material->compression_coefficient, thickness,
+		                                             solver_def, &solver->bands, err);
+		plume_free(voigt);
+		return status;
+	}
 	plume_sim_def sim_def = macroscale_sim_def(material, thickness, solver_def);
 	plume_status status = plume_sim_create(mesh, &sim_def, &solver->sim, err);
 	if (status != PLUME_OK)
@@ -313,8 +334,9 @@ plume_status plume_lab_traction(const plume_lab_material *material, const plume_
 }
 
 plume_status lab_mean_curve(const plume_lab_material *material, const plume_sample_def *sample,
-                            const plume_traction_def *def, int phase_count, double *slope, int *solve_count,
-                            double *strain, double *stress, plume_lab_progress *progress, plume_error *err)
+                            const plume_traction_def *def, int phase_count, double *slope, double *phase_slopes,
+                            int *solve_count, double *strain, double *stress, plume_lab_progress *progress,
+                            plume_error *err)
 {
 	if (phase_count < 1)
 		return plume_error_set(err, PLUME_ERROR_SPEC, "phase count is %d, allowed >= 1", phase_count);
@@ -336,6 +358,8 @@ plume_status lab_mean_curve(const plume_lab_material *material, const plume_samp
 			return status;
 		}
 		sum += r.slope;
+		if (phase_slopes != NULL)
+			phase_slopes[k] = r.slope;
 		solves += r.solve_count;
 		// Every phase loads the clamp to the same strains: the stresses average sample by sample.
 		for (int i = 0; i < r.count && stress != NULL; ++i) {
@@ -361,5 +385,5 @@ plume_status plume_lab_mean_slope(const plume_lab_material *material, const plum
                                   const plume_traction_def *def, int phase_count, double *slope, int *solve_count,
                                   plume_error *err)
 {
-	return lab_mean_curve(material, sample, def, phase_count, slope, solve_count, NULL, NULL, NULL, err);
+	return lab_mean_curve(material, sample, def, phase_count, slope, NULL, solve_count, NULL, NULL, NULL, err);
 }
