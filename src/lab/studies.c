@@ -328,10 +328,11 @@ static plume_status study_conditioning(const plume_study_def *def, const char *c
 // The slope of a traction test, for the mesoscale model the mean over the calibration's
 // band phases: the measure the calibration fitted E_vw to, so the models meet at 45 degrees.
 static plume_status slope_at(const plume_lab_material *material, const plume_sample_def *sample, int steps,
-                             int phase_count, double *slope, plume_error *err)
+                             double strain_max, int phase_count, double *slope, plume_error *err)
 {
 	plume_traction_def def = plume_traction_default_def();
 	def.steps = steps;
+	def.strain_max = strain_max;
 	def.solver.tolerance = 1e-6;
 	def.accept_residual = 1e-4;
 	return plume_lab_mean_slope(material, sample, &def, phase_count, slope, NULL, err);
@@ -368,17 +369,22 @@ static plume_status study_angles(const plume_study_def *def, const char *csv, co
 		macro_material.E_vv = result.E_vv;
 		macro_material.E_ww = result.E_ww;
 		macro_material.E_vw = result.E_vw;
+		// The calibration's protocol (docs/lab.md): its strain range, its compression term and
+		// its elements, so that the two models meet at 45 degrees, where E_vw was fitted.
+		macro_material.quadratic = !cal.barb_constraint && cal.macroscale_quadratic;
+		macro_material.compression_coefficient = cal.mesoscale.compression_coefficient;
 		plume_sample_def sample = cal.sample;
 		sample.height = cal.aspect_ratio * sample.width;
 		for (int a = 0; a < ANGLES && status == PLUME_OK; ++a) {
 			angle_deg[a] = 15.0 * a;
 			sample.barb_angle = angle_deg[a] * PI / 180.0;
 			sample.element_count = cal.sample.element_count;
-			status = slope_at(&meso_material, &sample, cal.steps, cal.phase_count, &meso[p][a], err);
+			status =
+			    slope_at(&meso_material, &sample, cal.steps, cal.tilted_strain_max, cal.phase_count, &meso[p][a], err);
 			study_progress(def, &done, total);
 			sample.element_count = cal.macroscale_elements;
 			if (status == PLUME_OK)
-				status = slope_at(&macro_material, &sample, cal.steps, 1, &macro[p][a], err);
+				status = slope_at(&macro_material, &sample, cal.steps, cal.tilted_strain_max, 1, &macro[p][a], err);
 			study_progress(def, &done, total);
 			if (status == PLUME_OK) {
 				meso[p][a] /= E_b[p];
