@@ -114,6 +114,12 @@ typedef struct run_state {
 	plume_barb_embedding *carried;   ///< its embedding
 	double *field_times;             ///< the time of every frame written, for the .pvd
 	int field_capacity;
+	const char *vane_base; ///< the group the vane's plane moves with (vane_base_group)
+	double min_stretch;    ///< extremes over the steps, for summary.json (NaN: none yet)
+	double max_out_of_plane;
+	double max_kinetic;
+	double max_elastic;
+	double *max_reaction; ///< per handle: the largest |reaction|, N
 } run_state;
 
 // time: the scene's time of the step (plume_sim_time stays 0 in quasi-static scenes,
@@ -163,6 +169,7 @@ static void write_handle_columns(run_state *run, double time, const plume_sim *s
 		// plume_scene_run hands its own (non-const) simulator to the callback as const; the
 		// reaction only re-evaluates forces at the current state and changes nothing it reports.
 		plume_sim_group_reaction((plume_sim *)sim, handle->group, &force);
+		run->max_reaction[h] = fmax(run->max_reaction[h], plume_v3_length(force));
 		plume_scene_handle_pose(handle, time, &translation, &rotation);
 		fprintf(run->stats, ",%.9e,%.9e,%.9e,%.9g,%.9g,%.9g", force.x, force.y, force.z, translation.x, translation.y,
 		        translation.z);
@@ -185,9 +192,16 @@ static plume_status on_step(void *user, int step, double time, const plume_sim *
 		// bending) and gravitational (with the scene's constant forces). Like the reactions, they
 		// re-evaluate the const simulator's state and change nothing it reports.
 		plume_sim_energies e = plume_sim_energy((plume_sim *)sim);
-		fprintf(run->stats, "%.9g,%d,%.6e,%.12e,%.6e,%.6f,%.9e,%.9e,%.9e", time, report->newton_iterations,
-		        report->gradient_norm, report->energy, report->max_barb_strain, wall_seconds, e.kinetic,
-		        e.membrane + e.compression + e.bending, e.gravity);
+		double elastic = e.membrane + e.compression + e.bending;
+		plume_sim_vane_shape vane = plume_sim_vane_shape_measure(sim, run->vane_base);
+		fprintf(run->stats, "%.9g,%d,%.6e,%.12e,%.6e,%.6f,%.9e,%.9e,%.9e,%.9g,%.9e", time, report->newton_iterations,
+		        report->gradient_norm, report->energy, report->max_barb_strain, wall_seconds, e.kinetic, elastic,
+		        e.gravity, vane.min_principal_stretch, vane.max_out_of_plane);
+		// fmin/fmax skip NaN: a measure that is never defined stays NaN (null in summary.json).
+		run->min_stretch = fmin(run->min_stretch, vane.min_principal_stretch);
+		run->max_out_of_plane = fmax(run->max_out_of_plane, vane.max_out_of_plane);
+		run->max_kinetic = fmax(run->max_kinetic, e.kinetic);
+		run->max_elastic = fmax(run->max_elastic, elastic);
 		write_handle_columns(run, time, sim);
 		fputc('\n', run->stats);
 		run->max_strain = fmax(run->max_strain, report->max_barb_strain);
@@ -218,6 +232,19 @@ void cli_scene_bounds(const plume_scene *scene, plume_vec3 *lo, plume_vec3 *hi)
 	*hi = plume_v3(hi->x + pad, hi->y + pad, hi->z + pad);
 }
 
+/// The group whose rigid motion carries the rest vane's plane for vane_max_out_of_plane: the
+/// rachis clamp (the first two rows of rachis vertices at the calamus) when the mesh has it,
+/// else the first handle's group (docs/simulation.md).
+static const char *vane_base_group(const plume_scene *scene)
+{
+	if (plume_mesh_find_group(scene->mesh, "rachis_clamp") != NULL || scene->handle_count == 0)
+		return "rachis_clamp";
+	return scene->handles[0].group;
+}
+
+/// A JSON number, or null for NaN (a measure never defined in the run).
+static json_t *json_measure(double value) { return isnan(value) ? json_null() : json_real(value); }
+
 static plume_status write_summary(cli_output *output, const plume_scene *scene, const plume_scene_summary *summary,
                                   const run_state *run, const plume_error *failure, plume_error *err)
 {
@@ -245,6 +272,14 @@ static plume_status write_summary(cli_output *output, const plume_scene *scene, 
 	json_object_set_new(root, "vertices", json_integer(summary->vertex_count));
 	json_object_set_new(root, "faces", json_integer(summary->face_count));
 	json_object_set_new(root, "barb_constraints", json_integer(summary->constraint_count));
+	json_object_set_new(root, "vane_min_principal_stretch", json_measure(run->min_stretch));
+	json_object_set_new(root, "vane_max_out_of_plane", json_measure(run->max_out_of_plane));
+	json_object_set_new(root, "max_kinetic_energy", json_measure(run->max_kinetic));
+	json_object_set_new(root, "max_elastic_energy", json_measure(run->max_elastic));
+	json_t *reactions = json_array();
+	for (int h = 0; h < scene->handle_count; ++h)
+		json_array_append_new(reactions, json_real(run->max_reaction[h]));
+	json_object_set_new(root, "handle_max_reaction", reactions);
 	json_object_set_new(root, "mesh_min_angle_deg", json_real(scene->mesh_report.min_angle * 180 / acos(-1.0)));
 	json_object_set_new(root, "mesh_aligned_fraction", json_real(scene->mesh_report.aligned_fraction));
 	json_object_set_new(root, "mesh_guides_dropped", json_integer(scene->mesh_report.guides_dropped));
@@ -305,11 +340,16 @@ static plume_status simulate(const plume_scene *scene, cli_output *output, run_s
 	snprintf(path, sizeof path, "%s/fields", output->stage);
 	if (run->fields && mkdir(path, 0777) != 0)
 		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot create: %s", path, "mkdir failed");
+	run->vane_base = vane_base_group(scene);
+	run->min_stretch = run->max_out_of_plane = run->max_kinetic = run->max_elastic = NAN;
+	run->max_reaction = calloc((size_t)(scene->handle_count > 0 ? scene->handle_count : 1), sizeof *run->max_reaction);
+	if (run->max_reaction == NULL)
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "simulate: out of memory");
 	run->stats = fopen(cli_output_path(output, "stats.csv", path, sizeof path), "wb");
 	if (run->stats == NULL)
 		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write", path);
 	fprintf(run->stats, "time,newton_iterations,gradient_norm,energy,max_barb_strain,wall_seconds,kinetic_energy,"
-	                    "elastic_energy,gravitational_energy");
+	                    "elastic_energy,gravitational_energy,vane_min_principal_stretch,vane_max_out_of_plane");
 	for (int h = 0; h < scene->handle_count; ++h)
 		fprintf(run->stats, ",handle%d_fx,handle%d_fy,handle%d_fz,handle%d_dx,handle%d_dy,handle%d_dz", h, h, h, h, h,
 		        h);
@@ -478,6 +518,7 @@ int cli_simulate(int argc, char **argv)
 	plume_mesh_obj_writer_destroy(run.obj);
 	plume_embedding_destroy(run.carried);
 	free(run.field_times);
+	free(run.max_reaction);
 	cli_barb_renderer_end(&run.renderer);
 	if (status != PLUME_OK)
 		return cli_fail(status == PLUME_ERROR_NUMERIC && failure.message[0] ? &failure : &err);

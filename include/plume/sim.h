@@ -234,6 +234,23 @@ typedef struct plume_sim_face_field {
 /// entries), at the current positions. PLUME_ERROR_MEMORY when scratch cannot be allocated.
 plume_status plume_sim_face_fields(const plume_sim *sim, plume_sim_face_field *out, plume_error *err);
 
+/// The vane's shape at the current state (plume_sim_vane_shape_measure); the vane is the
+/// faces of material 0.
+typedef struct plume_sim_vane_shape {
+	/// Smallest in-plane principal stretch over the vane faces: sqrt of the smallest
+	/// eigenvalue of C = F^T F against the reference. 1 unstretched, below 1 compressed.
+	/// NaN without vane faces.
+	double min_principal_stretch;
+	/// Largest distance of a vane vertex from the rest vane's plane moved rigidly with the
+	/// base group, m. The plane passes through the rest vane's area centroid, normal to
+	/// its summed face normals; the motion maps the base group's rest frame (its centroid,
+	/// its vertex farthest from the centroid, the vertex farthest off that line) onto the
+	/// same frame now. NaN without vane faces, or when the group is unknown or has fewer
+	/// than three non-collinear vertices.
+	double max_out_of_plane;
+} plume_sim_vane_shape;
+plume_sim_vane_shape plume_sim_vane_shape_measure(const plume_sim *sim, const char *base_group);
+
 PLUME_API_END
 #ifdef __cplusplus
 }

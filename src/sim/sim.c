@@ -565,7 +565,7 @@ void plume_sim_destroy(plume_sim *sim)
 // ---------------------------------------------------------------------------
 // Handles
 
-static const plume_vertex_group *find_group(const plume_sim *sim, const char *name)
+const plume_vertex_group *plume_sim_find_group(const plume_sim *sim, const char *name)
 {
 	for (int g = 0; g < sim->group_count; ++g)
 		if (strcmp(sim->groups[g].name, name) == 0)
@@ -591,7 +591,7 @@ int plume_sim_add_handle(plume_sim *sim, const char *group_name, plume_error *er
 {
 	PLUME_ASSERT_HANDLE(sim);
 	PLUME_ASSERT(group_name != NULL);
-	const plume_vertex_group *group = find_group(sim, group_name);
+	const plume_vertex_group *group = plume_sim_find_group(sim, group_name);
 	if (group == NULL) {
 		char known[512] = "";
 		for (int g = 0; g < sim->group_count; ++g) {
@@ -639,7 +639,7 @@ plume_status plume_sim_set_group_load(plume_sim *sim, const char *group_name, pl
 {
 	PLUME_ASSERT_HANDLE(sim);
 	PLUME_ASSERT(group_name != NULL);
-	const plume_vertex_group *group = find_group(sim, group_name);
+	const plume_vertex_group *group = plume_sim_find_group(sim, group_name);
 	if (group == NULL || group->count == 0)
 		return plume_error_set(err, PLUME_ERROR_SPEC, "no vertices in group \"%s\" to load", group_name);
 	plume_vec3 share = plume_v3_scale(force, 1.0 / group->count);
@@ -835,7 +835,7 @@ bool plume_sim_group_reaction(plume_sim *sim, const char *group_name, plume_vec3
 {
 	PLUME_ASSERT_HANDLE(sim);
 	PLUME_ASSERT(group_name != NULL && force != NULL);
-	const plume_vertex_group *group = find_group(sim, group_name);
+	const plume_vertex_group *group = plume_sim_find_group(sim, group_name);
 	if (group == NULL)
 		return false;
 	static const sim_problem statics = {.dynamic = false};

@@ -145,6 +145,9 @@ void plume_sim_add_constraint_forces(const plume_sim *sim, const plume_vec3 *x, 
 /// Largest |l - L| / L over all barb-aligned edges at positions x.
 double plume_sim_max_barb_strain(const plume_sim *sim, const plume_vec3 *x);
 
+/// The simulator's copy of the mesh's vertex group with that name, or NULL.
+const plume_vertex_group *plume_sim_find_group(const plume_sim *sim, const char *name);
+
 /// Minimises the problem from sim->x with handles at their targets for fraction s of the step.
 plume_status plume_sim_newton(plume_sim *sim, const sim_problem *problem, plume_solve_report *report, plume_error *err);
 

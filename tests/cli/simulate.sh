@@ -30,6 +30,26 @@ check "summary says completed" grep -q '"completed": true' "$out/summary.json"
 check "summary has steps" grep -q '"steps": 5' "$out/summary.json"
 check "summary has max_barb_strain" grep -q '"max_barb_strain"' "$out/summary.json"
 check "summary has rachis_tip_deflection" grep -q '"rachis_tip_deflection"' "$out/summary.json"
+# The vane's shape and the handle's reaction per step, their extremes in the summary:
+# a feather held at its clamp sags under gravity (its vane leaves the plane by a little,
+# well under its length) and stretches by next to nothing; the clamp carries its weight (+z).
+check "stats has the vane's shape" grep -q "^time,.*,gravitational_energy,vane_min_principal_stretch,vane_max_out_of_plane,handle0_fx," "$out/stats.csv"
+check "vane shape and reactions: plausible, summary gives their extremes" /usr/bin/python3 -c '
+import csv, json, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+summary = json.load(open(sys.argv[2]))
+stretch = [float(r["vane_min_principal_stretch"]) for r in rows]
+lift = [float(r["vane_max_out_of_plane"]) for r in rows]
+force = [(float(r["handle0_fx"])**2 + float(r["handle0_fy"])**2 + float(r["handle0_fz"])**2) ** 0.5 for r in rows]
+assert all(0.999 < s <= 1.0 + 1e-9 for s in stretch), stretch
+assert all(1e-6 < z < 0.01 for z in lift), lift
+assert all(float(r["handle0_fz"]) > 0 for r in rows)
+close = lambda a, b: abs(a - b) <= 1e-8 * abs(b)  # stats.csv has 9 digits, summary.json 10
+assert close(summary["vane_min_principal_stretch"], min(stretch)), summary
+assert close(summary["vane_max_out_of_plane"], max(lift)), summary
+assert len(summary["handle_max_reaction"]) == 1 and close(summary["handle_max_reaction"][0], max(force)), summary
+assert summary["max_kinetic_energy"] > 0 and summary["max_elastic_energy"] > 0 and summary["mesh_min_angle_deg"] > 0
+' "$out/stats.csv" "$out/summary.json"
 check "stdout reports the run" grep -q "5 steps" "$scratch/out.txt"
 check "frames keep the mesh's vertex count" test "$(grep -c '^v ' "$out/frames/0003.obj")" -eq "$(grep -c '^v ' "$out/mesh.obj")"
 
