@@ -1112,8 +1112,9 @@ static double straight_truss_energy(double kappa, double lambda)
 /// straight compressed state's membrane energy with the bending energy of the inextensible
 /// buckled state (all over L h E, per unit width). The buckled minimum lies between two
 /// closed forms: above Euler's pinned-end bound pi^2 D (1 - lambda) / L (post-buckling the
-/// end load stays above the critical pi^2 D / L^2, whatever the end conditions), below the
-/// circular arc's 2 D theta^2 / L with sin(theta)/theta = lambda (one isometric state).
+/// end load stays above the critical pi^2 D / L^2; clamped ends only raise it), below the
+/// circular arc's 2 D theta^2 / L with sin(theta)/theta = lambda (one isometric state with
+/// pinned ends, as the figure's truss).
 /// Measured here: St-Venant-Kirchhoff alone never buckles (straight <= 0.045 of Euler's
 /// bound); Kikuuwe's term with the printed kappa = 3e3 E does not either (its straight
 /// energy peaks at 0.39 of Euler's bound, at lambda = 0), so the figure's claim does not
