@@ -1076,6 +1076,91 @@ static void test_triangle_energy_and_projection(void **state)
 }
 
 // ---------------------------------------------------------------------------
+// Thesis Figure 6.8: the one-dimensional truss under compression
+
+/// Half the angle of a circular arc of length 1 whose chord is lambda: sin(t)/t = lambda.
+static double arc_half_angle(double lambda)
+{
+	double lo = 1e-12, hi = PI;
+	for (int i = 0; i < 200; ++i) {
+		double mid = 0.5 * (lo + hi);
+		if (sin(mid) / mid > lambda)
+			lo = mid;
+		else
+			hi = mid;
+	}
+	return 0.5 * (lo + hi);
+}
+
+/// Energy per unit reference area, over h E, of plume's membrane (+ compression) triangle
+/// of thickness h, E = 1, nu = 0 and coefficient kappa / E, stretched uniaxially by lambda:
+/// the straight (unbuckled) truss of Figure 6.8, J = lambda.
+static double straight_truss_energy(double kappa, double lambda)
+{
+	double voigt[9];
+	plume_isotropic_tensor(1.0, 0.0, voigt);
+	plume_vec2 reference[3] = {{0, 0}, {1, 0}, {0, 1}};
+	plume_membrane_element element;
+	const double h = 1e-3;
+	assert_true(plume_membrane_element_init(&element, (int[]){0, 1, 2}, reference, h, voigt, kappa));
+	plume_vec3 x[3] = {{0, 0, 0}, {lambda, 0, 0}, {0, 1, 0}};
+	double energy = plume_membrane_energy(&element, x, NULL, NULL) + plume_compression_energy(&element, x, NULL, NULL);
+	return energy / (element.area * h);
+}
+
+/// Figure 6.8 compares, for a truss of length L and thickness h with D = h L^2 E / 3, the
+/// straight compressed state's membrane energy with the bending energy of the inextensible
+/// buckled state (all over L h E, per unit width). The buckled minimum lies between two
+/// closed forms: above Euler's pinned-end bound pi^2 D (1 - lambda) / L (post-buckling the
+/// end load stays above the critical pi^2 D / L^2; clamped ends only raise it), below the
+/// circular arc's 2 D theta^2 / L with sin(theta)/theta = lambda (one isometric state with
+/// pinned ends, as the figure's truss).
+/// Measured here: St-Venant-Kirchhoff alone never buckles (straight <= 0.045 of Euler's
+/// bound); Kikuuwe's term with the printed kappa = 3e3 E does not either (its straight
+/// energy peaks at 0.39 of Euler's bound, at lambda = 0), so the figure's claim does not
+/// follow from its printed numbers. It can from kappa = 8.2e3 E (Euler's bound at lambda
+/// = 0) and does for certain from about 1.7e4 E (the arc); at 2e4 E below lambda = 0.13.
+static void test_truss_buckling_figure_6_8(void **state)
+{
+	(void)state;
+	const double D = 1.0 / 3.0; // D / (h L^2 E), Figure 6.8
+	// plume's term on the uniaxial state is the figure's L h kappa/12 ((1 - lambda)/6)^3;
+	// plume's St-Venant-Kirchhoff energy is the Green strain's 1/8 (lambda^2 - 1)^2 (the
+	// figure prints 1/2 (lambda^2 - 1)^2, without the 1/2 of the Green strain).
+	for (double lambda = 0.05; lambda < 1.0; lambda += 0.05) {
+		double u = (1 - lambda) / 6, svk = 0.125 * (lambda * lambda - 1) * (lambda * lambda - 1);
+		assert_close(straight_truss_energy(0.0, lambda), svk, 1e-12);
+		assert_close(straight_truss_energy(3e3, lambda) - svk, 3e3 / 12 * u * u * u, 1e-12);
+	}
+	double kappas[] = {0.0, 3e3, 1.6e4, 2e4};
+	double worst[4] = {0}, worst_arc[4] = {0}, buckle_from[4] = {0};
+	for (int k = 0; k < 4; ++k) {
+		for (int i = 0; i < 100; ++i) {
+			double lambda = 0.01 * i; // 0 ... 0.99
+			double straight = straight_truss_energy(kappas[k], lambda);
+			double theta = arc_half_angle(lambda);
+			double euler = PI * PI * D * (1 - lambda), arc = 2 * D * theta * theta;
+			assert_true(euler < arc);
+			worst[k] = fmax(worst[k], straight / euler);
+			worst_arc[k] = fmax(worst_arc[k], straight / arc);
+			if (straight > arc)
+				buckle_from[k] = fmax(buckle_from[k], lambda);
+		}
+		print_message("truss kappa = %.3g E: straight / Euler bound <= %.3f, straight / arc <= %.3f, buckles "
+		              "below lambda = %.2f\n",
+		              kappas[k], worst[k], worst_arc[k], buckle_from[k]);
+	}
+	// Without the term, and with the printed kappa, the straight truss is the lower state at
+	// every lambda in [0, 1): buckling would raise the energy.
+	assert_true(worst[0] < 0.05);
+	assert_close(worst[1], (0.125 + 3e3 / 12 / 216) / (PI * PI * D), 1e-3); // at lambda = 0
+	assert_true(worst[1] < 0.4);
+	// A larger kappa makes the straight state dearer than the arc: buckling is lower.
+	assert_true(worst_arc[3] > 1.0 && buckle_from[3] > 0.0 && buckle_from[3] < 0.3);
+	assert_true(worst_arc[2] < 1.02); // 1.6e4 E is about the threshold
+}
+
+// ---------------------------------------------------------------------------
 // Materials of thesis Table 6.1
 
 static void test_table_6_1_materials(void **state)
@@ -1126,6 +1211,7 @@ int main(void)
 	    cmocka_unit_test(test_project_psd_translation_free),
 	    cmocka_unit_test(test_triangle_energy_and_projection),
 	    cmocka_unit_test(test_table_6_1_materials),
+	    cmocka_unit_test(test_truss_buckling_figure_6_8),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
