@@ -283,7 +283,7 @@ plume_status plume_sim_newton(plume_sim *sim, const sim_problem *problem, plume_
 			break;
 
 		status = factor_and_solve(sim, exact, report, err);
-		if (exact && status != PLUME_OK) {
+		if (exact && status == PLUME_ERROR_NUMERIC) {
 			// The exact Hessian is not positive definite on the constraints' tangent space
 			// (its factors' inertia says so, kkt.h): project, and keep projecting for the
 			// rest of this solve rather than pay for that test again.
