@@ -1,5 +1,5 @@
 // Benchmark: the paper's Figure 1 scenario (examples/scenes/figure1-anisotropic.json)
-// at the paper's resolution (e = 5 mm) and on finer meshes (e = 2.5, 1.75 mm), with
+// at the paper's resolution (e = 5 mm) and on finer meshes (e = 2.5, 1.75, 1.25 mm), with
 // the isotropic comparison at 5 mm, and the solver's floor: per mesh size, the CPU
 // of one Newton iteration against the CPU of one numeric factorisation of the same
 // KKT matrix in the same run, their ratio, factorisations and solves per iteration,
@@ -11,7 +11,8 @@
 // points at link time (bench/CMakeLists.txt: --wrap=cholmod_factorize,
 // --wrap=cholmod_solve2), so the library carries no benchmark code. Times are CPU
 // times (the machine may be shared: CPU seconds are steadier than wall seconds).
-// `bench_simulate quick` runs the 5 mm sizes only.
+// `bench_simulate quick` runs the 5 mm sizes only, `bench_simulate all` adds e = 1.25 mm
+// (5,000 vertices, a few minutes).
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>
@@ -211,10 +212,10 @@ static double command_cpu(void)
 
 int main(int argc, char **argv)
 {
-	bool quick = argc > 1 && argv[1][0] == 'q';
-	static const double sizes[] = {0.005, 0.0025, 0.00175};
-	int size_count = quick ? 1 : 3;
-	result results[3], isotropic;
+	bool quick = argc > 1 && argv[1][0] == 'q', all = argc > 1 && argv[1][0] == 'a';
+	static const double sizes[] = {0.005, 0.0025, 0.00175, 0.00125};
+	int size_count = quick ? 1 : all ? 4 : 3;
+	result results[4], isotropic;
 	int failures = 0;
 	for (int i = 0; i < size_count; ++i)
 		failures += run("figure1-anisotropic", sizes[i], results + i);

@@ -360,21 +360,29 @@ static void test_patch_general_uniform_deformation(void **state)
 // ---------------------------------------------------------------------------
 // Finite differences
 
+/// A random reference triangle of the vane's material (E_vv given, at a random barb angle)
+/// or the rachis' (isotropic), with the Kikuuwe term.
+static void random_element(plume_rng *rng, double E_vv, bool isotropic, plume_vec2 reference[3],
+                           plume_membrane_element *element)
+{
+	double voigt[9];
+	if (isotropic)
+		plume_isotropic_tensor(34e6, 0.49, voigt);
+	else
+		plume_orthotropic_tensor(E_vv, 4.8e4, 2e4, plume_rng_range(rng, -PI, PI), voigt);
+	random_triangle(rng, reference);
+	assert_true(plume_membrane_element_init(element, (int[]){0, 1, 2}, reference, 1.2e-4, voigt, 5.04e7));
+}
+
 static void test_membrane_finite_differences(void **state)
 {
 	(void)state;
 	plume_rng rng = plume_rng_seed(4);
 	double worst = 0.0;
 	for (int trial = 0; trial < 40; ++trial) {
-		double voigt[9];
-		if (trial % 3 == 2)
-			plume_isotropic_tensor(34e6, 0.49, voigt);
-		else
-			plume_orthotropic_tensor(3.6e8 * (trial % 3), 4.8e4, 2e4, plume_rng_range(&rng, -PI, PI), voigt);
 		plume_vec2 reference[3];
-		random_triangle(&rng, reference);
 		plume_membrane_element element;
-		assert_true(plume_membrane_element_init(&element, (int[]){0, 1, 2}, reference, 1.2e-4, voigt, 5.04e7));
+		random_element(&rng, 3.6e8 * (trial % 3), trial % 3 == 2, reference, &element);
 		plume_vec3 x[3];
 		deform(&rng, reference, 3, 0.4, 0.2, x);
 		double error = finite_difference_error(membrane_fn, &element, x, 3, 1e-6);
@@ -1020,15 +1028,9 @@ static void test_triangle_energy_and_projection(void **state)
 	plume_rng rng = plume_rng_seed(12);
 	int projected = 0;
 	for (int trial = 0; trial < 60; ++trial) {
-		double voigt[9];
-		if (trial % 3 == 2)
-			plume_isotropic_tensor(34e6, 0.49, voigt);
-		else
-			plume_orthotropic_tensor(3.6e8, 4.8e4, 2e4, plume_rng_range(&rng, -PI, PI), voigt);
 		plume_vec2 reference[3];
-		random_triangle(&rng, reference);
 		plume_membrane_element element;
-		assert_true(plume_membrane_element_init(&element, (int[]){0, 1, 2}, reference, 1.2e-4, voigt, 5.04e7));
+		random_element(&rng, 3.6e8, trial % 3 == 2, reference, &element);
 		bool tension = trial % 4 == 0;
 		// In tension: stretched 2-10 % along both reference axes, then rotated; otherwise
 		// shrunk and sheared at random (compression active on most of them).

@@ -355,6 +355,45 @@ static void test_kkt_factor_reports_indefinite(void **state)
 	plume_kkt_free(&kkt);
 }
 
+static void test_kkt_factor_inertia(void **state)
+{
+	(void)state;
+	// With constraints the exact Hessian is accepted iff it is positive definite on the
+	// constraints' tangent space, read from the inertia of the LDL' factors: one barb
+	// between two vertices along x (C = [-1 0 0 1 0 0]), H = 2 I with one entry changed.
+	plume_kkt kkt;
+	memset(&kkt, 0, sizeof kkt);
+	plume_error err = {0};
+	const int pair[2] = {0, 1};
+	assert_int_equal(plume_kkt_init(&kkt, 2, 0, NULL, 0, NULL, 0, 1, pair, &err), PLUME_OK);
+	double *values = plume_kkt_values(&kkt), shift;
+	for (int trial = 0; trial < 2; ++trial) {
+		plume_kkt_zero(&kkt);
+		for (int v = 0; v < 2; ++v)
+			for (int d = 0; d < 3; ++d)
+				values[kkt.vertex_slots[9 * v + 4 * d]] = 2.0;
+		values[kkt.constraint_slots[0]] = -1.0;
+		values[kkt.constraint_slots[3]] = 1.0;
+		values[kkt.constraint_slots[6]] = -1e-15;
+		// Trial 0: H_x0x0 = -1 makes H indefinite, but the tangent space sees x0 only with
+		// x1 ((-1 + 2) / 2 > 0 along x0 = x1): accepted. Trial 1: H_y0y0 = -1 is a tangent
+		// direction: refused.
+		values[kkt.vertex_slots[4 * trial]] = -1.0;
+		plume_status status = plume_kkt_factor(&kkt, false, &shift, &err);
+		if (trial == 1) {
+			assert_int_equal(status, PLUME_ERROR_NUMERIC);
+			assert_non_null(strstr(err.message, "tangent space"));
+			continue;
+		}
+		assert_int_equal(status, PLUME_OK);
+		double rhs[7] = {1, 2, 3, 4, 5, 6, 0.5}, x[7];
+		assert_int_equal(plume_kkt_solve(&kkt, rhs, x, &err), PLUME_OK);
+		assert_close(x[3] - x[0], 0.5, 1e-14);  // the linearised constraint, to rounding
+		assert_close(-x[0] - x[6], 1.0, 1e-12); // H dx + C^T lambda = rhs on x0
+	}
+	plume_kkt_free(&kkt);
+}
+
 static void test_bad_definitions(void **state)
 {
 	(void)state;
@@ -394,6 +433,7 @@ int main(void)
 	    cmocka_unit_test(test_reaction_balances_load),
 	    cmocka_unit_test(test_steps_are_deterministic),
 	    cmocka_unit_test(test_kkt_factor_reports_indefinite),
+	    cmocka_unit_test(test_kkt_factor_inertia),
 	    cmocka_unit_test(test_bad_definitions),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);

@@ -172,6 +172,15 @@ static double free_norm2(const plume_sim *sim, const double *vector)
 	return sqrt(sum);
 }
 
+/// g . dx over the position unknowns (held ones have g = 0).
+static double free_dot(const plume_sim *sim, const double *g, const double *step)
+{
+	double sum = 0;
+	for (int i = 0; i < 3 * sim->vertex_count; ++i)
+		sum += g[i] * step[i];
+	return sum;
+}
+
 static void apply_step(const plume_sim *sim, const plume_vec3 *x, const double *step, double alpha, plume_vec3 *out)
 {
 	for (int i = 0; i < sim->vertex_count; ++i)
@@ -254,7 +263,7 @@ plume_status plume_sim_newton(plume_sim *sim, const sim_problem *problem, plume_
 	// factors, free once factored: one factorisation an iteration unless it fails. (The
 	// sign of g . dx is no test: on a constrained step it is positive whenever reaching
 	// the constraints costs potential, and the merit still descends.)
-	bool exact = !sim->exact_hessian_failed, exact_failed = false;
+	bool exact = !sim->exact_hessian_failed;
 	sim->exact_hessian_failed = false;
 	report->converged = false;
 	report->newton_iterations = 0;
@@ -283,21 +292,24 @@ plume_status plume_sim_newton(plume_sim *sim, const sim_problem *problem, plume_
 			break;
 
 		status = factor_and_solve(sim, exact, report, err);
-		if (exact && status != PLUME_OK) {
+		double slope = status == PLUME_OK ? free_dot(sim, g, step) : 0;
+		// Without constraints g . dx must be negative: a Cholesky factorisation that
+		// succeeds on a matrix that is positive definite only to rounding can still give
+		// an ascent step. (With constraints its sign is no test, see above.)
+		if (exact && (status == PLUME_ERROR_NUMERIC || (m == 0 && status == PLUME_OK && slope >= 0))) {
 			// The exact Hessian is not positive definite on the constraints' tangent space
-			// (its factors' inertia says so, kkt.h): project, and keep projecting for the
-			// rest of this solve rather than pay for that test again.
+			// (its factors' inertia says so, kkt.h): project. The exact one is tried again
+			// after a full step (projected Newton alone is linear, too slow on the lab's
+			// locked meshes), and the next solve starts projected.
 			exact = false;
-			exact_failed = sim->exact_hessian_failed = true;
+			sim->exact_hessian_failed = true;
 			status = newton_system(sim, problem, exact, &phi, &residual, report, err);
 			if (status == PLUME_OK)
 				status = factor_and_solve(sim, exact, report, err);
+			slope = status == PLUME_OK ? free_dot(sim, g, step) : 0;
 		}
 		if (status != PLUME_OK)
 			return status;
-		double slope = 0;
-		for (int i = 0; i < n3; ++i)
-			slope += g[i] * step[i];
 		++report->newton_iterations;
 
 		double largest_multiplier = 0, step_size = 0;
@@ -357,7 +369,7 @@ plume_status plume_sim_newton(plume_sim *sim, const sim_problem *problem, plume_
 		memcpy(x, sim->trial, sizeof(plume_vec3) * (size_t)sim->vertex_count);
 		for (int k = 0; k < m; ++k)
 			sim->lambda[k] += alpha * (step[n3 + k] - sim->lambda[k]);
-		exact = alpha == 1 && !exact_failed;
+		exact = alpha == 1;
 	}
 	report->max_barb_strain = plume_sim_max_barb_strain(sim, x);
 	return plume_error_set(err, PLUME_ERROR_NUMERIC,

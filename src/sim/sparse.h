@@ -5,8 +5,10 @@
 // The factorisation is always simplicial: with Debian's reference BLAS the supernodal
 // method was slower on every plume system measured (Figure 1's isotropic vane: 3.7 s
 // against 0.73 s of factorisation; the 8000-element band model: 18 s against 13 s),
-// and without BLAS the bits do not depend on the thread count. AMD ordering; the
-// library never prints.
+// and without BLAS the bits do not depend on the thread count. The fill-reducing
+// ordering (the cheapest of AMD and two nested dissections, chosen once per pattern) is
+// applied to the pattern itself, so that every factorisation reads the matrix in place.
+// The library never prints.
 #ifndef PLUME_SIM_SPARSE_H
 #define PLUME_SIM_SPARSE_H
 
