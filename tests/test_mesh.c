@@ -471,7 +471,27 @@ static void test_explicit_guides(void **state)
 		assert_true(mesh->reference[v].y >= -1e-3 - 1e-9 && mesh->reference[v].y <= 0.1 + 1e-9);
 		assert_true(mesh->rest[v].z == 0.0);
 	}
+	// The estimate counts the rows and the guide vertices before any is placed: at least
+	// the mesh's vertices (trimming only removes some), at most the pool of placed ones.
+	plume_mesh_estimate estimate;
+	assert_int_equal(plume_mesh_estimate_guides(&guides, &def, &estimate, &err), PLUME_OK);
+	print_message("estimate %.0f vertices, %.0f faces, %.0f bytes; mesh %d vertices, %d faces\n", estimate.vertices,
+	              estimate.faces, estimate.bytes, mesh->vertex_count, mesh->face_count);
+	assert_true(estimate.vertices >= mesh->vertex_count && estimate.vertices <= 1.2 * mesh->vertex_count + 100);
+	assert_true(estimate.faces >= mesh->face_count);
+	assert_true(estimate.rachis_length > 0.099 && estimate.rachis_length < 0.101);
+	assert_true(estimate.longest_guide > 0.02 && estimate.longest_guide < 0.05);
+	assert_true(estimate.bytes >= PLUME_MESH_BYTES_PER_VERTEX * estimate.vertices);
 	plume_mesh_destroy(mesh);
+	// Past def.max_memory: PLUME_ERROR_LIMIT before the work, nothing built.
+	def.max_memory = (uint64_t)(0.5 * estimate.bytes);
+	assert_int_equal(plume_mesh_from_guides(&guides, &def, &mesh, &report, &err), PLUME_ERROR_LIMIT);
+	assert_null(mesh);
+	assert_non_null(strstr(err.message, "raise it with --max-memory"));
+	def.max_memory = (uint64_t)(2.0 * estimate.bytes);
+	assert_int_equal(plume_mesh_from_guides(&guides, &def, &mesh, &report, &err), PLUME_OK);
+	plume_mesh_destroy(mesh);
+	def.max_memory = 0;
 
 	// Widths are required for explicit guides.
 	def.rachis_width_base = 0.0;

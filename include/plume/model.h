@@ -120,8 +120,6 @@ typedef struct plume_spec_options {
 	void *progress_user;
 } plume_spec_options;
 
-/// The default of plume_spec_options.max_memory and of the CLI's --max-memory: 4 GiB.
-#define PLUME_DEFAULT_MAX_MEMORY (4ull << 30)
 
 /// Reads a feather spec from path and generates it. Syntax errors read
 /// "path:line:column: ..."; value errors "path: $.key.path: ...".

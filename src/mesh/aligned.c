@@ -75,10 +75,26 @@ typedef struct mesher {
 	mesh_strip *strip_list;
 	int strip_count;
 	int trimmed;
-	mesh_box *boxes; ///< the pool's box tree (build_index), 2 * leaf_count nodes
-	int leaf_count;  ///< a power of two, at least the number of buckets
+	mesh_box *boxes;   ///< the pool's box tree (build_index), 2 * leaf_count nodes
+	int leaf_count;    ///< a power of two, at least the number of buckets
+	double max_memory; ///< bytes (plume_mesh_def.max_memory)
 	plume_error *err;
 } mesher;
+
+/// Bytes a rachis row takes before any vertex is placed.
+static const double row_bytes = sizeof(mesh_row) + 2 * sizeof(mesh_line);
+
+/// PLUME_ERROR_LIMIT: what drives the size (the edge length, the rachis and
+/// guide lengths), the estimate and the limit.
+static plume_status limit_error(const mesher *m, const plume_mesh_estimate *estimate)
+{
+	return plume_error_set(m->err, PLUME_ERROR_LIMIT,
+	                       "edge_length %g m on a %.3g m rachis with guides up to %.3g m long makes %.0f rows and "
+	                       "about %.3g vertices, %.3g faces: %.3g GB while meshing; the limit is %.3g GB (raise it "
+	                       "with --max-memory, or use a larger edge_length)",
+	                       m->e, estimate->rachis_length, estimate->longest_guide, estimate->rows, estimate->vertices,
+	                       estimate->faces, estimate->bytes / 1e9, m->max_memory / 1e9);
+}
 
 static double cross2(plume_vec3 a, plume_vec3 b, plume_vec3 c)
 {
@@ -137,6 +153,13 @@ static plume_status place_rows(mesher *m)
 		return plume_error_set(m->err, PLUME_ERROR_SPEC,
 		                       "edge_length %g m is too small for a %g m rachis (%.0f rows): use a larger edge length",
 		                       e, end, total_steps + 1.0);
+	if ((total_steps + 1.0) * row_bytes > m->max_memory) {
+		plume_mesh_estimate rows_only = {.rows = total_steps + 1.0, .vertices = 2.0 * (total_steps + 1.0)};
+		rows_only.faces = 2.0 * rows_only.vertices;
+		rows_only.bytes = rows_only.rows * row_bytes;
+		rows_only.rachis_length = end;
+		return limit_error(m, &rows_only);
+	}
 	m->row_count = (int)total_steps + 1;
 	m->rows = plume_calloc((size_t)m->row_count, sizeof *m->rows);
 	if (m->rows == NULL)
@@ -274,17 +297,29 @@ static int clip_to_band(const mesh_row *row, int side, plume_vec3 *p, plume_vec2
 	return count;
 }
 
-/// Builds the guide through a row's rachis vertex on one side and places its vertices.
-static bool build_line(mesher *m, int side, int r)
+/// A row's guide on one side, in the plane, before its vertices are placed.
+typedef struct mesh_trace {
+	plume_vec3 p[MESH_GUIDE_SAMPLES + 1];
+	plume_vec2 uv[MESH_GUIDE_SAMPLES + 1];
+	int count;    ///< points in p and uv
+	double total; ///< plane arc length, m
+	double steps; ///< vertices after the root, one about every e (0: no guide); may be huge
+} mesh_trace;
+
+/// Traces the guide through a row's rachis vertex on one side. Returns false
+/// when the row has no guide there (trace->steps is 0 then too).
+static bool trace_line(const mesher *m, int side, int r, mesh_trace *trace)
 {
 	const mesh_input *in = m->input;
 	const mesh_row *row = m->rows + r;
 	const mesh_guide *guides = in->guides[side];
 	int n = in->guide_count[side];
-	mesh_line *line = m->lines + line_index(m, side, r);
-	memset(line, 0, sizeof *line);
+	plume_vec3 *p = trace->p;
+	plume_vec2 *uv = trace->uv;
+	trace->count = 0;
+	trace->total = trace->steps = 0.0;
 	if (n == 0 || row->sigma < in->sigma_first[side] - 0.5 * m->e || row->sigma > in->sigma_last[side] + 0.5 * m->e)
-		return true;
+		return false;
 
 	// The two guides rooted nearest along the rachis (thesis 6.2), or the end one.
 	int i0 = 0, i1 = 0;
@@ -304,8 +339,6 @@ static bool build_line(mesher *m, int side, int r)
 		i1 = hi;
 		alpha = (row->sigma - guides[lo].sigma) / (guides[hi].sigma - guides[lo].sigma);
 	}
-	plume_vec3 p[MESH_GUIDE_SAMPLES + 1];
-	plume_vec2 uv[MESH_GUIDE_SAMPLES + 1];
 	for (int k = 0; k < MESH_GUIDE_SAMPLES; ++k) {
 		p[k] = plume_v3_lerp(guides[i0].p[k], guides[i1].p[k], alpha);
 		plume_vec2 u0 = guides[i0].uv[k], u1 = guides[i1].uv[k];
@@ -313,7 +346,7 @@ static bool build_line(mesher *m, int side, int r)
 	}
 	int count = clip_to_band(row, side, p, uv);
 	if (count < 2)
-		return true; // the guide never leaves the rachis band: no vane here
+		return false; // the guide never leaves the rachis band: no vane here
 	// Shift the guide so that it starts at the rachis vertex, the shift fading
 	// to zero at the tip so that the tip stays on the barb tips' envelope.
 	plume_vec3 root = rachis_point(row, side);
@@ -330,18 +363,35 @@ static bool build_line(mesher *m, int side, int r)
 	p[0] = root;
 	uv[0] = (plume_vec2){0.0, row->t};
 	if (in->boundary != NULL && (count = clip_to_boundary(in, p, uv, count)) == 0)
-		return true;
-
+		return false;
 	double total = 0.0;
 	for (int k = 0; k + 1 < count; ++k)
 		total += sqrt(dist2(p[k], p[k + 1]));
-	int steps = total > 1e-6 * m->e ? (int)fmax(1.0, round(total / m->e)) : 0;
-	if (m->point_count + steps + 1 > MESH_MAX_VERTICES)
+	trace->count = count;
+	trace->total = total;
+	trace->steps = total > 1e-6 * m->e ? fmax(1.0, round(total / m->e)) : 0.0;
+	return true;
+}
+
+/// Places the vertices of a row's guide on one side (none when it has no guide).
+static bool build_line(mesher *m, int side, int r)
+{
+	mesh_line *line = m->lines + line_index(m, side, r);
+	memset(line, 0, sizeof *line);
+	mesh_trace trace;
+	if (!trace_line(m, side, r, &trace))
+		return true;
+	const plume_vec3 *p = trace.p;
+	const plume_vec2 *uv = trace.uv;
+	int count = trace.count;
+	double total = trace.total;
+	if (!(m->point_count + trace.steps + 1.0 <= MESH_MAX_VERTICES))
 		return false;
+	int steps = (int)trace.steps;
 	line->present = true;
 	line->first = m->point_count;
 	line->count = line->full = steps + 1;
-	if (!push_point(m, root, uv[0]))
+	if (!push_point(m, p[0], uv[0]))
 		return false;
 	int segment = 0;
 	double start = 0.0;
@@ -1184,11 +1234,60 @@ static plume_status assemble(mesher *m, plume_mesh **out, plume_mesh_report *rep
 	return PLUME_OK;
 }
 
+/// Counts what the placed rows' guides would add (trace_line), without placing it.
+static void count_mesh(const mesher *m, plume_mesh_estimate *out)
+{
+	const mesh_centre *rachis = &m->input->rachis;
+	*out = (plume_mesh_estimate){.rows = m->row_count, .rachis_length = rachis->sigma[rachis->count - 1]};
+	double pool = 0.0; // guide points, the roots included
+	for (int side = 0; side < 2; ++side)
+		for (int r = 0; r < m->row_count; ++r) {
+			mesh_trace trace;
+			if (!trace_line(m, side, r, &trace))
+				continue;
+			pool += trace.steps + 1.0;
+			out->longest_guide = fmax(out->longest_guide, trace.total);
+		}
+	out->vertices = 2.0 * m->row_count + pool;
+	out->faces = 2.0 * out->vertices;
+	out->bytes = m->row_count * row_bytes + PLUME_MESH_BYTES_PER_VERTEX * out->vertices;
+}
+
+/// Places the rows (refusing past the limit before allocating them) and counts the rest.
+static plume_status mesh_begin(mesher *m, const mesh_input *input, const plume_mesh_def *def,
+                               plume_mesh_estimate *estimate, plume_error *err)
+{
+	*m = (mesher){.input = input,
+	              .e = def->edge_length,
+	              .include_calamus = def->include_calamus,
+	              .max_memory = (double)(def->max_memory > 0 ? def->max_memory : PLUME_DEFAULT_MAX_MEMORY),
+	              .err = err};
+	plume_status status = place_rows(m);
+	if (status != PLUME_OK)
+		return status;
+	count_mesh(m, estimate);
+	return PLUME_OK;
+}
+
+static void mesh_end(mesher *m)
+{
+	plume_free(m->rows);
+	plume_free(m->lines);
+	plume_free(m->points);
+	plume_free(m->uvs);
+	plume_free(m->ids);
+	plume_free(m->strip_list);
+	plume_free(m->boxes);
+}
+
 static plume_status mesh_run(const mesh_input *input, const plume_mesh_def *def, plume_mesh **out,
                              plume_mesh_report *report, plume_error *err)
 {
-	mesher m = {.input = input, .e = def->edge_length, .include_calamus = def->include_calamus, .err = err};
-	plume_status status = place_rows(&m);
+	mesher m;
+	plume_mesh_estimate estimate;
+	plume_status status = mesh_begin(&m, input, def, &estimate, err);
+	if (status == PLUME_OK && !(estimate.bytes <= m.max_memory))
+		status = limit_error(&m, &estimate);
 	if (status == PLUME_OK) {
 		m.lines = plume_calloc((size_t)(2 * m.row_count), sizeof *m.lines);
 		if (m.lines == NULL)
@@ -1206,13 +1305,16 @@ static plume_status mesh_run(const mesh_input *input, const plume_mesh_def *def,
 		status = plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory");
 	if (status == PLUME_OK)
 		status = assemble(&m, out, report);
-	plume_free(m.rows);
-	plume_free(m.lines);
-	plume_free(m.points);
-	plume_free(m.uvs);
-	plume_free(m.ids);
-	plume_free(m.strip_list);
-	plume_free(m.boxes);
+	mesh_end(&m);
+	return status;
+}
+
+static plume_status mesh_estimate(const mesh_input *input, const plume_mesh_def *def, plume_mesh_estimate *out,
+                                  plume_error *err)
+{
+	mesher m;
+	plume_status status = mesh_begin(&m, input, def, out, err);
+	mesh_end(&m);
 	return status;
 }
 
@@ -1242,6 +1344,36 @@ plume_status plume_mesh_from_guides(const plume_mesh_guides *guides, const plume
 	if (status != PLUME_OK)
 		return status;
 	status = mesh_run(&input, def, out, report, err);
+	mesh_input_free(&input);
+	return status;
+}
+
+plume_status plume_mesh_estimate_feather(const plume_feather *feather, const plume_mesh_def *def,
+                                         plume_mesh_estimate *out, plume_error *err)
+{
+	assert(feather != NULL && def != NULL && out != NULL);
+	assert(def->cookie == PLUME_DEF_COOKIE && "plume_mesh_def not from plume_mesh_default_def()");
+	memset(out, 0, sizeof *out);
+	mesh_input input;
+	plume_status status = mesh_input_from_feather(feather, def, &input, err);
+	if (status != PLUME_OK)
+		return status;
+	status = mesh_estimate(&input, def, out, err);
+	mesh_input_free(&input);
+	return status;
+}
+
+plume_status plume_mesh_estimate_guides(const plume_mesh_guides *guides, const plume_mesh_def *def,
+                                        plume_mesh_estimate *out, plume_error *err)
+{
+	assert(guides != NULL && def != NULL && out != NULL);
+	assert(def->cookie == PLUME_DEF_COOKIE && "plume_mesh_def not from plume_mesh_default_def()");
+	memset(out, 0, sizeof *out);
+	mesh_input input;
+	plume_status status = mesh_input_from_guides(guides, def, &input, err);
+	if (status != PLUME_OK)
+		return status;
+	status = mesh_estimate(&input, def, out, err);
 	mesh_input_free(&input);
 	return status;
 }
