@@ -150,6 +150,17 @@ edit "$bad/scene-short.json" "$bad/scene-fine.json" "d['mesh']['edge_length'] = 
 expect_no_output "scene mesh past the limit" 5 'scene-fine.json: edge_length 1e-06 m on a' "$scratch/m5" \
 	$T "$plume" simulate "$bad/scene-fine.json" -o "$scratch/m5"
 
+# --- renders past the limit: pixels x images (cli/render.c, plume_raytrace_estimate_bytes) ---
+expect_no_output "render turntable of 100 16384^2 images" 5 \
+	'filoplume.json: 100 image(s) of 16384x16384 pixels' "$scratch/r1" \
+	$T "$plume" render "$examples/franco-walter/filoplume.json" -o "$scratch/r1" --size 16384x16384 --turntable 100
+check "render limit names the estimate and --max-memory" \
+	grep -qF 'take about 110 GB; the limit is 4.29 GB (raise it with --max-memory' "$scratch/err.txt"
+expect_no_output "render 4096^2 past --max-memory 64M" 5 'take about 0.201 GB; the limit is 0.0671 GB' "$scratch/r2" \
+	$T "$plume" render "$examples/franco-walter/filoplume.json" -o "$scratch/r2" --size 4096x4096 --max-memory 64M
+expect_no_output "render a strip past --max-memory 256M" 5 'held at once' "$scratch/r3" \
+	$T "$plume" render "$scratch/o17" -o "$scratch/r3" --strip 3 --size 8192x8192 --max-memory 256M
+
 # --- all or nothing over an earlier run (cli/output.c) -----------------------------------
 edit "$bad/scene-short.json" "$bad/scene-three.json" "d['duration'] = 0.033"
 run=$scratch/run
