@@ -150,6 +150,18 @@ edit "$bad/scene-short.json" "$bad/scene-fine.json" "d['mesh']['edge_length'] = 
 expect_no_output "scene mesh past the limit" 5 'scene-fine.json: edge_length 1e-06 m on a' "$scratch/m5" \
 	$T "$plume" simulate "$bad/scene-fine.json" -o "$scratch/m5"
 
+# --- a Franco-Walter feather past the limit: barbs x samples (plume_fw_estimate_bytes) -------
+edit "$examples/franco-walter/hawk.json" "$bad/fw-dense.json" \
+	"d['barb_samples'] = 1000; d['segments'][0]['barb_count'] = 5000; d['segments'][1]['barb_count'] = 5000"
+expect_no_output "FW 20000 barbs x 1000 samples past --max-memory 64M" 5 \
+	'fw-dense.json: $.segments[*].barb_count (5000 and 5000 barbs a vane) x $.barb_samples (1000)' "$scratch/g1" \
+	$T "$plume" generate "$bad/fw-dense.json" -o "$scratch/g1" --max-memory 64M
+check "FW limit names the estimate and --max-memory" \
+	grep -qF 'make a feather of about 1.6 GB; the limit is 0.0671 GB (raise it with --max-memory' "$scratch/err.txt"
+edit "$bad/fw-dense.json" "$bad/fw-range.json" "d['segments'][0]['barb_count'] = 6000"
+expect_no_output "FW out of range wins over the limit" 3 '$.segments[0].barb_count' "$scratch/g2" \
+	$T "$plume" generate "$bad/fw-range.json" -o "$scratch/g2" --max-memory 64M
+
 # --- renders past the limit: pixels x images (cli/render.c, plume_raytrace_estimate_bytes) ---
 expect_no_output "render turntable of 100 16384^2 images" 5 \
 	'filoplume.json: 100 image(s) of 16384x16384 pixels' "$scratch/r1" \
