@@ -43,6 +43,8 @@ void cli_help_generate(void)
 	     "      --size WxH         image size in pixels (default: 1200 tall, width to fit)\n"
 	     "  -t, --texture IMAGE    colour the barbs from IMAGE (Franco & Walter 4.4) instead\n"
 	     "                         of the line style; feather.glb embeds IMAGE\n"
+	     "      --max-memory BYTES refuse a Franco-Walter feather estimated past BYTES (K, M, G\n"
+	     "                         suffixes; default 4G): 80 B a point (docs/cli.md)\n"
 	     "  -h, --help             this help\n"
 	     "\n"
 	     "Specs are described in docs/spec-franco-walter.md and docs/spec-zhang-kanai.md;\n"
@@ -57,6 +59,7 @@ int cli_generate(int argc, char **argv)
 	    {"format", required_argument, NULL, 'f'},
 	    {"size", required_argument, NULL, 'S'},
 	    {"texture", required_argument, NULL, 't'},
+	    {"max-memory", required_argument, NULL, 'M'},
 	    {"help", no_argument, NULL, 'h'},
 	    {NULL, 0, NULL, 0},
 	};
@@ -84,6 +87,10 @@ int cli_generate(int argc, char **argv)
 				return CLI_EXIT_USAGE;
 			break;
 		case 't': texture_path = optarg; break;
+		case 'M':
+			if (!cli_parse_memory("generate", optarg, &spec_options.max_memory))
+				return CLI_EXIT_USAGE;
+			break;
 		case 'h': cli_help_generate(); return CLI_EXIT_OK;
 		case ':': return cli_usage_error("generate", "option '%s' needs a value", argv[optind - 1]);
 		default: return cli_usage_error("generate", "unknown option '%s'", argv[optind - 1]);

@@ -40,6 +40,8 @@ void cli_help_mesh(void)
 	     "  -s, --seed N            random seed of a feather spec; overrides its \"seed\"\n"
 	     "      --size WxH          image size in pixels (default: 1200 tall)\n"
 	     "  -f, --format LIST       comma-separated: obj,png,glb (default: obj,png)\n"
+	     "      --max-memory BYTES  refuse a mesh estimated past BYTES (K, M, G suffixes;\n"
+	     "                          default 4G): about 320 bytes a vertex (docs/cli.md)\n"
 	     "  -h, --help              this help\n"
 	     "\n"
 	     "The guides spec is described in docs/meshing.md.");
@@ -177,6 +179,7 @@ int cli_mesh(int argc, char **argv)
 	    {"size", required_argument, NULL, 'S'},
 	    {"help", no_argument, NULL, 'h'},
 	    {"format", required_argument, NULL, 'f'},
+	    {"max-memory", required_argument, NULL, 'M'},
 	    {NULL, 0, NULL, 0},
 	};
 	const char *output_dir = NULL;
@@ -207,6 +210,10 @@ int cli_mesh(int argc, char **argv)
 				return CLI_EXIT_USAGE;
 			if ((formats & ~(unsigned)(CLI_FORMAT_OBJ | CLI_FORMAT_PNG | CLI_FORMAT_GLB)) != 0)
 				return cli_usage_error("mesh", "--format '%s': a mesh writes obj, png, glb", optarg);
+			break;
+		case 'M':
+			if (!cli_parse_memory("mesh", optarg, &spec_options.max_memory))
+				return CLI_EXIT_USAGE;
 			break;
 		case 'h': cli_help_mesh(); return CLI_EXIT_OK;
 		case ':': return cli_usage_error("mesh", "option '%s' needs a value", argv[optind - 1]);

@@ -41,6 +41,9 @@ void cli_help_render(void)
 	     "  -c, --camera FILE      camera, lights and render settings (docs/rendering.md);\n"
 	     "                         default: automatic framing of the feather from the front\n"
 	     "      --spp N            samples per pixel, [1, 4096] (default 16)\n"
+	     "      --max-memory BYTES refuse images estimated past BYTES (K, M, G suffixes; default\n"
+	     "                         4G): 8 B a pixel while rendering, 4 B a pixel per image\n"
+	     "                         written and per image held (--strip) (docs/cli.md)\n"
 	     "      --size WxH         image size in pixels (default 800x800)\n"
 	     "  -s, --seed N           seed of the sampling (spec renders also use it for the feather)\n"
 	     "  -t, --texture IMAGE    colour the barbs from IMAGE (Franco & Walter 4.4)\n"
@@ -65,6 +68,7 @@ typedef struct render_options {
 	unsigned formats;
 	bool frames_given; ///< --frames: render frame numbers first, first + step, ... <= last
 	int frame_first, frame_last, frame_step;
+	uint64_t max_memory; ///< --max-memory (0: PLUME_DEFAULT_MAX_MEMORY)
 } render_options;
 
 static bool parse_count(const char *text, int lo, int hi, int *out)
@@ -93,6 +97,7 @@ static int parse_options(int argc, char **argv, render_options *o)
 	    {"shell", no_argument, NULL, 'm'},
 	    {"format", required_argument, NULL, 'f'},
 	    {"frames", required_argument, NULL, 'F'},
+	    {"max-memory", required_argument, NULL, 'M'},
 	    {"help", no_argument, NULL, 'h'},
 	    {NULL, 0, NULL, 0},
 	};
@@ -167,6 +172,10 @@ static int parse_options(int argc, char **argv, render_options *o)
 			o->frames_given = true;
 			break;
 		}
+		case 'M':
+			if (!cli_parse_memory("render", optarg, &o->max_memory))
+				return CLI_EXIT_USAGE;
+			break;
 		case 'h': cli_help_render(); return -1;
 		case ':': return cli_usage_error("render", "option '%s' needs a value", argv[optind - 1]);
 		default: return cli_usage_error("render", "unknown option '%s'", argv[optind - 1]);
@@ -176,6 +185,22 @@ static int parse_options(int argc, char **argv, render_options *o)
 		return CLI_EXIT_USAGE;
 	o->input = argv[optind];
 	return CLI_EXIT_OK;
+}
+
+/// Refuses (PLUME_ERROR_LIMIT) images whose estimate (plume_raytrace_estimate_bytes) passes --max-memory.
+static plume_status check_images(const render_options *o, const plume_raytrace_def *def, int images, int held,
+                                 const char *count_keys, plume_error *err)
+{
+	double bytes = plume_raytrace_estimate_bytes(def, images, held);
+	double limit = (double)(o->max_memory > 0 ? o->max_memory : PLUME_DEFAULT_MAX_MEMORY);
+	if (bytes <= limit)
+		return PLUME_OK;
+	return plume_error_set(err, PLUME_ERROR_LIMIT,
+	                       "%s: %d image(s) of %dx%d pixels (--size or the camera's $.camera.size; %s), %d held at "
+	                       "once, take about %.3g GB; the limit is %.3g GB (raise it with --max-memory, or render "
+	                       "fewer or smaller images)",
+	                       o->input, images, def->camera.width, def->camera.height, count_keys, held, bytes / 1e9,
+	                       limit / 1e9);
 }
 
 /// The render settings: defaults, then the camera file, then the command line.
@@ -231,7 +256,7 @@ static bool is_coat_spec(const char *path)
 static plume_status render_spec(const render_options *o, const plume_raytrace_def *def, cli_output *output,
                                 plume_error *err)
 {
-	plume_spec_options spec_options = {.seed = o->seed, .seed_given = o->seed_given};
+	plume_spec_options spec_options = {.seed = o->seed, .seed_given = o->seed_given, .max_memory = o->max_memory};
 	plume_feather *feather = NULL;
 	plume_coat *coat = NULL;
 	const plume_feather **list = NULL;
@@ -263,10 +288,11 @@ static plume_status render_spec(const render_options *o, const plume_raytrace_de
 	}
 	scene.feathers = list;
 	char path[4608];
-	if (o->turntable == 0) {
+	status = check_images(o, def, o->turntable > 0 ? o->turntable : 1, 0, "--turntable", err);
+	if (status == PLUME_OK && o->turntable == 0) {
 		cli_output_path(output, "feather.png", path, sizeof path);
 		status = plume_raytrace_render_png(&scene, def, path, NULL, err);
-	} else {
+	} else if (status == PLUME_OK) {
 		char folder[4352];
 		status = stage_folder(output, "turntable", folder, sizeof folder, err);
 		plume_raytrace_def frame = *def;
@@ -488,6 +514,9 @@ static plume_status render_sim(const render_options *o, const plume_raytrace_def
 		    err, PLUME_ERROR_SPEC, "%s: no frame in --frames %d:%d:%d (the frames are %.*s to %.*s)", o->input,
 		    o->frame_first, o->frame_last, o->frame_step, (int)strlen(in.frame_names[0]) - 4, in.frame_names[0],
 		    (int)strlen(in.frame_names[in.frame_count - 1]) - 4, in.frame_names[in.frame_count - 1]);
+	const int slots = o->strip < in.frame_count ? o->strip : in.frame_count;
+	if (status == PLUME_OK)
+		status = check_images(o, &frame_def, selected + (slots > 0), slots, "the frames, --frames, --strip", err);
 	if (status == PLUME_OK && o->frames_given) {
 		cli_output_path(output, "frames", folder, sizeof folder);
 		if (mkdir(folder, 0777) != 0)
@@ -496,8 +525,7 @@ static plume_status render_sim(const render_options *o, const plume_raytrace_def
 		status = stage_folder(output, "frames", folder, sizeof folder, err);
 	const int w = frame_def.camera.width, h = frame_def.camera.height;
 	uint8_t *image = malloc(4 * (size_t)w * (size_t)h);
-	// A strip of more frames than there are shows each frame once.
-	const int slots = o->strip < in.frame_count ? o->strip : in.frame_count;
+	// A strip of more frames than there are shows each frame once (slots).
 	uint8_t *strip = slots > 0 ? calloc(4 * (size_t)w * (size_t)h, (size_t)slots) : NULL;
 	if (status == PLUME_OK && (image == NULL || (slots > 0 && strip == NULL)))
 		status = plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory for the images");

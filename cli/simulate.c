@@ -451,6 +451,7 @@ int cli_simulate(int argc, char **argv)
 
 	plume_error err = {0}, failure = {0};
 	plume_scene *scene = NULL;
+	spec_options.max_memory = max_bytes; // the feather and its mesh too
 	plume_status status = plume_scene_load(argv[optind], &spec_options, &scene, &err);
 	if (status != PLUME_OK)
 		return cli_fail(&err);

@@ -471,7 +471,27 @@ static void test_explicit_guides(void **state)
 		assert_true(mesh->reference[v].y >= -1e-3 - 1e-9 && mesh->reference[v].y <= 0.1 + 1e-9);
 		assert_true(mesh->rest[v].z == 0.0);
 	}
+	// The estimate counts the rows and the guide vertices before any is placed: at least
+	// the mesh's vertices (trimming only removes some), at most the pool of placed ones.
+	plume_mesh_estimate estimate;
+	assert_int_equal(plume_mesh_estimate_guides(&guides, &def, &estimate, &err), PLUME_OK);
+	print_message("estimate %.0f vertices, %.0f faces, %.0f bytes; mesh %d vertices, %d faces\n", estimate.vertices,
+	              estimate.faces, estimate.bytes, mesh->vertex_count, mesh->face_count);
+	assert_true(estimate.vertices >= mesh->vertex_count && estimate.vertices <= 1.2 * mesh->vertex_count + 100);
+	assert_true(estimate.faces >= mesh->face_count);
+	assert_true(estimate.rachis_length > 0.099 && estimate.rachis_length < 0.101);
+	assert_true(estimate.longest_guide > 0.02 && estimate.longest_guide < 0.05);
+	assert_true(estimate.bytes >= PLUME_MESH_BYTES_PER_VERTEX * estimate.vertices);
 	plume_mesh_destroy(mesh);
+	// Past def.max_memory: PLUME_ERROR_LIMIT before the work, nothing built.
+	def.max_memory = (uint64_t)(0.5 * estimate.bytes);
+	assert_int_equal(plume_mesh_from_guides(&guides, &def, &mesh, &report, &err), PLUME_ERROR_LIMIT);
+	assert_null(mesh);
+	assert_non_null(strstr(err.message, "raise it with --max-memory"));
+	def.max_memory = (uint64_t)(2.0 * estimate.bytes);
+	assert_int_equal(plume_mesh_from_guides(&guides, &def, &mesh, &report, &err), PLUME_OK);
+	plume_mesh_destroy(mesh);
+	def.max_memory = 0;
 
 	// Widths are required for explicit guides.
 	def.rachis_width_base = 0.0;
@@ -537,6 +557,53 @@ static void test_guides_spec_splines(void **state)
 	assert_aligned_mesh(mesh, &report, report.edge_length);
 	plume_mesh_destroy(mesh);
 	test_remove_tree(dir);
+}
+
+/// A feather five times the example's size: the strip walk's spatial index
+/// (src/mesh/aligned.c) gives the scan's mesh. The counts are those the
+/// mesher gave before the index (it took 5x longer here, 150x at 20x the size).
+static void test_tall_guides(void **state)
+{
+	(void)state;
+	int64_t before = plume_bytes_in_use();
+	char path[640];
+	snprintf(path, sizeof path, "%s/tests/data/tall-guides.json", PLUME_SOURCE_DIR);
+	plume_mesh_spec_options options = plume_mesh_spec_default_options();
+	plume_mesh *mesh = NULL;
+	plume_mesh_report report;
+	plume_error err;
+	if (plume_mesh_spec_read(path, &options, &mesh, &report, &err) != PLUME_OK)
+		fail_msg("%s", err.message);
+	assert_int_equal(mesh->vertex_count, 10024);
+	assert_int_equal(mesh->face_count, 19735);
+	assert_int_equal(mesh->barb_edge_count, 9722);
+	assert_int_equal(report.vertices_trimmed, 98);
+	assert_int_equal(report.guide_count[0], 149);
+	assert_int_equal(report.guide_count[1], 150);
+	assert_true(report.aligned_fraction == 1.0);
+	plume_mesh_destroy(mesh);
+	assert_int_equal(plume_bytes_in_use(), before);
+}
+
+/// The last safety net finds overlapping faces through a grid (src/mesh/aligned.c,
+/// find_overlap) and names the face the sweep over x-sorted boxes named before.
+static void test_overlap_reported(void **state)
+{
+	(void)state;
+	int64_t before = plume_bytes_in_use();
+	char path[640];
+	snprintf(path, sizeof path, "%s/examples/franco-walter/peacock.json", PLUME_SOURCE_DIR);
+	plume_mesh_spec_options options = plume_mesh_spec_default_options();
+	options.edge_length = 0.001;
+	options.seed = 4;
+	options.seed_given = true;
+	plume_mesh *mesh = NULL;
+	plume_error err;
+	assert_int_equal(plume_mesh_spec_read(path, &options, &mesh, NULL, &err), PLUME_ERROR_NUMERIC);
+	assert_null(mesh);
+	if (strstr(err.message, "fold over one another near (-0.0270704, 0.126913) m") == NULL)
+		fail_msg("%s", err.message);
+	assert_int_equal(plume_bytes_in_use(), before);
 }
 
 // ---------------------------------------------------------------------------
@@ -702,6 +769,8 @@ int main(void)
 	    cmocka_unit_test(test_explicit_guides),
 	    cmocka_unit_test(test_guides_spec_errors),
 	    cmocka_unit_test(test_guides_spec_splines),
+	    cmocka_unit_test(test_tall_guides),
+	    cmocka_unit_test(test_overlap_reported),
 	    cmocka_unit_test(test_obj_round_trip),
 	    cmocka_unit_test(test_obj_reader),
 	    cmocka_unit_test(test_groups_and_barb_edges),

@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "model/zhang_kanai_internal.h"
 #include "plume/zhang_kanai.h"
 #include "support.h"
 
@@ -703,9 +704,31 @@ static void test_no_leaks(void **state)
 	assert_int_equal(plume_bytes_in_use(), before);
 }
 
+/// Unfurling wraps angle differences into (-pi, pi] (zhang_kanai_unfurl.c): a turn at a time
+/// for sane values (bit for bit as before), bounded for any value (1e20 and inf looped forever).
+static void test_wrap_angle_is_bounded(void **state)
+{
+	(void)state;
+	const double pi = 3.14159265358979323846;
+	assert_true(zk_wrap_angle(1.5 * pi) == 1.5 * pi - 2.0 * pi);
+	assert_true(zk_wrap_angle(-pi) == -pi + 2.0 * pi);
+	assert_true(zk_wrap_angle(0.25) == 0.25);
+	double a = 7.0 * pi + 0.5, turned = a;
+	while (turned > pi)
+		turned -= 2.0 * pi;
+	assert_true(zk_wrap_angle(a) == turned);
+	double huge = zk_wrap_angle(1e20);
+	assert_true(huge > -pi && huge <= pi);
+	assert_true(huge == remainder(1e20, 2.0 * pi)); // exact: 1e20 less a whole number of turns
+	assert_true(isnan(zk_wrap_angle(INFINITY)));
+	assert_true(isnan(zk_wrap_angle(-INFINITY)));
+	assert_true(isnan(zk_wrap_angle(NAN)));
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
+	    cmocka_unit_test(test_wrap_angle_is_bounded),
 	    cmocka_unit_test(test_emitters_monotone_and_clamped),
 	    cmocka_unit_test(test_constant_speed_matches_exact_loci),
 	    cmocka_unit_test(test_rk4_converges_at_fourth_order),

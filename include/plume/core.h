@@ -61,6 +61,10 @@ typedef struct plume_error {
 /// on in every build type unless libplume is configured with -DPLUME_DISABLE_ASSERTS=ON.
 #define PLUME_DEF_COOKIE 0x706c756du
 
+/// The default of every max_memory (plume_spec_options, plume_mesh_def) and of the CLI's
+/// --max-memory: 4 GiB (docs/cli.md, "Limits").
+#define PLUME_DEFAULT_MAX_MEMORY (4ull << 30)
+
 /// Short stable name of a status ("io", "syntax", "spec", ...).
 const char *plume_status_name(plume_status status);
 

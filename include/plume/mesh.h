@@ -70,6 +70,10 @@ typedef struct plume_mesh_def {
 	double rachis_width_tip;
 	/// Keep the bare calamus below the vane as rachis faces. Default true.
 	bool include_calamus;
+	/// Bytes the mesher may use, estimated before it places the guide vertices
+	/// (plume_mesh_estimate_feather); PLUME_ERROR_LIMIT past it. 0 (the default)
+	/// means PLUME_DEFAULT_MAX_MEMORY.
+	uint64_t max_memory;
 	/// PLUME_DEF_COOKIE, set by plume_mesh_default_def; do not change.
 	uint32_t cookie;
 } plume_mesh_def;
@@ -122,6 +126,31 @@ typedef struct plume_mesh_guides {
 plume_status plume_mesh_from_guides(const plume_mesh_guides *guides, const plume_mesh_def *def, plume_mesh **out,
                                     plume_mesh_report *report, plume_error *err);
 
+/// What meshing would build, counted before the work: the rows along the rachis
+/// and the guide vertices every edge length along each row's guide, as the mesher
+/// places them before any trimming (so an upper bound of the mesh's vertices).
+typedef struct plume_mesh_estimate {
+	double rows;          ///< rachis rows, two rachis vertices each
+	double vertices;      ///< guide and rachis vertices, at most
+	double faces;         ///< faces, at most (two per vertex)
+	double bytes;         ///< the mesher's peak memory, about PLUME_MESH_BYTES_PER_VERTEX a vertex
+	double rachis_length; ///< plane arc length of the rachis, m
+	double longest_guide; ///< the longest guide line, m (clipped to, or extended to, the boundary)
+} plume_mesh_estimate;
+
+/// Bytes the mesher and its mesh take per vertex, about: the point pool (grown
+/// by doubling), its spatial index, the mesh's arrays and two faces with their
+/// overlap check.
+#define PLUME_MESH_BYTES_PER_VERTEX 320
+
+/// Counts what plume_mesh_from_feather (def) would build, without building it;
+/// fails as it would on a feather it cannot mesh (a shaft too short, no width).
+plume_status plume_mesh_estimate_feather(const plume_feather *feather, const plume_mesh_def *def,
+                                         plume_mesh_estimate *out, plume_error *err);
+/// The same for plume_mesh_from_guides.
+plume_status plume_mesh_estimate_guides(const plume_mesh_guides *guides, const plume_mesh_def *def,
+                                        plume_mesh_estimate *out, plume_error *err);
+
 /// Options of plume_mesh_spec_read.
 typedef struct plume_mesh_spec_options {
 	/// > 0: overrides the spec's edge length, m. Default 0 (the spec's, else plume_mesh_default_def's).
@@ -129,6 +158,9 @@ typedef struct plume_mesh_spec_options {
 	/// Overrides a feather spec's "seed" when seed_given is true.
 	uint64_t seed;
 	bool seed_given;
+	/// Bytes generating the feather and meshing it may take (plume_spec_options.max_memory,
+	/// plume_mesh_def.max_memory). Default 0: PLUME_DEFAULT_MAX_MEMORY.
+	uint64_t max_memory;
 } plume_mesh_spec_options;
 
 plume_mesh_spec_options plume_mesh_spec_default_options(void);

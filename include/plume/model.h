@@ -85,6 +85,11 @@ plume_fw_def plume_fw_default_def(void);
 /// path of the spec ("$.segments[1].barb_count is 6000, allowed [0, 5000]").
 plume_status plume_fw_def_validate(const plume_fw_def *def, plume_error *err);
 
+/// Bytes the feather of def takes, counted before the work: its points (the shaft's
+/// shaft_samples and barb_samples for each barb of both vanes) times the feather's five
+/// per-point arrays (position, normal, arc length, width, uv).
+double plume_fw_estimate_bytes(const plume_fw_def *def);
+
 /// Generates the feather. Same def and seed, same bytes, on every machine.
 plume_status plume_fw_generate(const plume_fw_def *def, uint64_t seed, plume_feather **out, plume_error *err);
 
@@ -120,8 +125,6 @@ typedef struct plume_spec_options {
 	void *progress_user;
 } plume_spec_options;
 
-/// The default of plume_spec_options.max_memory and of the CLI's --max-memory: 4 GiB.
-#define PLUME_DEFAULT_MAX_MEMORY (4ull << 30)
 
 /// Reads a feather spec from path and generates it. Syntax errors read
 /// "path:line:column: ..."; value errors "path: $.key.path: ...".

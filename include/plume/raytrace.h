@@ -182,6 +182,12 @@ void plume_raytrace_scene_bounds(const plume_raytrace_scene *scene, plume_vec3 *
 plume_status plume_raytrace_render(const plume_raytrace_scene *scene, const plume_raytrace_def *def, uint8_t *rgba,
                                    plume_raytrace_stats *stats, plume_error *err);
 
+/// Bytes that rendering `images` images of def's camera size takes, about: 8 B a pixel while one
+/// renders (its RGBA buffer and the PNG encoder's surface), 4 B a pixel for each image written (a
+/// PNG is at most about its raw pixels) and 4 B a pixel for each of `held` images kept in memory
+/// together (a strip of frames). Callers compare it with their limit before the work (docs/cli.md).
+double plume_raytrace_estimate_bytes(const plume_raytrace_def *def, int images, int held);
+
 /// Renders and writes a PNG atomically: the file appears whole or not at all.
 plume_status plume_raytrace_render_png(const plume_raytrace_scene *scene, const plume_raytrace_def *def,
                                        const char *path, plume_raytrace_stats *stats, plume_error *err);

@@ -44,6 +44,18 @@ plume_status plume_fw_spec_generate(const char *file, const json_t *root, const 
 		return status;
 	if (options != NULL && options->seed_given)
 		seed = options->seed;
+	double bytes = plume_fw_estimate_bytes(&def);
+	double limit =
+	    (double)(options != NULL && options->max_memory > 0 ? options->max_memory : PLUME_DEFAULT_MAX_MEMORY);
+	if (!(bytes <= limit) && plume_fw_def_validate(&def, err) == PLUME_OK)
+		return plume_error_set(err, PLUME_ERROR_LIMIT,
+		                       "%s: $.segments[*].barb_count (%d and %d barbs a vane) x $.barb_samples (%d) and "
+		                       "$.shaft_samples (%d) make a feather of about %.3g GB; the limit is %.3g GB (raise it "
+		                       "with --max-memory, or lower them)",
+		                       file, def.segments[0].barb_count, def.segments[1].barb_count, def.barb_samples,
+		                       def.shaft_samples, bytes / 1e9, limit / 1e9);
+	if (!(bytes <= limit))
+		return err != NULL ? err->status : PLUME_ERROR_SPEC;
 	return plume_fw_generate(&def, seed, out, err);
 }
 

@@ -273,6 +273,7 @@ plume_status plume_mesh_spec_read(const char *path, const plume_mesh_spec_option
 	if (root == NULL)
 		return err != NULL ? err->status : PLUME_ERROR_IO;
 	plume_mesh_def def = plume_mesh_default_def();
+	def.max_memory = options->max_memory;
 	plume_status status = PLUME_OK;
 	if (json_is_object(root) && json_object_get(root, "guides") != NULL) {
 		plume_spec_reader reader = plume_spec_reader_begin(path, err);
@@ -295,7 +296,8 @@ plume_status plume_mesh_spec_read(const char *path, const plume_mesh_spec_option
 		}
 		plume_mesh_guides_storage_free(&storage);
 	} else {
-		plume_spec_options spec_options = {.seed = options->seed, .seed_given = options->seed_given};
+		plume_spec_options spec_options = {
+		    .seed = options->seed, .seed_given = options->seed_given, .max_memory = options->max_memory};
 		plume_feather *feather = NULL;
 		status = plume_spec_generate(path, &spec_options, &feather, err);
 		if (status == PLUME_OK) {

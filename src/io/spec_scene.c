@@ -388,6 +388,7 @@ static plume_status build_mesh(const char *file, const json_t *root, const plume
 {
 	plume_spec_reader reader = plume_spec_reader_begin(file, err);
 	plume_mesh_def mesh_def = plume_mesh_default_def();
+	mesh_def.max_memory = options != NULL ? options->max_memory : 0;
 	const json_t *mesh = plume_spec_object(&reader, root, "$", "mesh");
 	if (mesh != NULL)
 		plume_spec_mesh_def(&reader, mesh, "$.mesh", &mesh_def);

@@ -51,6 +51,11 @@ typedef struct mesh_line {
 	int full;  ///< vertices before any trimming
 } mesh_line;
 
+/// An axis-aligned box in the feather plane; empty when x0 > x1.
+typedef struct mesh_box {
+	double x0, y0, x1, y1;
+} mesh_box;
+
 typedef struct mesh_strip {
 	int a, b; ///< line indices; walking from a to b turns counter-clockwise
 	bool shared_end;
@@ -70,8 +75,26 @@ typedef struct mesher {
 	mesh_strip *strip_list;
 	int strip_count;
 	int trimmed;
+	mesh_box *boxes;   ///< the pool's box tree (build_index), 2 * leaf_count nodes
+	int leaf_count;    ///< a power of two, at least the number of buckets
+	double max_memory; ///< bytes (plume_mesh_def.max_memory)
 	plume_error *err;
 } mesher;
+
+/// Bytes a rachis row takes before any vertex is placed.
+static const double row_bytes = sizeof(mesh_row) + 2 * sizeof(mesh_line);
+
+/// PLUME_ERROR_LIMIT: what drives the size (the edge length, the rachis and
+/// guide lengths), the estimate and the limit.
+static plume_status limit_error(const mesher *m, const plume_mesh_estimate *estimate)
+{
+	return plume_error_set(m->err, PLUME_ERROR_LIMIT,
+	                       "edge_length %g m on a %.3g m rachis with guides up to %.3g m long makes %.0f rows and "
+	                       "about %.3g vertices, %.3g faces: %.3g GB while meshing; the limit is %.3g GB (raise it "
+	                       "with --max-memory, or use a larger edge_length)",
+	                       m->e, estimate->rachis_length, estimate->longest_guide, estimate->rows, estimate->vertices,
+	                       estimate->faces, estimate->bytes / 1e9, m->max_memory / 1e9);
+}
 
 static double cross2(plume_vec3 a, plume_vec3 b, plume_vec3 c)
 {
@@ -130,6 +153,13 @@ static plume_status place_rows(mesher *m)
 		return plume_error_set(m->err, PLUME_ERROR_SPEC,
 		                       "edge_length %g m is too small for a %g m rachis (%.0f rows): use a larger edge length",
 		                       e, end, total_steps + 1.0);
+	if ((total_steps + 1.0) * row_bytes > m->max_memory) {
+		plume_mesh_estimate rows_only = {.rows = total_steps + 1.0, .vertices = 2.0 * (total_steps + 1.0)};
+		rows_only.faces = 2.0 * rows_only.vertices;
+		rows_only.bytes = rows_only.rows * row_bytes;
+		rows_only.rachis_length = end;
+		return limit_error(m, &rows_only);
+	}
 	m->row_count = (int)total_steps + 1;
 	m->rows = plume_calloc((size_t)m->row_count, sizeof *m->rows);
 	if (m->rows == NULL)
@@ -267,17 +297,29 @@ static int clip_to_band(const mesh_row *row, int side, plume_vec3 *p, plume_vec2
 	return count;
 }
 
-/// Builds the guide through a row's rachis vertex on one side and places its vertices.
-static bool build_line(mesher *m, int side, int r)
+/// A row's guide on one side, in the plane, before its vertices are placed.
+typedef struct mesh_trace {
+	plume_vec3 p[MESH_GUIDE_SAMPLES + 1];
+	plume_vec2 uv[MESH_GUIDE_SAMPLES + 1];
+	int count;    ///< points in p and uv
+	double total; ///< plane arc length, m
+	double steps; ///< vertices after the root, one about every e (0: no guide); may be huge
+} mesh_trace;
+
+/// Traces the guide through a row's rachis vertex on one side. Returns false
+/// when the row has no guide there (trace->steps is 0 then too).
+static bool trace_line(const mesher *m, int side, int r, mesh_trace *trace)
 {
 	const mesh_input *in = m->input;
 	const mesh_row *row = m->rows + r;
 	const mesh_guide *guides = in->guides[side];
 	int n = in->guide_count[side];
-	mesh_line *line = m->lines + line_index(m, side, r);
-	memset(line, 0, sizeof *line);
+	plume_vec3 *p = trace->p;
+	plume_vec2 *uv = trace->uv;
+	trace->count = 0;
+	trace->total = trace->steps = 0.0;
 	if (n == 0 || row->sigma < in->sigma_first[side] - 0.5 * m->e || row->sigma > in->sigma_last[side] + 0.5 * m->e)
-		return true;
+		return false;
 
 	// The two guides rooted nearest along the rachis (thesis 6.2), or the end one.
 	int i0 = 0, i1 = 0;
@@ -297,8 +339,6 @@ static bool build_line(mesher *m, int side, int r)
 		i1 = hi;
 		alpha = (row->sigma - guides[lo].sigma) / (guides[hi].sigma - guides[lo].sigma);
 	}
-	plume_vec3 p[MESH_GUIDE_SAMPLES + 1];
-	plume_vec2 uv[MESH_GUIDE_SAMPLES + 1];
 	for (int k = 0; k < MESH_GUIDE_SAMPLES; ++k) {
 		p[k] = plume_v3_lerp(guides[i0].p[k], guides[i1].p[k], alpha);
 		plume_vec2 u0 = guides[i0].uv[k], u1 = guides[i1].uv[k];
@@ -306,7 +346,7 @@ static bool build_line(mesher *m, int side, int r)
 	}
 	int count = clip_to_band(row, side, p, uv);
 	if (count < 2)
-		return true; // the guide never leaves the rachis band: no vane here
+		return false; // the guide never leaves the rachis band: no vane here
 	// Shift the guide so that it starts at the rachis vertex, the shift fading
 	// to zero at the tip so that the tip stays on the barb tips' envelope.
 	plume_vec3 root = rachis_point(row, side);
@@ -323,18 +363,35 @@ static bool build_line(mesher *m, int side, int r)
 	p[0] = root;
 	uv[0] = (plume_vec2){0.0, row->t};
 	if (in->boundary != NULL && (count = clip_to_boundary(in, p, uv, count)) == 0)
-		return true;
-
+		return false;
 	double total = 0.0;
 	for (int k = 0; k + 1 < count; ++k)
 		total += sqrt(dist2(p[k], p[k + 1]));
-	int steps = total > 1e-6 * m->e ? (int)fmax(1.0, round(total / m->e)) : 0;
-	if (m->point_count + steps + 1 > MESH_MAX_VERTICES)
+	trace->count = count;
+	trace->total = total;
+	trace->steps = total > 1e-6 * m->e ? fmax(1.0, round(total / m->e)) : 0.0;
+	return true;
+}
+
+/// Places the vertices of a row's guide on one side (none when it has no guide).
+static bool build_line(mesher *m, int side, int r)
+{
+	mesh_line *line = m->lines + line_index(m, side, r);
+	memset(line, 0, sizeof *line);
+	mesh_trace trace;
+	if (!trace_line(m, side, r, &trace))
+		return true;
+	const plume_vec3 *p = trace.p;
+	const plume_vec2 *uv = trace.uv;
+	int count = trace.count;
+	double total = trace.total;
+	if (!(m->point_count + trace.steps + 1.0 <= MESH_MAX_VERTICES))
 		return false;
+	int steps = (int)trace.steps;
 	line->present = true;
 	line->first = m->point_count;
 	line->count = line->full = steps + 1;
-	if (!push_point(m, root, uv[0]))
+	if (!push_point(m, p[0], uv[0]))
 		return false;
 	int segment = 0;
 	double start = 0.0;
@@ -445,47 +502,188 @@ static bool cross_segments(plume_vec3 p, plume_vec3 q, plume_vec3 r, plume_vec3 
 	return ((o1 > 0.0 && o2 < 0.0) || (o1 < 0.0 && o2 > 0.0)) && ((o3 > 0.0 && o4 < 0.0) || (o3 < 0.0 && o4 > 0.0));
 }
 
+// ---------------------------------------------------------------------------
+// Spatial index of the guide vertices
+//
+// The strip walk asks two questions over and over: does a vertex still to be
+// walked lie in this ear (ear_is_empty), and which segment of a guide first
+// crosses this segment (strip_is_simple, cut_distant_crossings). Scanning the
+// guides answers each in time linear in their length, which made meshing
+// quadratic in guide length: a 5 m feather meshed at 4 mm (the fuzzer's tall
+// feathers, fuzz/corpus/mesh_spec/tall-*) took minutes. A tree of bounding boxes
+// over the point pool answers both in O(log n + k), k the candidates whose boxes
+// meet the question's box: a handful, since guide steps are about e long.
+//
+// The answers are the scan's, in the scan's order: a point inside or on a
+// triangle lies in the triangle's bounding box and two segments that cross have
+// overlapping boxes, so the boxes skip only candidates that fail the exact test,
+// and the tree is visited in index order, so the first crossing it finds is the
+// one the scan found. The question's box is padded by a relative 1e-9 so that a
+// candidate that the rounded orientation tests would accept a hair outside its
+// exact box is still tested.
+//
+// Layout: the pool's points in buckets of MESH_BUCKET; leaf b bounds the
+// bucket's points and, for each, the next point on the same guide line, so it
+// bounds the bucket's segments too (segment j joins points j and j + 1). Node n
+// has children 2n and 2n + 1; leaf b is node leaf_count + b. Points do not move
+// once the strips are collected (cutting a guide only lowers its count) and
+// every query names its index range, so the tree is built once.
+/// Ranges shorter than MESH_SCAN_MAX are scanned: the tree costs more there.
+enum { MESH_BUCKET = 8, MESH_SCAN_MAX = 48 };
+
+static void box_add(mesh_box *box, plume_vec3 p)
+{
+	box->x0 = p.x < box->x0 ? p.x : box->x0;
+	box->y0 = p.y < box->y0 ? p.y : box->y0;
+	box->x1 = p.x > box->x1 ? p.x : box->x1;
+	box->y1 = p.y > box->y1 ? p.y : box->y1;
+}
+
+/// The padded box of up to three points (the third may repeat the second).
+static mesh_box query_box(plume_vec3 p, plume_vec3 q, plume_vec3 r)
+{
+	mesh_box box = {INFINITY, INFINITY, -INFINITY, -INFINITY};
+	box_add(&box, p);
+	box_add(&box, q);
+	box_add(&box, r);
+	double pad = 1e-9 * (fmax(fmax(fabs(box.x0), fabs(box.x1)), fmax(fabs(box.y0), fabs(box.y1))) + (box.x1 - box.x0) +
+	                     (box.y1 - box.y0));
+	box.x0 -= pad;
+	box.y0 -= pad;
+	box.x1 += pad;
+	box.y1 += pad;
+	return box;
+}
+
+static bool build_index(mesher *m)
+{
+	int buckets = (m->point_count + MESH_BUCKET - 1) / MESH_BUCKET;
+	m->leaf_count = 1;
+	while (m->leaf_count < buckets)
+		m->leaf_count *= 2;
+	m->boxes = plume_alloc(2 * (size_t)m->leaf_count * sizeof *m->boxes);
+	if (m->boxes == NULL)
+		return false;
+	for (int n = 0; n < 2 * m->leaf_count; ++n)
+		m->boxes[n] = (mesh_box){INFINITY, INFINITY, -INFINITY, -INFINITY};
+	for (int l = 0; l < 2 * m->row_count; ++l) {
+		const mesh_line *line = m->lines + l;
+		int end = line->present ? line->first + line->full : 0;
+		for (int j = line->first; j < end; ++j) {
+			mesh_box *leaf = m->boxes + m->leaf_count + j / MESH_BUCKET;
+			box_add(leaf, m->points[j]);
+			if (j + 1 < end)
+				box_add(leaf, m->points[j + 1]);
+		}
+	}
+	for (int n = m->leaf_count - 1; n >= 1; --n) {
+		const mesh_box *a = m->boxes + 2 * n, *b = m->boxes + 2 * n + 1;
+		m->boxes[n] = (mesh_box){fmin(a->x0, b->x0), fmin(a->y0, b->y0), fmax(a->x1, b->x1), fmax(a->y1, b->y1)};
+	}
+	return true;
+}
+
+/// What a query tests at each candidate pool index j.
+typedef struct index_query {
+	int lo, hi;   ///< pool indices to consider
+	mesh_box box; ///< the padded box of p, q (and r)
+	plume_vec3 p, q, r;
+	bool triangle; ///< point j in triangle pqr; else segment j crossing pq
+} index_query;
+
+static bool query_hit(const mesher *m, const index_query *query, int j)
+{
+	plume_vec3 x = m->points[j], p = query->p, q = query->q, r = query->r;
+	if (!query->triangle)
+		return cross_segments(p, q, x, m->points[j + 1]);
+	if ((x.x == p.x && x.y == p.y) || (x.x == q.x && x.y == q.y) || (x.x == r.x && x.y == r.y))
+		return false;
+	return cross2(p, q, x) >= 0.0 && cross2(q, r, x) >= 0.0 && cross2(r, p, x) >= 0.0;
+}
+
+/// The least index in [query->lo, query->hi] of node's points [first, last] that hits, or -1.
+static int index_find(const mesher *m, const index_query *query, int node, int first, int last)
+{
+	const mesh_box *box = m->boxes + node, *want = &query->box;
+	if (last < query->lo || first > query->hi || box->x0 > want->x1 || want->x0 > box->x1 || box->y0 > want->y1 ||
+	    want->y0 > box->y1)
+		return -1;
+	if (node >= m->leaf_count) {
+		int to = last < query->hi ? last : query->hi;
+		for (int j = first > query->lo ? first : query->lo; j <= to; ++j)
+			if (query_hit(m, query, j))
+				return j;
+		return -1;
+	}
+	int middle = first + (last - first + 1) / 2;
+	int found = index_find(m, query, 2 * node, first, middle - 1);
+	return found >= 0 ? found : index_find(m, query, 2 * node + 1, middle, last);
+}
+
+/// The least index in [query->lo, query->hi] that hits, or -1: a scan when
+/// the range is short (the tree costs more there), the tree otherwise.
+static int index_first(const mesher *m, const index_query *query)
+{
+	if (query->hi - query->lo >= MESH_SCAN_MAX)
+		return index_find(m, query, 1, 0, m->leaf_count * MESH_BUCKET - 1);
+	for (int j = query->lo; j <= query->hi; ++j)
+		if (query_hit(m, query, j))
+			return j;
+	return -1;
+}
+
+/// The first segment k in [from, to] of a line (points k and k + 1) that properly crosses pq, or -1.
+static int first_crossing(const mesher *m, const mesh_line *line, int from, int to, plume_vec3 p, plume_vec3 q)
+{
+	index_query query = {line->first + from, line->first + to, query_box(p, q, q), p, q, q, false};
+	int found = index_first(m, &query);
+	return found < 0 ? -1 : found - line->first;
+}
+
+/// True when a point i in [from, to] of a line, other than p, q and r, lies inside or on triangle pqr.
+static bool point_in_triangle(const mesher *m, const mesh_line *line, int from, int to, plume_vec3 p, plume_vec3 q,
+                              plume_vec3 r)
+{
+	index_query query = {line->first + from, line->first + to, query_box(p, q, r), p, q, r, true};
+	return index_first(m, &query) >= 0;
+}
+
 /// The strip's outline (guide A, closing edge, guide B back, bottom edge) must
 /// be a simple polygon. Returns false with where to cut the guides when a
 /// segment of one guide crosses the other guide, the closing edge or the
-/// bottom edge.
+/// bottom edge: the first such segment pair (i, k) in the order i, then k.
 static bool strip_is_simple(const mesher *m, const mesh_strip *strip, int *cut_a, int *cut_b)
 {
 	const mesh_line *la = m->lines + strip->a, *lb = m->lines + strip->b;
 	const plume_vec3 *A = m->points + la->first, *B = m->points + lb->first;
-	int ma = la->count - 1, nb = lb->count - 1;
+	int ma = la->count - 1, nb = lb->count - 1, k;
 	for (int i = 0; i < ma; ++i)
-		for (int k = 0; k < nb; ++k)
-			if (cross_segments(A[i], A[i + 1], B[k], B[k + 1])) {
-				*cut_a = i;
-				*cut_b = k;
-				return false;
-			}
-	for (int i = 1; i < ma; ++i)
-		if (cross_segments(A[i], A[i + 1], A[0], B[0])) {
+		if ((k = first_crossing(m, lb, 0, nb - 1, A[i], A[i + 1])) >= 0) {
 			*cut_a = i;
-			*cut_b = nb;
-			return false;
-		}
-	for (int k = 1; k < nb; ++k)
-		if (cross_segments(B[k], B[k + 1], A[0], B[0])) {
-			*cut_a = ma;
 			*cut_b = k;
 			return false;
 		}
+	if ((k = first_crossing(m, la, 1, ma - 1, A[0], B[0])) >= 0) {
+		*cut_a = k;
+		*cut_b = nb;
+		return false;
+	}
+	if ((k = first_crossing(m, lb, 1, nb - 1, A[0], B[0])) >= 0) {
+		*cut_a = ma;
+		*cut_b = k;
+		return false;
+	}
 	if (!strip->shared_end) {
-		for (int i = 0; i + 1 < ma; ++i)
-			if (cross_segments(A[i], A[i + 1], A[ma], B[nb])) {
-				*cut_a = ma - 1;
-				*cut_b = nb;
-				return false;
-			}
-		for (int k = 0; k + 1 < nb; ++k)
-			if (cross_segments(B[k], B[k + 1], A[ma], B[nb])) {
-				*cut_a = ma;
-				*cut_b = nb - 1;
-				return false;
-			}
+		if (first_crossing(m, la, 0, ma - 2, A[ma], B[nb]) >= 0) {
+			*cut_a = ma - 1;
+			*cut_b = nb;
+			return false;
+		}
+		if (first_crossing(m, lb, 0, nb - 2, A[ma], B[nb]) >= 0) {
+			*cut_a = ma;
+			*cut_b = nb - 1;
+			return false;
+		}
 	}
 	return true;
 }
@@ -496,20 +694,7 @@ static bool ear_is_empty(const mesher *m, const mesh_strip *strip, int i, int k,
                          plume_vec3 r)
 {
 	const mesh_line *la = m->lines + strip->a, *lb = m->lines + strip->b;
-	const plume_vec3 *A = m->points + la->first, *B = m->points + lb->first;
-	int ma = la->count - 1, nb = lb->count - 1;
-	for (int side = 0; side < 2; ++side) {
-		const plume_vec3 *X = side == 0 ? A : B;
-		int from = side == 0 ? i : k, to = side == 0 ? ma : nb;
-		for (int j = from; j <= to; ++j) {
-			plume_vec3 x = X[j];
-			if ((x.x == p.x && x.y == p.y) || (x.x == q.x && x.y == q.y) || (x.x == r.x && x.y == r.y))
-				continue;
-			if (cross2(p, q, x) >= 0.0 && cross2(q, r, x) >= 0.0 && cross2(r, p, x) >= 0.0)
-				return false;
-		}
-	}
-	return true;
+	return !point_in_triangle(m, la, i, la->count - 1, p, q, r) && !point_in_triangle(m, lb, k, lb->count - 1, p, q, r);
 }
 
 /// Walks one strip. Each triangle is (a_i, a_i+1, b_k), barb edge 0, or
@@ -549,11 +734,10 @@ static bool walk_strip(const mesher *m, const mesh_strip *strip, strip_out *out,
 	return true;
 }
 
-/// Walks every strip; where one fails, cuts both guides there and starts
-/// over, until all strips walk through. Each cut removes at least one vertex,
-/// so this ends.
 /// Guides of one vane two to four rows apart must not cross either (a short
-/// guide between them would not separate them); where they do, both are cut.
+/// guide between them would not separate them); where they do, both are cut
+/// at their first crossing. One call is enough: after it no such pair crosses,
+/// and cutting guides only removes segments, so none crosses later either.
 static bool cut_distant_crossings(mesher *m)
 {
 	bool clean = true;
@@ -563,68 +747,101 @@ static bool cut_distant_crossings(mesher *m)
 				mesh_line *a = m->lines + line_index(m, side, r), *b = m->lines + line_index(m, side, r + d);
 				if (!a->present || !b->present)
 					continue;
-				const plume_vec3 *A = m->points + a->first, *B = m->points + b->first;
-				for (int i = 0; i + 1 < a->count; ++i)
-					for (int k = 0; k + 1 < b->count; ++k)
-						if (cross_segments(A[i], A[i + 1], B[k], B[k + 1])) {
-							m->trimmed += (a->count - (i + 1)) + (b->count - (k + 1));
-							a->count = i + 1;
-							b->count = k + 1;
-							clean = false;
-						}
-			}
-	// The vane's outer edge between two neighbouring tips must not cross a guide nearby.
-	for (int side = 0; side < 2; ++side)
-		for (int r = 0; r + 1 < m->row_count; ++r) {
-			mesh_line *a = m->lines + line_index(m, side, r), *b = m->lines + line_index(m, side, r + 1);
-			if (!a->present || !b->present)
-				continue;
-			plume_vec3 p = m->points[a->first + a->count - 1], q = m->points[b->first + b->count - 1];
-			for (int d = -3; d <= 4; ++d) {
-				if (d == 0 || d == 1 || r + d < 0 || r + d >= m->row_count)
-					continue;
-				mesh_line *c = m->lines + line_index(m, side, r + d);
-				const plume_vec3 *C = m->points + c->first;
-				for (int k = 0; c->present && k + 1 < c->count; ++k)
-					if (cross_segments(p, q, C[k], C[k + 1])) {
-						m->trimmed += c->count - (k + 1);
-						c->count = k + 1;
+				const plume_vec3 *A = m->points + a->first;
+				for (int i = 0, k; i + 1 < a->count; ++i)
+					if ((k = first_crossing(m, b, 0, b->count - 2, A[i], A[i + 1])) >= 0) {
+						m->trimmed += (a->count - (i + 1)) + (b->count - (k + 1));
+						a->count = i + 1;
+						b->count = k + 1;
 						clean = false;
-						break;
 					}
 			}
-		}
 	return clean;
 }
 
+/// The vane's outer edge between the tips of the guides of rows r and r + 1
+/// must not cross a guide nearby; where it does, that guide is cut.
+static bool cut_edge_crossings(mesher *m, int side, int r)
+{
+	bool clean = true;
+	mesh_line *a = m->lines + line_index(m, side, r), *b = m->lines + line_index(m, side, r + 1);
+	plume_vec3 p = m->points[a->first + a->count - 1], q = m->points[b->first + b->count - 1];
+	for (int d = -3; d <= 4; ++d) {
+		if (d == 0 || d == 1 || r + d < 0 || r + d >= m->row_count)
+			continue;
+		mesh_line *c = m->lines + line_index(m, side, r + d);
+		int k = c->present ? first_crossing(m, c, 0, c->count - 2, p, q) : -1;
+		if (k >= 0) {
+			m->trimmed += c->count - (k + 1);
+			c->count = k + 1;
+			clean = false;
+		}
+	}
+	return clean;
+}
+
+/// Walks every strip; where one fails, cuts both guides there and starts
+/// over, until all strips walk through. Each cut removes at least one vertex,
+/// so this ends. Returns the vane's face count, or -1 out of memory.
+///
+/// A check passed once passes again while its inputs keep their counts (its
+/// guides were not cut since), so each pass re-runs only those whose guides
+/// were cut: a strip's walk, an outer edge's crossings. The cuts, and so the
+/// mesh, are those of re-running every check in every pass, in the same
+/// order; the work is the checks whose guides changed instead of all of them
+/// times the passes (a cut can ripple along a vane over many passes).
 static int settle_strips(mesher *m)
 {
-	for (;;) {
-		bool clean = cut_distant_crossings(m);
+	// The two counts each check last passed with (-1: not passed yet), and a strip's faces then.
+	int *strip_seen = plume_alloc(3 * (size_t)m->strip_count * sizeof *strip_seen);
+	int *edge_seen = plume_alloc(4 * (size_t)m->row_count * sizeof *edge_seen);
+	if (strip_seen == NULL || edge_seen == NULL) {
+		plume_free(strip_seen);
+		plume_free(edge_seen);
+		return -1;
+	}
+	memset(strip_seen, 0xff, 3 * (size_t)m->strip_count * sizeof *strip_seen);
+	memset(edge_seen, 0xff, 4 * (size_t)m->row_count * sizeof *edge_seen);
+	bool clean = cut_distant_crossings(m);
+	for (bool first = true; first || !clean; first = false) {
+		clean = true;
+		for (int side = 0; side < 2; ++side)
+			for (int r = 0; r + 1 < m->row_count; ++r) {
+				const mesh_line *a = m->lines + line_index(m, side, r), *b = m->lines + line_index(m, side, r + 1);
+				int *seen = edge_seen + 2 * line_index(m, side, r);
+				if (!a->present || !b->present || (seen[0] == a->count && seen[1] == b->count))
+					continue;
+				seen[0] = a->count;
+				seen[1] = b->count;
+				clean &= cut_edge_crossings(m, side, r);
+			}
 		for (int s = 0; s < m->strip_count; ++s) {
 			mesh_strip *strip = m->strip_list + s;
 			mesh_line *a = m->lines + strip->a, *b = m->lines + strip->b;
+			int *seen = strip_seen + 3 * s;
+			if (seen[0] == a->count && seen[1] == b->count)
+				continue;
 			if (strip->shared_end && (a->count != a->full || b->count != b->full))
 				strip->shared_end = false; // a cut guide no longer reaches the shared tip
 			strip_out dry = {NULL, 0};
 			int i, k;
-			if (strip_is_simple(m, strip, &i, &k) && walk_strip(m, strip, &dry, &i, &k))
+			if (strip_is_simple(m, strip, &i, &k) && walk_strip(m, strip, &dry, &i, &k)) {
+				seen[0] = a->count;
+				seen[1] = b->count;
+				seen[2] = dry.faces;
 				continue;
+			}
 			m->trimmed += (a->count - (i + 1)) + (b->count - (k + 1));
 			a->count = i + 1;
 			b->count = k + 1;
 			clean = false;
 		}
-		if (clean)
-			break;
 	}
-	int faces = 0;
-	for (int s = 0; s < m->strip_count; ++s) {
-		strip_out dry = {NULL, 0};
-		int i, k;
-		walk_strip(m, m->strip_list + s, &dry, &i, &k);
-		faces += dry.faces;
-	}
+	int faces = 0; // every strip passed with its present counts in the last pass
+	for (int s = 0; s < m->strip_count; ++s)
+		faces += strip_seen[3 * s + 2];
+	plume_free(strip_seen);
+	plume_free(edge_seen);
 	return faces;
 }
 
@@ -788,8 +1005,117 @@ static bool faces_overlap(const plume_mesh *mesh, int f, int g)
 	return false;
 }
 
-/// The last safety net: no two faces of the result may overlap (sweep over
-/// face boxes sorted by x). Returns the first overlapping face, or -1.
+/// The first box, in the x order of boxes, whose face overlaps a later
+/// box's face: its rank, or -1. Quadratic where many boxes share an x range
+/// (a tall feather): grid_overlap answers the same faster.
+static int sweep_overlap(const plume_mesh *mesh, const face_box *boxes)
+{
+	for (int i = 0; i < mesh->face_count; ++i)
+		for (int j = i + 1; j < mesh->face_count && boxes[j].x0 <= boxes[i].x1; ++j)
+			if (boxes[j].y0 <= boxes[i].y1 && boxes[i].y0 <= boxes[j].y1 &&
+			    faces_overlap(mesh, boxes[i].face, boxes[j].face))
+				return i;
+	return -1;
+}
+
+/// A uniform grid over the face boxes, cells about one box wide.
+typedef struct face_grid {
+	double x0, y0, size;
+	int nx, ny;
+} face_grid;
+
+static int grid_column(const face_grid *grid, double x)
+{
+	int c = (int)((x - grid->x0) / grid->size);
+	return c < grid->nx ? c : grid->nx - 1;
+}
+
+static int grid_row(const face_grid *grid, double y)
+{
+	int c = (int)((y - grid->y0) / grid->size);
+	return c < grid->ny ? c : grid->ny - 1;
+}
+
+/// sweep_overlap's answer through a grid: boxes that meet share the cell of
+/// the lower-left corner of their intersection and are tested there only, so
+/// each pair the sweep tests is tested once, and the least rank in an
+/// overlapping pair is the sweep's answer. Returns it, -1 for none, -2 out of
+/// memory, -3 when boxes are not finite or too many cells would be filled
+/// (then the sweep answers).
+static int grid_overlap(const plume_mesh *mesh, const face_box *boxes)
+{
+	int n = mesh->face_count;
+	double x1 = -INFINITY, y1 = -INFINITY, extent = 0.0;
+	face_grid grid = {INFINITY, INFINITY, 0.0, 0, 0};
+	for (int i = 0; i < n; ++i) {
+		const face_box *b = boxes + i;
+		if (!(isfinite(b->x0) && isfinite(b->x1) && isfinite(b->y0) && isfinite(b->y1)))
+			return -3;
+		grid.x0 = fmin(grid.x0, b->x0);
+		grid.y0 = fmin(grid.y0, b->y0);
+		x1 = fmax(x1, b->x1);
+		y1 = fmax(y1, b->y1);
+		extent += fmax(b->x1 - b->x0, b->y1 - b->y0);
+	}
+	grid.size = extent / n;
+	if (!(grid.size > 0.0 && isfinite(x1 - grid.x0) && isfinite(y1 - grid.y0)))
+		return -3;
+	while (((x1 - grid.x0) / grid.size + 1.0) * ((y1 - grid.y0) / grid.size + 1.0) > 4.0 * n + 16.0)
+		grid.size *= 2.0;
+	grid.nx = (int)((x1 - grid.x0) / grid.size) + 1;
+	grid.ny = (int)((y1 - grid.y0) / grid.size) + 1;
+	double filled = 0.0;
+	for (int i = 0; i < n; ++i)
+		filled += (double)(grid_column(&grid, boxes[i].x1) - grid_column(&grid, boxes[i].x0) + 1) *
+		          (grid_row(&grid, boxes[i].y1) - grid_row(&grid, boxes[i].y0) + 1);
+	if (filled > 32.0 * n + 1024.0)
+		return -3;
+	int cells = grid.nx * grid.ny;
+	int *start = plume_calloc((size_t)cells + 1, sizeof *start);
+	int *items = plume_alloc((size_t)filled * sizeof *items + 1);
+	if (start == NULL || items == NULL) {
+		plume_free(start);
+		plume_free(items);
+		return -2;
+	}
+	// Each cell lists the ranks of the boxes that cover it, in increasing order.
+	for (int pass = 0; pass < 2; ++pass) {
+		for (int i = 0; i < n; ++i)
+			for (int y = grid_row(&grid, boxes[i].y0); y <= grid_row(&grid, boxes[i].y1); ++y)
+				for (int x = grid_column(&grid, boxes[i].x0); x <= grid_column(&grid, boxes[i].x1); ++x) {
+					if (pass == 0)
+						start[y * grid.nx + x + 1]++;
+					else
+						items[start[y * grid.nx + x]++] = i;
+				}
+		if (pass == 0)
+			for (int c = 0; c < cells; ++c)
+				start[c + 1] += start[c];
+		else
+			for (int c = cells; c > 0; --c) // the fill moved each start to the next cell's
+				start[c] = start[c - 1];
+		start[0] = 0;
+	}
+	int best = n;
+	for (int c = 0; c < cells; ++c)
+		for (int a = start[c]; a < start[c + 1] && items[a] < best; ++a)
+			for (int b = a + 1; b < start[c + 1]; ++b) {
+				const face_box *p = boxes + items[a], *q = boxes + items[b];
+				if (!(q->x0 <= p->x1 && p->x0 <= q->x1 && q->y0 <= p->y1 && p->y0 <= q->y1) ||
+				    grid_row(&grid, fmax(p->y0, q->y0)) * grid.nx + grid_column(&grid, fmax(p->x0, q->x0)) != c)
+					continue;
+				if (faces_overlap(mesh, p->face, q->face)) {
+					best = items[a];
+					break;
+				}
+			}
+	plume_free(start);
+	plume_free(items);
+	return best < n ? best : -1;
+}
+
+/// The last safety net: no two faces of the result may overlap. Returns the
+/// first face, in the order of the face boxes' left sides, that overlaps another.
 static int find_overlap(const plume_mesh *mesh, bool *out_of_memory)
 {
 	face_box *boxes = plume_alloc((size_t)mesh->face_count * sizeof *boxes);
@@ -810,12 +1136,11 @@ static int find_overlap(const plume_mesh *mesh, bool *out_of_memory)
 		}
 	}
 	qsort(boxes, (size_t)mesh->face_count, sizeof *boxes, compare_boxes);
-	int found = -1;
-	for (int i = 0; i < mesh->face_count && found < 0; ++i)
-		for (int j = i + 1; j < mesh->face_count && boxes[j].x0 <= boxes[i].x1 && found < 0; ++j)
-			if (boxes[j].y0 <= boxes[i].y1 && boxes[i].y0 <= boxes[j].y1 &&
-			    faces_overlap(mesh, boxes[i].face, boxes[j].face))
-				found = boxes[i].face;
+	int rank = grid_overlap(mesh, boxes);
+	if (rank == -3)
+		rank = sweep_overlap(mesh, boxes);
+	*out_of_memory = rank == -2;
+	int found = rank >= 0 ? boxes[rank].face : -1;
 	plume_free(boxes);
 	return found;
 }
@@ -823,6 +1148,8 @@ static int find_overlap(const plume_mesh *mesh, bool *out_of_memory)
 static plume_status assemble(mesher *m, plume_mesh **out, plume_mesh_report *report)
 {
 	int vane_faces = settle_strips(m);
+	if (vane_faces < 0)
+		return plume_error_set(m->err, PLUME_ERROR_MEMORY, "out of memory walking the strips");
 	int vertex_count = number_vertices(m);
 	if (vertex_count == 2 * m->row_count || vane_faces == 0)
 		return plume_error_set(m->err, PLUME_ERROR_SPEC,
@@ -907,11 +1234,60 @@ static plume_status assemble(mesher *m, plume_mesh **out, plume_mesh_report *rep
 	return PLUME_OK;
 }
 
+/// Counts what the placed rows' guides would add (trace_line), without placing it.
+static void count_mesh(const mesher *m, plume_mesh_estimate *out)
+{
+	const mesh_centre *rachis = &m->input->rachis;
+	*out = (plume_mesh_estimate){.rows = m->row_count, .rachis_length = rachis->sigma[rachis->count - 1]};
+	double pool = 0.0; // guide points, the roots included
+	for (int side = 0; side < 2; ++side)
+		for (int r = 0; r < m->row_count; ++r) {
+			mesh_trace trace;
+			if (!trace_line(m, side, r, &trace))
+				continue;
+			pool += trace.steps + 1.0;
+			out->longest_guide = fmax(out->longest_guide, trace.total);
+		}
+	out->vertices = 2.0 * m->row_count + pool;
+	out->faces = 2.0 * out->vertices;
+	out->bytes = m->row_count * row_bytes + PLUME_MESH_BYTES_PER_VERTEX * out->vertices;
+}
+
+/// Places the rows (refusing past the limit before allocating them) and counts the rest.
+static plume_status mesh_begin(mesher *m, const mesh_input *input, const plume_mesh_def *def,
+                               plume_mesh_estimate *estimate, plume_error *err)
+{
+	*m = (mesher){.input = input,
+	              .e = def->edge_length,
+	              .include_calamus = def->include_calamus,
+	              .max_memory = (double)(def->max_memory > 0 ? def->max_memory : PLUME_DEFAULT_MAX_MEMORY),
+	              .err = err};
+	plume_status status = place_rows(m);
+	if (status != PLUME_OK)
+		return status;
+	count_mesh(m, estimate);
+	return PLUME_OK;
+}
+
+static void mesh_end(mesher *m)
+{
+	plume_free(m->rows);
+	plume_free(m->lines);
+	plume_free(m->points);
+	plume_free(m->uvs);
+	plume_free(m->ids);
+	plume_free(m->strip_list);
+	plume_free(m->boxes);
+}
+
 static plume_status mesh_run(const mesh_input *input, const plume_mesh_def *def, plume_mesh **out,
                              plume_mesh_report *report, plume_error *err)
 {
-	mesher m = {.input = input, .e = def->edge_length, .include_calamus = def->include_calamus, .err = err};
-	plume_status status = place_rows(&m);
+	mesher m;
+	plume_mesh_estimate estimate;
+	plume_status status = mesh_begin(&m, input, def, &estimate, err);
+	if (status == PLUME_OK && !(estimate.bytes <= m.max_memory))
+		status = limit_error(&m, &estimate);
 	if (status == PLUME_OK) {
 		m.lines = plume_calloc((size_t)(2 * m.row_count), sizeof *m.lines);
 		if (m.lines == NULL)
@@ -925,16 +1301,20 @@ static plume_status mesh_run(const mesh_input *input, const plume_mesh_def *def,
 				                               "edge_length %g m is too small for this feather (over %d vertices)", m.e,
 				                               MESH_MAX_VERTICES)
 				             : plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory placing guide vertices");
-	if (status == PLUME_OK && !collect_strips(&m))
+	if (status == PLUME_OK && !(collect_strips(&m) && build_index(&m)))
 		status = plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory");
 	if (status == PLUME_OK)
 		status = assemble(&m, out, report);
-	plume_free(m.rows);
-	plume_free(m.lines);
-	plume_free(m.points);
-	plume_free(m.uvs);
-	plume_free(m.ids);
-	plume_free(m.strip_list);
+	mesh_end(&m);
+	return status;
+}
+
+static plume_status mesh_estimate(const mesh_input *input, const plume_mesh_def *def, plume_mesh_estimate *out,
+                                  plume_error *err)
+{
+	mesher m;
+	plume_status status = mesh_begin(&m, input, def, out, err);
+	mesh_end(&m);
 	return status;
 }
 
@@ -964,6 +1344,36 @@ plume_status plume_mesh_from_guides(const plume_mesh_guides *guides, const plume
 	if (status != PLUME_OK)
 		return status;
 	status = mesh_run(&input, def, out, report, err);
+	mesh_input_free(&input);
+	return status;
+}
+
+plume_status plume_mesh_estimate_feather(const plume_feather *feather, const plume_mesh_def *def,
+                                         plume_mesh_estimate *out, plume_error *err)
+{
+	assert(feather != NULL && def != NULL && out != NULL);
+	assert(def->cookie == PLUME_DEF_COOKIE && "plume_mesh_def not from plume_mesh_default_def()");
+	memset(out, 0, sizeof *out);
+	mesh_input input;
+	plume_status status = mesh_input_from_feather(feather, def, &input, err);
+	if (status != PLUME_OK)
+		return status;
+	status = mesh_estimate(&input, def, out, err);
+	mesh_input_free(&input);
+	return status;
+}
+
+plume_status plume_mesh_estimate_guides(const plume_mesh_guides *guides, const plume_mesh_def *def,
+                                        plume_mesh_estimate *out, plume_error *err)
+{
+	assert(guides != NULL && def != NULL && out != NULL);
+	assert(def->cookie == PLUME_DEF_COOKIE && "plume_mesh_def not from plume_mesh_default_def()");
+	memset(out, 0, sizeof *out);
+	mesh_input input;
+	plume_status status = mesh_input_from_guides(guides, def, &input, err);
+	if (status != PLUME_OK)
+		return status;
+	status = mesh_estimate(&input, def, out, err);
 	mesh_input_free(&input);
 	return status;
 }

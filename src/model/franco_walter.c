@@ -247,6 +247,13 @@ static plume_status build_barb(plume_feather *feather, const plume_fw_def *def, 
 	return plume_feather_add_barb(feather, &record) < 0 ? PLUME_ERROR_MEMORY : PLUME_OK;
 }
 
+double plume_fw_estimate_bytes(const plume_fw_def *def)
+{
+	double barbs = 2.0 * ((double)def->segments[0].barb_count + (double)def->segments[1].barb_count);
+	double points = (double)def->shaft_samples + barbs * (double)def->barb_samples;
+	return points * (2.0 * sizeof(plume_vec3) + 2.0 * sizeof(double) + sizeof(plume_vec2));
+}
+
 plume_status plume_fw_generate(const plume_fw_def *def, uint64_t seed, plume_feather **out, plume_error *err)
 {
 	*out = NULL;

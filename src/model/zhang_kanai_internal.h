@@ -110,4 +110,7 @@ void zk_barbules_free(zk_barbules *barbules);
 /// polyline, as a parameter segment + u; returns false when they do not meet.
 bool zk_sphere_polyline(plume_vec3 centre, double radius, const plume_vec3 *line, int count, plume_vec3 *hit);
 
+/// The angle a in (-pi, pi], in at most 33 steps whatever a is (NaN for a non-finite a).
+double zk_wrap_angle(double a);
+
 #endif

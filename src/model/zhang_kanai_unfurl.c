@@ -26,8 +26,13 @@ static zk_frame frame_from_heading(double psi)
 	return (zk_frame){.t = {c, 0.0, s}, .n = {s, 0.0, -c}, .b = {0.0, 1.0, 0.0}};
 }
 
-static double wrap_angle(double a)
+double zk_wrap_angle(double a)
 {
+	// A difference of two angles needs a turn or two. Past 64 pi (a runaway or
+	// non-finite angle) remainder() reduces it at once: turn by turn never ended
+	// (1e20 - 2 pi is 1e20, inf - 2 pi is inf); NaN (also from inf) skips the loops.
+	if (!(fabs(a) <= 64.0 * pi))
+		a = remainder(a, 2.0 * pi);
 	while (a > pi)
 		a -= 2.0 * pi;
 	while (a <= -pi)
@@ -68,7 +73,7 @@ void zk_unfurl_chain(plume_vec3 *p, zk_frame *frame, int count, double w)
 		double alpha = atan2(across, along); // offset's angle from the tangent, in the parent's frame
 		double horizontal = hypot(along, across);
 		double child_psi = atan2(frame[j + 1].t.z, frame[j + 1].t.x);
-		double delta = wrap_angle(child_psi - psi);
+		double delta = zk_wrap_angle(child_psi - psi);
 		psi = child_psi;
 		// A vector at angle beta from t towards n has the world heading psi - beta.
 		double segment_heading = heading - (1.0 - w) * alpha;

@@ -639,6 +639,12 @@ plume_status plume_write_rgba_png(int width, int height, const uint8_t *rgba, co
 	return status;
 }
 
+double plume_raytrace_estimate_bytes(const plume_raytrace_def *def, int images, int held)
+{
+	double pixels = (double)def->camera.width * (double)def->camera.height;
+	return pixels * (8.0 + 4.0 * images + 4.0 * held);
+}
+
 plume_status plume_raytrace_render_png(const plume_raytrace_scene *scene, const plume_raytrace_def *def,
                                        const char *path, plume_raytrace_stats *stats, plume_error *err)
 {

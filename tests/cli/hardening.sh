@@ -134,6 +134,45 @@ expect_no_output "PNG frames past a 1M limit" 5 'the limit is 0.00105 GB' "$scra
 $T "$plume" simulate "$bad/scene-short.json" -o "$scratch/o17" --max-memory 64M >/dev/null 2>&1
 check "a short run fits in 64M" test -s "$scratch/o17/summary.json"
 
+# --- meshes past the limit: refused before the guide vertices are placed (src/mesh/aligned.c) ---
+expect_no_output "mesh edge length 10 um" 5 \
+	'guides.json: edge_length 1e-05 m on a 0.12 m rachis with guides up to' "$scratch/m1" \
+	$T "$plume" mesh "$examples/meshes/guides.json" -o "$scratch/m1" -e 1e-5
+check "mesh limit names the estimate, the limit and --max-memory" \
+	grep -qE 'about [0-9.e+]+ vertices, [0-9.e+]+ faces: [0-9.]+ GB while meshing; the limit is 4.29 GB \(raise it with --max-memory' "$scratch/err.txt"
+expect_no_output "tall feather past --max-memory 32M" 5 'the limit is 0.0336 GB' "$scratch/m2" \
+	$T "$plume" mesh "$source_dir/fuzz/corpus/mesh_spec/tall-feather-2.json" -o "$scratch/m2" --max-memory 32M
+expect_no_output "mesh at 0.5 mm past --max-memory 1M" 5 'the limit is 0.00105 GB' "$scratch/m3" \
+	$T "$plume" mesh "$examples/meshes/guides.json" -o "$scratch/m3" -e 5e-4 --max-memory 1M
+$T "$plume" mesh "$examples/meshes/guides.json" -o "$scratch/m4" --max-memory 2M -f obj 2>"$scratch/err.txt"
+check "mesh --max-memory 2M meshes the example ($(cat "$scratch/err.txt"))" test -s "$scratch/m4/mesh.obj"
+edit "$bad/scene-short.json" "$bad/scene-fine.json" "d['mesh']['edge_length'] = 1e-6"
+expect_no_output "scene mesh past the limit" 5 'scene-fine.json: edge_length 1e-06 m on a' "$scratch/m5" \
+	$T "$plume" simulate "$bad/scene-fine.json" -o "$scratch/m5"
+
+# --- a Franco-Walter feather past the limit: barbs x samples (plume_fw_estimate_bytes) -------
+edit "$examples/franco-walter/hawk.json" "$bad/fw-dense.json" \
+	"d['barb_samples'] = 1000; d['segments'][0]['barb_count'] = 5000; d['segments'][1]['barb_count'] = 5000"
+expect_no_output "FW 20000 barbs x 1000 samples past --max-memory 64M" 5 \
+	'fw-dense.json: $.segments[*].barb_count (5000 and 5000 barbs a vane) x $.barb_samples (1000)' "$scratch/g1" \
+	$T "$plume" generate "$bad/fw-dense.json" -o "$scratch/g1" --max-memory 64M
+check "FW limit names the estimate and --max-memory" \
+	grep -qF 'make a feather of about 1.6 GB; the limit is 0.0671 GB (raise it with --max-memory' "$scratch/err.txt"
+edit "$bad/fw-dense.json" "$bad/fw-range.json" "d['segments'][0]['barb_count'] = 6000"
+expect_no_output "FW out of range wins over the limit" 3 '$.segments[0].barb_count' "$scratch/g2" \
+	$T "$plume" generate "$bad/fw-range.json" -o "$scratch/g2" --max-memory 64M
+
+# --- renders past the limit: pixels x images (cli/render.c, plume_raytrace_estimate_bytes) ---
+expect_no_output "render turntable of 100 16384^2 images" 5 \
+	'filoplume.json: 100 image(s) of 16384x16384 pixels' "$scratch/r1" \
+	$T "$plume" render "$examples/franco-walter/filoplume.json" -o "$scratch/r1" --size 16384x16384 --turntable 100
+check "render limit names the estimate and --max-memory" \
+	grep -qF 'take about 110 GB; the limit is 4.29 GB (raise it with --max-memory' "$scratch/err.txt"
+expect_no_output "render 4096^2 past --max-memory 64M" 5 'take about 0.201 GB; the limit is 0.0671 GB' "$scratch/r2" \
+	$T "$plume" render "$examples/franco-walter/filoplume.json" -o "$scratch/r2" --size 4096x4096 --max-memory 64M
+expect_no_output "render a strip past --max-memory 256M" 5 'held at once' "$scratch/r3" \
+	$T "$plume" render "$scratch/o17" -o "$scratch/r3" --strip 3 --size 8192x8192 --max-memory 256M
+
 # --- all or nothing over an earlier run (cli/output.c) -----------------------------------
 edit "$bad/scene-short.json" "$bad/scene-three.json" "d['duration'] = 0.033"
 run=$scratch/run
