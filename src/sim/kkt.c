@@ -257,3 +257,16 @@ plume_status plume_kkt_solve(plume_kkt *kkt, const double *rhs, double *solution
 	}
 	return PLUME_OK;
 }
+
+void plume_kkt_multiply_add(const plume_kkt *kkt, const double *x, double *y)
+{
+	const int *p = kkt->system.matrix->p, *rows = kkt->system.matrix->i, *unknown = kkt->system.permutation;
+	const double *values = kkt->system.matrix->x;
+	for (size_t column = 0; column < kkt->system.matrix->ncol; ++column)
+		for (int e = p[column]; e < p[column + 1]; ++e) {
+			size_t i = (size_t)unknown[rows[e]], j = (size_t)unknown[column];
+			y[i] += values[e] * x[j];
+			if (i != j)
+				y[j] += values[e] * x[i];
+		}
+}

@@ -62,4 +62,7 @@ plume_status plume_kkt_factor(plume_kkt *kkt, bool allow_shift, double *shift, p
 /// only while the componentwise backward error is above 1e-14 and falling, at most 3.
 plume_status plume_kkt_solve(plume_kkt *kkt, const double *rhs, double *solution, plume_error *err);
 
+/// y += K x for the assembled (symmetric) matrix.
+void plume_kkt_multiply_add(const plume_kkt *kkt, const double *x, double *y);
+
 #endif
