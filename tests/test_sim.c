@@ -365,7 +365,7 @@ static void test_kkt_factor_inertia(void **state)
 	memset(&kkt, 0, sizeof kkt);
 	plume_error err = {0};
 	const int pair[2] = {0, 1};
-	assert_int_equal(plume_kkt_init(&kkt, 2, 0, NULL, 0, NULL, 0, 1, pair, &err), PLUME_OK);
+	assert_int_equal(plume_kkt_init(&kkt, 2, 0, NULL, 0, NULL, 4, 0, 1, pair, &err), PLUME_OK);
 	double *values = plume_kkt_values(&kkt), shift;
 	for (int trial = 0; trial < 2; ++trial) {
 		plume_kkt_zero(&kkt);
