@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "model/feather_internal.h"
 #include "plume/streit_heidrich.h"
 #include "support.h"
 
@@ -611,12 +612,15 @@ static void test_scan_round_trip(void **state)
 // ---------------------------------------------------------------------------
 // Specs and bad input (item 10)
 
+static const char *const preset_names[] = {"down",      "semiplume", "contour", "flight",
+                                           "filoplume", "bristle",   "peacock", "continuum"};
+enum { PRESET_COUNT = sizeof preset_names / sizeof preset_names[0] };
+
 static void test_presets_generate(void **state)
 {
 	(void)state;
-	static const char *const names[] = {"down",      "semiplume", "contour", "flight",
-	                                    "filoplume", "bristle",   "peacock", "continuum"};
-	for (size_t i = 0; i < sizeof names / sizeof names[0]; ++i) {
+	const char *const *names = preset_names;
+	for (size_t i = 0; i < PRESET_COUNT; ++i) {
 		char path[512];
 		snprintf(path, sizeof path, "%s/examples/streit-heidrich/%s.json", PLUME_SOURCE_DIR, names[i]);
 		plume_feather *feather = NULL;
@@ -635,6 +639,57 @@ static void test_presets_generate(void **state)
 		assert_int_equal(plume_spec_generate(path, &options, &feather, &err), PLUME_ERROR_UNSUPPORTED);
 		assert_null(feather);
 	}
+}
+
+/// plume_sh_estimate_bytes is counted before the work: it must cover the feather built, at full growth and
+/// half-way, for every preset, and stay within 5 times it (bristle's
+/// silhouette is zero above 20% of the rachis, and a barb without length is dropped).
+static void test_estimate_covers_presets(void **state)
+{
+	(void)state;
+	const char *const *names = preset_names;
+	for (size_t i = 0; i < PRESET_COUNT; ++i) {
+		char path[512];
+		snprintf(path, sizeof path, "%s/examples/streit-heidrich/%s.json", PLUME_SOURCE_DIR, names[i]);
+		plume_sh_def *def = test_malloc(sizeof *def);
+		uint64_t seed;
+		plume_sh_lod lod;
+		plume_error err;
+		if (plume_sh_def_read(path, def, &seed, &lod, &err) != PLUME_OK)
+			fail_msg("%s", err.message);
+		double estimate = plume_sh_estimate_bytes(def, &lod);
+		for (int stage = 1; stage <= 2; ++stage) {
+			plume_feather *feather = NULL;
+			assert_int_equal(plume_sh_generate_lod(def, seed, stage / 2.0, &lod, &feather, &err), PLUME_OK);
+			double bytes = plume_feather_bytes(feather);
+			print_message("%s stage %.1f: estimate %.0f bytes, feather %.0f bytes\n", names[i], stage / 2.0, estimate,
+			              bytes);
+			assert_true(bytes <= estimate);
+			if (stage == 2)
+				assert_true(estimate <= 5.0 * bytes);
+			plume_feather_destroy(feather);
+		}
+		test_free(def);
+	}
+}
+
+/// The densest feather the keys allow (PLUME_SH_MAX_BARBS barbs of 32 control vertices elevated 60 times,
+/// with an afterfeather) is estimated past 16 MB and refused with PLUME_ERROR_LIMIT before the work.
+static void test_estimate_refuses_dense(void **state)
+{
+	(void)state;
+	const char *json = "{\"model\": \"streit-heidrich\", \"spacing_base\": 1e-6, \"spacing_tip\": 1e-6,"
+	                   " \"rachis_length\": 0.5, \"lod\": {\"barb_elevations\": 60},"
+	                   " \"key_barbs\": [{\"position\": 0.5, \"cvs\": [[0,0,0],[0.1,0,0],[0.2,0,0],[0.3,0,0],"
+	                   "[0.4,0,0],[0.5,0,0],[0.6,0,0],[0.7,0,0],[0.8,0,0],[0.9,0,0],[1,0,0]]}]}";
+	plume_spec_options options = {.max_memory = 16u << 20};
+	plume_feather *feather = NULL;
+	plume_error err;
+	assert_int_equal(plume_spec_parse(json, "dense.json", &options, &feather, &err), PLUME_ERROR_LIMIT);
+	assert_null(feather);
+	print_message("%s\n", err.message);
+	assert_non_null(strstr(err.message, "dense.json: $.rachis_length / $.spacing_base"));
+	assert_non_null(strstr(err.message, "the limit is 0.0168 GB (raise it with --max-memory"));
 }
 
 static void expect_spec_error(const char *json, plume_status status, const char *fragment)
@@ -711,6 +766,8 @@ int main(void)
 	    cmocka_unit_test(test_determinism),
 	    cmocka_unit_test(test_scan_round_trip),
 	    cmocka_unit_test(test_presets_generate),
+	    cmocka_unit_test(test_estimate_covers_presets),
+	    cmocka_unit_test(test_estimate_refuses_dense),
 	    cmocka_unit_test(test_bad_specs),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);

@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "model/feather_internal.h"
 #include "model/zhang_kanai_internal.h"
 #include "plume/zhang_kanai.h"
 #include "support.h"
@@ -660,6 +661,54 @@ static void test_curve_stays_positive(void **state)
 	assert_close(plume_zk_curve_eval(&curve, 0.5), 1e-3, 1e-15); // flat between equal values
 }
 
+/// plume_zk_estimate_bytes is counted before the growth: it must cover the feather built for every example,
+/// at full growth and at growth stages that keep the developing barbs.
+static void test_estimate_covers_examples(void **state)
+{
+	(void)state;
+	static const char *const names[] = {"figure10-asymmetry-020", "figure11-expansion",  "figure11-split",
+	                                    "figure13-crest",         "figure8-contour",     "figure9-tip-angular",
+	                                    "figure9-tip-pointed",    "figure9-tip-rounded", "figure11-without-expansion"};
+	for (size_t i = 0; i < sizeof names / sizeof names[0]; ++i) {
+		char path[512];
+		snprintf(path, sizeof path, "%s/examples/zhang-kanai/%s.json", PLUME_SOURCE_DIR, names[i]);
+		plume_zk_def def;
+		uint64_t seed;
+		plume_error err;
+		if (plume_zk_def_read(path, &def, &seed, &err) != PLUME_OK)
+			fail_msg("%s", err.message);
+		double estimate = plume_zk_estimate_bytes(&def);
+		static const double stages[] = {1.0, 0.5, 0.9};
+		for (int k = 0; k < 3; ++k) {
+			def.growth_stage = stages[k];
+			plume_feather *feather = NULL;
+			assert_int_equal(plume_zk_generate(&def, seed, &feather, NULL, &err), PLUME_OK);
+			double bytes = plume_feather_bytes(feather);
+			print_message("%s stage %.1f: estimate %.0f bytes, feather %.0f bytes\n", names[i], stages[k], estimate,
+			              bytes);
+			assert_true(bytes <= estimate);
+			if (k == 0)
+				assert_true(estimate <= 20.0 * bytes);
+			plume_feather_destroy(feather);
+		}
+	}
+}
+
+/// The keys' own ranges allow 5000 barbs a vane traced at a microsecond step: refused before the growth.
+static void test_estimate_refuses_dense(void **state)
+{
+	(void)state;
+	const char *json = "{\"model\": \"zhang-kanai\", \"barb_count\": 5000, \"step\": 1e-6, \"downsample\": 1}";
+	plume_spec_options options = {0};
+	plume_feather *feather = NULL;
+	plume_error err;
+	assert_int_equal(plume_spec_parse(json, "dense.json", &options, &feather, &err), PLUME_ERROR_LIMIT);
+	assert_null(feather);
+	print_message("%s\n", err.message);
+	assert_non_null(strstr(err.message, "dense.json: $.barb_count (5000) and the barbs still growing"));
+	assert_non_null(strstr(err.message, "the limit is 4.29 GB (raise it with --max-memory"));
+}
+
 static void test_spec_stage_options(void **state)
 {
 	(void)state;
@@ -748,6 +797,8 @@ int main(void)
 	    cmocka_unit_test(test_bad_definitions),
 	    cmocka_unit_test(test_curve_stays_positive),
 	    cmocka_unit_test(test_spec_stage_options),
+	    cmocka_unit_test(test_estimate_covers_examples),
+	    cmocka_unit_test(test_estimate_refuses_dense),
 	    cmocka_unit_test(test_no_leaks),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);

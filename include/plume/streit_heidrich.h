@@ -156,6 +156,13 @@ plume_sh_lod plume_sh_default_lod(void);
 plume_status plume_sh_generate(const plume_sh_def *def, uint64_t seed, double stage, plume_feather **out,
                                plume_error *err);
 
+/// Bytes the feather of def takes at lod (NULL: plume_sh_default_lod()), counted before the work and
+/// never below the built feather's: per feather (main, afterfeather) the barbs a vane can hold (the
+/// rachis's control polygon, which no Bezier arc outruns, over the smaller spacing; at most
+/// PLUME_SH_MAX_BARBS) times the points of a barb (the widest key barb, Bdf1/Bdf2's four control
+/// vertices included, plus the elevations), and the shaft. Past any limit for a def that does not validate.
+double plume_sh_estimate_bytes(const plume_sh_def *def, const plume_sh_lod *lod);
+
 /// plume_sh_generate with an explicit level of detail (lod NULL: plume_sh_default_lod()).
 plume_status plume_sh_generate_lod(const plume_sh_def *def, uint64_t seed, double stage, const plume_sh_lod *lod,
                                    plume_feather **out, plume_error *err);

@@ -170,6 +170,16 @@ plume_zk_def plume_zk_default_def(void);
 /// ("$.posterior overlaps $.anterior: ...", "$.emitter_speed[2][1] is -1, ...").
 plume_status plume_zk_def_validate(const plume_zk_def *def, plume_error *err);
 
+/// Bytes the feather of def takes, counted before the growth and never below the built feather's.
+/// A pathline crosses less than the collar's perimeter L (the circle's 2 pi R, or the Bezier collar's
+/// control polygon, which no Bezier arc outruns) at V_b >= its smallest control value (the curves never
+/// leave their control values' range), so it takes at most T = L / min V_b seconds: T / step steps
+/// (growth refuses more than two million), every downsample-th kept. A vane holds N mature barbs and the
+/// ones emitted in the last T seconds, one per ridge_width (1 - ridge_width_variation) of emitter travel at
+/// V_e <= its largest control value. Barbules (expansion with keep_barbules) add four points a vertex.
+/// Past any limit for a def that does not validate.
+double plume_zk_estimate_bytes(const plume_zk_def *def);
+
 /// How snapping went for one barb (IV-C).
 typedef enum plume_zk_snap {
 	PLUME_ZK_SNAP_OFF = 0, ///< expansion is off

@@ -1,4 +1,6 @@
 // Feather specs: the "model" key picks the generator.
+#include <stdarg.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "spec.h"
@@ -29,6 +31,28 @@ plume_status plume_fw_def_read(const char *path, plume_fw_def *def, uint64_t *se
 	return status;
 }
 
+double plume_spec_memory_limit(const plume_spec_options *options)
+{
+	return (double)(options != NULL && options->max_memory > 0 ? options->max_memory : PLUME_DEFAULT_MAX_MEMORY);
+}
+
+plume_status plume_spec_check_feather_bytes(const char *file, double bytes, const plume_spec_options *options,
+                                            plume_error *err, const char *keys, ...)
+{
+	double limit = plume_spec_memory_limit(options);
+	if (bytes <= limit)
+		return PLUME_OK;
+	char what[512];
+	va_list args;
+	va_start(args, keys);
+	vsnprintf(what, sizeof what, keys, args);
+	va_end(args);
+	return plume_error_set(err, PLUME_ERROR_LIMIT,
+	                       "%s: %s make a feather of about %.3g GB; the limit is %.3g GB (raise it with --max-memory, "
+	                       "or lower them)",
+	                       file, what, bytes / 1e9, limit / 1e9);
+}
+
 plume_status plume_fw_spec_generate(const char *file, const json_t *root, const plume_spec_options *options,
                                     plume_feather **out, plume_error *err)
 {
@@ -44,18 +68,16 @@ plume_status plume_fw_spec_generate(const char *file, const json_t *root, const 
 		return status;
 	if (options != NULL && options->seed_given)
 		seed = options->seed;
+	// A def out of its ranges gets its range message, not the limit's.
 	double bytes = plume_fw_estimate_bytes(&def);
-	double limit =
-	    (double)(options != NULL && options->max_memory > 0 ? options->max_memory : PLUME_DEFAULT_MAX_MEMORY);
-	if (!(bytes <= limit) && plume_fw_def_validate(&def, err) == PLUME_OK)
-		return plume_error_set(err, PLUME_ERROR_LIMIT,
-		                       "%s: $.segments[*].barb_count (%d and %d barbs a vane) x $.barb_samples (%d) and "
-		                       "$.shaft_samples (%d) make a feather of about %.3g GB; the limit is %.3g GB (raise it "
-		                       "with --max-memory, or lower them)",
-		                       file, def.segments[0].barb_count, def.segments[1].barb_count, def.barb_samples,
-		                       def.shaft_samples, bytes / 1e9, limit / 1e9);
-	if (!(bytes <= limit))
-		return err != NULL ? err->status : PLUME_ERROR_SPEC;
+	if (!(bytes <= plume_spec_memory_limit(options)) && (status = plume_fw_def_validate(&def, err)) != PLUME_OK)
+		return status;
+	if ((status = plume_spec_check_feather_bytes(
+	         file, bytes, options, err,
+	         "$.segments[*].barb_count (%d and %d barbs a vane) x $.barb_samples (%d) and "
+	         "$.shaft_samples (%d)",
+	         def.segments[0].barb_count, def.segments[1].barb_count, def.barb_samples, def.shaft_samples)) != PLUME_OK)
+		return status;
 	return plume_fw_generate(&def, seed, out, err);
 }
 

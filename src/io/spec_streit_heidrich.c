@@ -505,8 +505,12 @@ plume_status plume_sh_spec_generate(const char *file, const json_t *root, const 
 	if (status == PLUME_OK) {
 		if (options != NULL && options->seed_given)
 			seed = options->seed;
-		status = plume_sh_generate_lod(def, seed, stage, &lod, out, err);
-		if (status != PLUME_OK)
+		status = plume_spec_check_feather_bytes(
+		    file, plume_sh_estimate_bytes(def, &lod), options, err,
+		    "$.rachis_length / $.spacing_base, $.spacing_tip (at most %d barbs a vane%s) x $.key_barbs[*].cvs and "
+		    "$.lod.barb_elevations (%d)",
+		    PLUME_SH_MAX_BARBS, def->has_afterfeather ? ", and $.afterfeather's" : "", lod.barb_elevations);
+		if (status == PLUME_OK && (status = plume_sh_generate_lod(def, seed, stage, &lod, out, err)) != PLUME_OK)
 			plume_error_prefix(err, file);
 	}
 	plume_free(def);

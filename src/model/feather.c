@@ -7,6 +7,22 @@
 #include "../core/vec_inline.h"
 #include "feather_internal.h"
 
+double plume_feather_layout_bytes(double points, double barbs, double barbules, double shaft)
+{
+	return points * (2.0 * sizeof(plume_vec3) + 2.0 * sizeof(double) + sizeof(plume_vec2)) +
+	       barbs * sizeof(plume_barb_record) + barbules * sizeof(plume_barbule_record) +
+	       shaft * sizeof(plume_shaft_sample);
+}
+
+double plume_feather_bytes(const plume_feather *feather)
+{
+	if (feather == NULL)
+		return 0.0;
+	return plume_feather_layout_bytes(feather->point_count, feather->barb_count, feather->barbule_count,
+	                                  feather->shaft_count) +
+	       plume_feather_bytes(feather->afterfeather);
+}
+
 plume_feather *plume_feather_create_empty(void)
 {
 	plume_feather *feather = plume_calloc(1, sizeof *feather);

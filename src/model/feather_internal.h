@@ -57,6 +57,14 @@ struct plume_feather {
 	char *summary; ///< generator diagnostics (JSON text) or NULL; see plume_feather_summary
 };
 
+/// Bytes of a feather holding `points` pool points (five per-point arrays), `barbs` barb and
+/// `barbules` barbule records and `shaft` shaft samples: what the generators' estimates before
+/// the work count (doubles, so that absurd counts do not overflow).
+double plume_feather_layout_bytes(double points, double barbs, double barbules, double shaft);
+
+/// plume_feather_layout_bytes of a built feather's counts, its afterfeather's included.
+double plume_feather_bytes(const plume_feather *feather);
+
 /// An empty feather, or NULL when memory runs out.
 plume_feather *plume_feather_create_empty(void);
 

@@ -251,7 +251,7 @@ double plume_fw_estimate_bytes(const plume_fw_def *def)
 {
 	double barbs = 2.0 * ((double)def->segments[0].barb_count + (double)def->segments[1].barb_count);
 	double points = (double)def->shaft_samples + barbs * (double)def->barb_samples;
-	return points * (2.0 * sizeof(plume_vec3) + 2.0 * sizeof(double) + sizeof(plume_vec2));
+	return plume_feather_layout_bytes(points, barbs, 0.0, def->shaft_samples);
 }
 
 plume_status plume_fw_generate(const plume_fw_def *def, uint64_t seed, plume_feather **out, plume_error *err)

@@ -734,6 +734,38 @@ static plume_status check_lod(const plume_sh_lod *lod, plume_error *err)
 	return PLUME_OK;
 }
 
+/// Barbs, points and shaft samples of one feather of plume_sh_estimate_bytes, added to counts[3].
+static void sh_estimate_feather(const plume_sh_params *p, const plume_sh_lod *lod, double counts[3])
+{
+	// build_feather's rachis: cl + [0, rl] with the bends rlc rl and rvdc rl at the inner control vertices,
+	// scaled down (never up) by the growth stage.
+	double rl = p->rachis_length;
+	double bend = sqrt(rl * rl / 9.0 + pow(p->rachis_side_curvature * rl, 2) + pow(p->rachis_front_curvature * rl, 2));
+	double polygon = 2.0 * bend + rl / 3.0;
+	// barb_positions: barb k where the density 1 / spacing integrates to k + 1/2.
+	double barbs = fmin(PLUME_SH_MAX_BARBS, polygon / fmin(p->spacing_base, p->spacing_tip) + 1.0);
+	int cvs = 4;
+	for (int j = 0; j < p->key_barb_count && j < PLUME_SH_MAX_KEY_BARBS; ++j)
+		if (p->key_barbs[j].cv_count > cvs)
+			cvs = p->key_barbs[j].cv_count;
+	double per_barb = fmin(PLUME_BEZIER_MAX_POINTS, (double)cvs + lod->barb_elevations);
+	counts[0] += 2.0 * barbs;
+	counts[1] += 2.0 * barbs * per_barb;
+	counts[2] += (double)lod->calamus_samples + 4.0 + lod->rachis_elevations;
+}
+
+double plume_sh_estimate_bytes(const plume_sh_def *def, const plume_sh_lod *lod)
+{
+	plume_sh_lod default_lod = plume_sh_default_lod();
+	if (lod == NULL)
+		lod = &default_lod;
+	double counts[3] = {0.0, 0.0, 0.0}; // barbs, points, shaft samples
+	sh_estimate_feather(&def->main, lod, counts);
+	if (def->has_afterfeather)
+		sh_estimate_feather(&def->afterfeather, lod, counts);
+	return plume_feather_layout_bytes(counts[1], counts[0], 0.0, counts[2]);
+}
+
 plume_status plume_sh_generate_lod(const plume_sh_def *def, uint64_t seed, double stage, const plume_sh_lod *lod,
                                    plume_feather **out, plume_error *err)
 {

@@ -20,6 +20,7 @@
 #include <string.h>
 
 #include "../core/alloc.h"
+#include "feather_internal.h"
 #include "zhang_kanai_internal.h"
 
 /// Upper bounds that turn a runaway spec into an error instead of a hang.
@@ -322,6 +323,50 @@ void zk_growth_free(zk_growth *growth)
 	plume_free(growth->locus);
 	plume_free(growth->time);
 	memset(growth, 0, sizeof *growth);
+}
+
+/// The smallest (largest when want_max) control value of a distribution: its monotone cubic stays between them.
+static double curve_extreme(const plume_zk_curve *curve, bool want_max)
+{
+	double value = curve->value[0];
+	for (int k = 1; k < curve->count && k < PLUME_ZK_MAX_CURVE_POINTS; ++k)
+		value = want_max ? fmax(value, curve->value[k]) : fmin(value, curve->value[k]);
+	return value;
+}
+
+/// The collar's perimeter or, for the Bezier collar, the length of its segments' control polygons
+/// (zk_collar_init's Catmull-Rom inner points), which bounds it from above.
+static double collar_length_bound(const plume_zk_def *def)
+{
+	if (def->collar_kind != PLUME_ZK_COLLAR_BEZIER)
+		return 6.283185307179586 * def->collar_radius; // 2 pi R
+	int n = def->collar_point_count;
+	if (n < 4 || n > PLUME_ZK_MAX_COLLAR_POINTS)
+		return INFINITY; // refused by validation
+	const plume_vec2 *p = def->collar_points;
+	double length = 0.0;
+	for (int k = 0; k < n; ++k) {
+		plume_vec2 a = p[k], b = p[(k + 1) % n], before = p[(k + n - 1) % n], after = p[(k + 2) % n];
+		plume_vec2 c1 = {a.x + (b.x - before.x) / 6.0, a.y + (b.y - before.y) / 6.0};
+		plume_vec2 c2 = {b.x - (after.x - a.x) / 6.0, b.y - (after.y - a.y) / 6.0};
+		length += hypot(c1.x - a.x, c1.y - a.y) + hypot(c2.x - c1.x, c2.y - c1.y) + hypot(b.x - c2.x, b.y - c2.y);
+	}
+	return length;
+}
+
+double plume_zk_estimate_bytes(const plume_zk_def *def)
+{
+	double path_time = collar_length_bound(def) / curve_extreme(&def->barb_speed, false);
+	double steps = fmin((double)MAX_STEPS_PER_PATH, ceil(path_time / def->step)) + 1.0;
+	double vertices_per_barb = steps / (double)(def->downsample > 0 ? def->downsample : 1) + 2.0;
+	double spacing = def->ridge_width * (1.0 - def->ridge_width_variation);
+	double developing =
+	    fmin((double)MAX_EMISSIONS_PER_VANE, path_time * curve_extreme(&def->emitter_speed, true) / spacing + 1.0);
+	double barbs = 2.0 * ((double)def->barb_count + developing);
+	double vertices = barbs * vertices_per_barb;
+	bool barbules = def->expansion && def->keep_barbules;
+	return plume_feather_layout_bytes(vertices * (barbules ? 5.0 : 1.0), barbs, barbules ? 2.0 * vertices : 0.0,
+	                                  def->shaft_samples);
 }
 
 static plume_status fail_runaway(plume_status status, plume_error *err)

@@ -162,6 +162,26 @@ edit "$bad/fw-dense.json" "$bad/fw-range.json" "d['segments'][0]['barb_count'] =
 expect_no_output "FW out of range wins over the limit" 3 '$.segments[0].barb_count' "$scratch/g2" \
 	$T "$plume" generate "$bad/fw-range.json" -o "$scratch/g2" --max-memory 64M
 
+# --- Streit-Heidrich and Zhang-Kanai feathers past the limit, within the keys' ranges -------
+# (plume_sh_estimate_bytes, plume_zk_estimate_bytes)
+edit "$examples/streit-heidrich/contour.json" "$bad/sh-dense.json" \
+	"d['spacing_base'] = d['spacing_tip'] = 1e-6; d['lod'] = {'barb_elevations': 60}"
+expect_no_output "SH 4000 barbs a vane x 64 points past --max-memory 16M" 5 \
+	'sh-dense.json: $.rachis_length / $.spacing_base, $.spacing_tip (at most 4000 barbs a vane)' "$scratch/g3" \
+	$T "$plume" generate "$bad/sh-dense.json" -o "$scratch/g3" --max-memory 16M
+check "SH limit names the estimate and --max-memory" \
+	grep -qF 'the limit is 0.0168 GB (raise it with --max-memory' "$scratch/err.txt"
+$T "$plume" generate "$examples/streit-heidrich/contour.json" -o "$scratch/g4" -f json --max-memory 1M \
+	2>"$scratch/err.txt"
+check "SH contour under --max-memory 1M ($(cat "$scratch/err.txt"))" test -s "$scratch/g4/feather.json"
+edit "$examples/zhang-kanai/figure11-expansion.json" "$bad/zk-dense.json" \
+	"d['barb_count'] = 5000; d['step'] = 1e-5; d['downsample'] = 1"
+expect_no_output "ZK 5000 barbs traced at 10 us with barbules" 5 \
+	'zk-dense.json: $.barb_count (5000) and the barbs still growing' "$scratch/g5" \
+	$T "$plume" generate "$bad/zk-dense.json" -o "$scratch/g5"
+check "ZK limit names the step, the barbules and --max-memory" \
+	grep -qF '($.step 1e-05, $.downsample 1, barbules kept) make a feather of about' "$scratch/err.txt"
+
 # --- renders past the limit: pixels x images (cli/render.c, plume_raytrace_estimate_bytes) ---
 expect_no_output "render turntable of 100 16384^2 images" 5 \
 	'filoplume.json: 100 image(s) of 16384x16384 pixels' "$scratch/r1" \
