@@ -52,6 +52,8 @@ void cli_help_lab(void)
 	     "study: writes DIR/<study>.csv, .png and .svg and prints a JSON summary.\n"
 	     "  --scale S              element counts times S (default 1; e.g. 0.25 for a quick look)\n"
 	     "\n"
+	     "  --max-memory BYTES     refuse a run whose largest mesh is estimated past BYTES\n"
+	     "                         (16 KiB an element; K, M, G suffixes; default 4G; docs/cli.md)\n"
 	     "  -o, --output DIR       output folder (created if missing; all files or none)\n"
 	     "  -h, --help             this help");
 }
@@ -142,17 +144,39 @@ static plume_status write_traction(cli_output *output, const plume_traction_resu
 	                      cli_output_path(output, "traction.svg", svg, sizeof svg), err);
 }
 
+/// Refuses (exit 5) a lab run whose estimate passes --max-memory (0: PLUME_DEFAULT_MAX_MEMORY); what
+/// names the keys or flags that size its largest mesh.
+static int check_memory(double bytes, uint64_t max_memory, const char *what)
+{
+	double limit = (double)(max_memory > 0 ? max_memory : PLUME_DEFAULT_MAX_MEMORY);
+	if (bytes <= limit)
+		return CLI_EXIT_OK;
+	plume_error err = {0};
+	plume_error_set(&err, PLUME_ERROR_LIMIT,
+	                "%s make meshes of about %.3g GB (%.0f KiB an element); the limit is %.3g GB (raise it with "
+	                "--max-memory, or lower them)",
+	                what, bytes / 1e9, PLUME_LAB_BYTES_PER_ELEMENT / 1024.0, limit / 1e9);
+	return cli_fail(&err);
+}
+
 static int run_traction(int argc, char **argv)
 {
-	static const struct option options[] = {
-	    {"output", required_argument, NULL, 'o'}, {"help", no_argument, NULL, 'h'}, {NULL, 0, NULL, 0}};
+	static const struct option options[] = {{"output", required_argument, NULL, 'o'},
+	                                        {"max-memory", required_argument, NULL, 'M'},
+	                                        {"help", no_argument, NULL, 'h'},
+	                                        {NULL, 0, NULL, 0}};
 	const char *output_dir = NULL;
+	uint64_t max_memory = 0;
 	int option;
 	optind = 1;
 	opterr = 0;
 	while ((option = getopt_long(argc, argv, ":o:h", options, NULL)) != -1) {
 		switch (option) {
 		case 'o': output_dir = optarg; break;
+		case 'M':
+			if (!cli_parse_memory("lab", optarg, &max_memory))
+				return CLI_EXIT_USAGE;
+			break;
 		case 'h': cli_help_lab(); return CLI_EXIT_OK;
 		case ':': return cli_usage_error("lab", "option '%s' needs a value", argv[optind - 1]);
 		default: return cli_usage_error("lab", "unknown option '%s'", argv[optind - 1]);
@@ -165,6 +189,11 @@ static int run_traction(int argc, char **argv)
 	plume_status status = plume_lab_spec_load(argv[optind], &spec, &err);
 	if (status != PLUME_OK)
 		return cli_fail(&err);
+	char what[4352];
+	snprintf(what, sizeof what, "%s: $.sample.elements (%d)", argv[optind], spec.sample.element_count);
+	int code = check_memory(plume_sample_estimate_bytes(spec.sample.element_count), max_memory, what);
+	if (code != CLI_EXIT_OK)
+		return code;
 	plume_traction_result result;
 	status = plume_lab_traction(&spec.material, &spec.sample, &spec.traction, &result, &err);
 	if (status != PLUME_OK) {
@@ -342,12 +371,14 @@ static int run_calibrate(int argc, char **argv)
 	    {"compression", required_argument, NULL, 'c'},
 	    {"linear-macro", no_argument, NULL, 'l'},
 	    {"no-uncertainty", no_argument, NULL, 'n'},
+	    {"max-memory", required_argument, NULL, 'M'},
 	    {"output", required_argument, NULL, 'o'},
 	    {"help", no_argument, NULL, 'h'},
 	    {NULL, 0, NULL, 0},
 	};
 	plume_calibration_def def = plume_calibration_default_def();
 	bool phi_given = false, Eb_given = false, EB_given = false;
+	uint64_t max_memory = 0;
 	const char *output_dir = NULL;
 	int option;
 	optind = 1;
@@ -378,6 +409,7 @@ static int run_calibrate(int argc, char **argv)
 		case 'c': ok = parse_double("--compression", optarg, &def.mesoscale.compression_coefficient); break;
 		case 'l': def.macroscale_quadratic = false; break;
 		case 'n': def.uncertainty = false; break;
+		case 'M': ok = cli_parse_memory("lab", optarg, &max_memory); break;
 		case 'o': output_dir = optarg; break;
 		case 'h': cli_help_lab(); return CLI_EXIT_OK;
 		case ':': return cli_usage_error("lab", "option '%s' needs a value", argv[optind - 1]);
@@ -395,6 +427,12 @@ static int run_calibrate(int argc, char **argv)
 		fprintf(stderr, "plume: --phi is %g, allowed in (0, 1)\n", def.mesoscale.bands.barb_fraction);
 		return CLI_EXIT_INPUT;
 	}
+	char what[160];
+	snprintf(what, sizeof what, "--elements %d and --macro-elements %d (%s)", def.sample.element_count,
+	         def.macroscale_elements, def.uncertainty ? "twice the larger for the spreads" : "the larger");
+	int code = check_memory(plume_calibration_estimate_bytes(&def), max_memory, what);
+	if (code != CLI_EXIT_OK)
+		return code;
 	plume_calibration_result r;
 	cli_progress progress;
 	cli_progress_begin(&progress, "lab calibrate", 1);
@@ -406,7 +444,7 @@ static int run_calibrate(int argc, char **argv)
 	if (status != PLUME_OK)
 		return cli_fail(&err);
 	print_calibration(stdout, &def, &r);
-	int code = output_dir != NULL ? write_calibration(output_dir, &def, &r) : CLI_EXIT_OK;
+	code = output_dir != NULL ? write_calibration(output_dir, &def, &r) : CLI_EXIT_OK;
 	plume_calibration_result_free(&r);
 	return code;
 }
@@ -418,11 +456,13 @@ static int run_study(int argc, char **argv)
 {
 	static const struct option options[] = {{"output", required_argument, NULL, 'o'},
 	                                        {"scale", required_argument, NULL, 's'},
+	                                        {"max-memory", required_argument, NULL, 'M'},
 	                                        {"help", no_argument, NULL, 'h'},
 	                                        {NULL, 0, NULL, 0}};
 	const char *output_dir = NULL;
 	plume_study_def def = plume_study_default_def(PLUME_STUDY_LOCKING);
 	double scale = 1.0;
+	uint64_t max_memory = 0;
 	int option;
 	optind = 1;
 	opterr = 0;
@@ -431,6 +471,10 @@ static int run_study(int argc, char **argv)
 		case 'o': output_dir = optarg; break;
 		case 's':
 			if (!parse_double("--scale", optarg, &scale))
+				return CLI_EXIT_USAGE;
+			break;
+		case 'M':
+			if (!cli_parse_memory("lab", optarg, &max_memory))
 				return CLI_EXIT_USAGE;
 			break;
 		case 'h': cli_help_lab(); return CLI_EXIT_OK;
@@ -452,6 +496,11 @@ static int run_study(int argc, char **argv)
 		return cli_usage_error("lab", "--scale is %g, allowed in (0, 16]", scale);
 	def = plume_study_default_def(kind);
 	def.scale = scale;
+	char what[96];
+	snprintf(what, sizeof what, "--scale %g (16000 x %g elements)", scale, scale);
+	int code = check_memory(plume_study_estimate_bytes(&def), max_memory, what);
+	if (code != CLI_EXIT_OK)
+		return code;
 	plume_error err = {0};
 	cli_output output;
 	plume_status status = cli_output_begin(&output, output_dir, &err);

@@ -128,6 +128,18 @@ enum { PLUME_BAND_BARBULE = 0, PLUME_BAND_BARB = 1 };
 plume_status plume_sample_mesh(const plume_sample_def *sample, const plume_band_def *bands, plume_mesh **out,
                                plume_error *err);
 
+/// Bytes a lab test holds per element of its sample mesh (mesh, quadratic dofs, sparse Hessian and its
+/// factorization), with a margin: measured 8.2 KB an element from 2000 to 8000 and 9.0 KB from 8000 to
+/// 32000 mesoscale (quadratic) elements (peak RSS of `plume lab traction`, docs/cli.md).
+#define PLUME_LAB_BYTES_PER_ELEMENT 16384.0
+/// What a lab run holds besides its meshes: the program, the plots.
+#define PLUME_LAB_BYTES_FIXED (32.0 * 1024 * 1024)
+
+/// Bytes a traction test on sample takes, counted before the work: PLUME_LAB_BYTES_FIXED plus
+/// element_count x PLUME_LAB_BYTES_PER_ELEMENT (the tests run one after another: a run's
+/// largest mesh sets its peak).
+double plume_sample_estimate_bytes(double element_count);
+
 /// The checks plume_sample_mesh makes before meshing.
 plume_status plume_sample_validate(const plume_sample_def *sample, const plume_band_def *bands, plume_error *err);
 
@@ -309,6 +321,11 @@ typedef struct plume_calibration_def {
 
 plume_calibration_def plume_calibration_default_def(void);
 
+/// Bytes a calibration takes, counted before the work (plume_sample_estimate_bytes): its largest mesh
+/// is the mesoscale sample or the macroscale one, twice that for the spreads (finer and wider meshes)
+/// when def->uncertainty.
+double plume_calibration_estimate_bytes(const plume_calibration_def *def);
+
 /// "chapter-5" when def's protocol fields (strain ranges, kappa, barb constraint, element
 /// kind, sample width and period, aspect ratio, phases, meshes) are the defaults, else "custom".
 const char *plume_calibration_protocol_name(const plume_calibration_def *def);
@@ -452,6 +469,10 @@ typedef struct plume_study_def {
 } plume_study_def;
 
 plume_study_def plume_study_default_def(plume_study_kind kind);
+
+/// Bytes a study takes, counted before the work (plume_sample_estimate_bytes): its largest mesh,
+/// 16000 elements (the locking study's reference and the size study's widest sample) times def->scale.
+double plume_study_estimate_bytes(const plume_study_def *def);
 
 /// "locking", "conditioning", "angles", "size" or "bending".
 bool plume_study_kind_from_name(const char *name, plume_study_kind *kind);

@@ -44,6 +44,13 @@ plume_calibration_def plume_calibration_default_def(void)
 	return def;
 }
 
+double plume_calibration_estimate_bytes(const plume_calibration_def *def)
+{
+	int largest =
+	    def->sample.element_count > def->macroscale_elements ? def->sample.element_count : def->macroscale_elements;
+	return plume_sample_estimate_bytes((def->uncertainty ? 2.0 : 1.0) * largest);
+}
+
 const char *plume_calibration_protocol_name(const plume_calibration_def *def)
 {
 	plume_calibration_def d = plume_calibration_default_def();

@@ -417,6 +417,11 @@ static int compare_face(const void *a, const void *b)
 	return 0;
 }
 
+double plume_sample_estimate_bytes(double element_count)
+{
+	return PLUME_LAB_BYTES_FIXED + element_count * PLUME_LAB_BYTES_PER_ELEMENT;
+}
+
 plume_status plume_sample_validate(const plume_sample_def *sample, const plume_band_def *bands, plume_error *err)
 {
 	PLUME_ASSERT_DEF(sample);

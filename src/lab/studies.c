@@ -37,6 +37,11 @@ static int scaled(int count, double scale)
 	return n < 8 ? 8 : n;
 }
 
+double plume_study_estimate_bytes(const plume_study_def *def)
+{
+	return plume_sample_estimate_bytes(16000.0 * def->scale);
+}
+
 // A growing table of rows, written column by column.
 enum { MAX_COLUMNS = 8 };
 typedef struct table {

@@ -182,6 +182,18 @@ expect_no_output "ZK 5000 barbs traced at 10 us with barbules" 5 \
 check "ZK limit names the step, the barbules and --max-memory" \
 	grep -qF '($.step 1e-05, $.downsample 1, barbules kept) make a feather of about' "$scratch/err.txt"
 
+# --- lab runs past the limit: the largest mesh's elements x 16 KiB (plume_sample_estimate_bytes) -----
+edit "$examples/lab/tilted-mesoscale.json" "$bad/lab-dense.json" "d['sample']['elements'] = 4000000"
+expect_no_output "lab traction of 4e6 elements" 5 \
+	'lab-dense.json: $.sample.elements (4000000) make meshes of about 65.6 GB (16 KiB an element); the limit is 4.29 GB (raise it with --max-memory' \
+	"$scratch/l1" $T "$plume" lab traction "$bad/lab-dense.json" -o "$scratch/l1"
+expect_no_output "lab calibrate --elements 100000 past --max-memory 1G" 5 \
+	'--elements 100000 and --macro-elements 2000 (twice the larger for the spreads) make meshes of about 3.31 GB' \
+	"$scratch/l2" $T "$plume" lab calibrate --phi 0.14 --Eb 3.92e4 --EB 2.57e9 --elements 100000 --max-memory 1G \
+	-o "$scratch/l2"
+expect_no_output "lab study --scale 16 past --max-memory 1G" 5 '--scale 16 (16000 x 16 elements) make meshes' \
+	"$scratch/l3" $T "$plume" lab study locking --scale 16 --max-memory 1G -o "$scratch/l3"
+
 # --- renders past the limit: pixels x images (cli/render.c, plume_raytrace_estimate_bytes) ---
 expect_no_output "render turntable of 100 16384^2 images" 5 \
 	'filoplume.json: 100 image(s) of 16384x16384 pixels' "$scratch/r1" \
