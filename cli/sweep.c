@@ -27,7 +27,7 @@
 
 void cli_help_sweep(void)
 {
-	puts("Usage: plume sweep SWEEP.json -o DIR [-j N] [--dry-run]\n"
+	puts("Usage: plume sweep SWEEP.json -o DIR [-j N] [--dry-run] [--max-runs N]\n"
 	     "       mpirun -n N plume sweep SWEEP.json -o DIR\n"
 	     "\n"
 	     "Runs one plume command (generate, mesh, coat, simulate, lab traction, lab\n"
@@ -48,6 +48,8 @@ void cli_help_sweep(void)
 	     "  -j, --jobs N           runs at once on this machine (default 1)\n"
 	     "      --dry-run          check the sweep and print each run's parameter values\n"
 	     "                         (CSV) without running anything or writing DIR\n"
+	     "      --max-runs N       refuse a sweep of more than N runs before any starts\n"
+	     "                         (default 100000, at most 1000000; docs/cli.md)\n"
 	     "  -h, --help             this help\n"
 	     "\n"
 	     "Under mpirun or srun (plume built with MPI) rank 0 schedules and every other\n"
@@ -85,11 +87,13 @@ int cli_sweep(int argc, char **argv)
 	static const struct option options[] = {{"output", required_argument, NULL, 'o'},
 	                                        {"jobs", required_argument, NULL, 'j'},
 	                                        {"dry-run", no_argument, NULL, 'n'},
+	                                        {"max-runs", required_argument, NULL, 'R'},
 	                                        {"help", no_argument, NULL, 'h'},
 	                                        {NULL, 0, NULL, 0}};
 	const char *output_dir = NULL;
 	int jobs = 1;
 	bool dry_run = false;
+	long max_runs = SWEEP_DEFAULT_MAX_RUNS;
 	int option;
 	optind = 1;
 	opterr = 0;
@@ -105,6 +109,13 @@ int cli_sweep(int argc, char **argv)
 			break;
 		}
 		case 'n': dry_run = true; break;
+		case 'R': {
+			char *end = NULL;
+			max_runs = strtol(optarg, &end, 10);
+			if (end == optarg || *end != '\0' || max_runs < 1 || max_runs > 1000000)
+				return cli_usage_error("sweep", "--max-runs expects a whole number in [1, 1000000], got '%s'", optarg);
+			break;
+		}
 		case 'h': cli_help_sweep(); return CLI_EXIT_OK;
 		case ':': return cli_usage_error("sweep", "option '%s' needs a value", argv[optind - 1]);
 		default: return cli_usage_error("sweep", "unknown option '%s'", argv[optind - 1]);
@@ -138,7 +149,16 @@ int cli_sweep(int argc, char **argv)
 	(void)saved_stderr;
 	sweep s;
 	int code = CLI_EXIT_OK;
-	if (!sweep_load(&s, argv[optind]) || (rank == 0 && !sweep_check(&s)))
+	if (!sweep_load(&s, argv[optind]))
+		code = CLI_EXIT_INPUT;
+	else if (rank == 0 && s.run_count > max_runs) {
+		// Before any run starts or DIR is touched: each run is a plume process.
+		sweep_error(&s,
+		            "$.samples (%d) x the grids' and lists' values (%d) make %d runs; the limit is %ld (raise it "
+		            "with --max-runs, up to 1000000)",
+		            s.samples, s.grid_count, s.run_count, max_runs);
+		code = CLI_EXIT_LIMIT;
+	} else if (rank == 0 && !sweep_check(&s))
 		code = CLI_EXIT_INPUT;
 	sweep_state state;
 	memset(&state, 0, sizeof state);

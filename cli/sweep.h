@@ -105,6 +105,10 @@ typedef struct sweep {
 	int run_count;
 } sweep;
 
+/// The runs a sweep may have unless --max-runs raises it (docs/cli.md, Limits); $.samples and the
+/// grids allow up to 1000000.
+#define SWEEP_DEFAULT_MAX_RUNS 100000L
+
 /// Prints "plume: FILE: message" on stderr; returns false.
 bool sweep_error(const sweep *s, const char *format, ...)
 #if defined(__GNUC__)

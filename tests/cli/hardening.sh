@@ -194,6 +194,18 @@ expect_no_output "lab calibrate --elements 100000 past --max-memory 1G" 5 \
 expect_no_output "lab study --scale 16 past --max-memory 1G" 5 '--scale 16 (16000 x 16 elements) make meshes' \
 	"$scratch/l3" $T "$plume" lab study locking --scale 16 --max-memory 1G -o "$scratch/l3"
 
+# --- a sweep of 1e6 runs (the spec's own cap) past the default --max-runs 100000 --------------------
+cat >"$bad/sweep-big.json" <<EOF
+{"command": "generate", "spec": "$examples/franco-walter/hawk.json", "outputs": [],
+ "parameters": [{"path": "\$.barb_width_base", "grid": {"from": 1e-4, "to": 2e-4, "count": 1000}},
+                {"path": "\$.barb_width_tip", "grid": {"from": 1e-5, "to": 2e-5, "count": 1000}}]}
+EOF
+expect_no_output "sweep of 1e6 runs" 5 \
+	"sweep-big.json: \$.samples (1) x the grids' and lists' values (1000000) make 1000000 runs; the limit is 100000 (raise it with --max-runs" \
+	"$scratch/s1" $T "$plume" sweep "$bad/sweep-big.json" -o "$scratch/s1"
+expect_no_output "sweep --max-runs 0" 2 "--max-runs expects a whole number in [1, 1000000], got '0'" "$scratch/s2" \
+	$T "$plume" sweep "$bad/sweep-big.json" -o "$scratch/s2" --max-runs 0
+
 # --- renders past the limit: pixels x images (cli/render.c, plume_raytrace_estimate_bytes) ---
 expect_no_output "render turntable of 100 16384^2 images" 5 \
 	'filoplume.json: 100 image(s) of 16384x16384 pixels' "$scratch/r1" \
