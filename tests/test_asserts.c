@@ -195,6 +195,14 @@ static void bad_shell_view(void)
 	plume_render_shell_png(mesh, NULL, &def, "/nonexistent/never-written.png", NULL);
 }
 
+static void bad_mesh(void)
+{
+	plume_feather *feather = small_feather();
+	GARBAGE(plume_mesh_def, def);
+	plume_mesh *out;
+	plume_mesh_from_feather(feather, &def, &out, NULL, NULL);
+}
+
 static void null_def(void)
 {
 	plume_feather *out;
@@ -204,9 +212,9 @@ static void null_def(void)
 static void test_uninitialised_definitions(void **state)
 {
 	(void)state;
-	misuse_fn *bodies[] = {bad_fw,       bad_sh,         bad_zk,       bad_sim,        bad_gltf,
-	                       bad_sample,   bad_band,       bad_traction, bad_study,      bad_raytrace,
-	                       bad_render2d, bad_shell_view, null_def,     bad_calibration};
+	misuse_fn *bodies[] = {bad_fw,       bad_sh,         bad_zk,       bad_sim,         bad_gltf,
+	                       bad_sample,   bad_band,       bad_traction, bad_study,       bad_raytrace,
+	                       bad_render2d, bad_shell_view, null_def,     bad_calibration, bad_mesh};
 	for (size_t i = 0; i < sizeof bodies / sizeof bodies[0]; ++i)
 		expect_abort(bodies[i], COOKIE);
 }

@@ -26,6 +26,7 @@
 #include <string.h>
 
 #include "../core/alloc.h"
+#include "../core/asserts.h"
 #include "aligned_internal.h"
 
 static const double pi = 3.14159265358979323846;
@@ -1321,8 +1322,8 @@ static plume_status mesh_estimate(const mesh_input *input, const plume_mesh_def 
 plume_status plume_mesh_from_feather(const plume_feather *feather, const plume_mesh_def *def, plume_mesh **out,
                                      plume_mesh_report *report, plume_error *err)
 {
-	assert(feather != NULL && def != NULL && out != NULL);
-	assert(def->cookie == PLUME_DEF_COOKIE && "plume_mesh_def not from plume_mesh_default_def()");
+	PLUME_ASSERT(feather != NULL && out != NULL);
+	PLUME_ASSERT_DEF(def);
 	*out = NULL;
 	mesh_input input;
 	plume_status status = mesh_input_from_feather(feather, def, &input, err);
@@ -1336,8 +1337,8 @@ plume_status plume_mesh_from_feather(const plume_feather *feather, const plume_m
 plume_status plume_mesh_from_guides(const plume_mesh_guides *guides, const plume_mesh_def *def, plume_mesh **out,
                                     plume_mesh_report *report, plume_error *err)
 {
-	assert(guides != NULL && def != NULL && out != NULL);
-	assert(def->cookie == PLUME_DEF_COOKIE && "plume_mesh_def not from plume_mesh_default_def()");
+	PLUME_ASSERT(guides != NULL && out != NULL);
+	PLUME_ASSERT_DEF(def);
 	*out = NULL;
 	mesh_input input;
 	plume_status status = mesh_input_from_guides(guides, def, &input, err);
@@ -1351,8 +1352,8 @@ plume_status plume_mesh_from_guides(const plume_mesh_guides *guides, const plume
 plume_status plume_mesh_estimate_feather(const plume_feather *feather, const plume_mesh_def *def,
                                          plume_mesh_estimate *out, plume_error *err)
 {
-	assert(feather != NULL && def != NULL && out != NULL);
-	assert(def->cookie == PLUME_DEF_COOKIE && "plume_mesh_def not from plume_mesh_default_def()");
+	PLUME_ASSERT(feather != NULL && out != NULL);
+	PLUME_ASSERT_DEF(def);
 	memset(out, 0, sizeof *out);
 	mesh_input input;
 	plume_status status = mesh_input_from_feather(feather, def, &input, err);
@@ -1366,8 +1367,8 @@ plume_status plume_mesh_estimate_feather(const plume_feather *feather, const plu
 plume_status plume_mesh_estimate_guides(const plume_mesh_guides *guides, const plume_mesh_def *def,
                                         plume_mesh_estimate *out, plume_error *err)
 {
-	assert(guides != NULL && def != NULL && out != NULL);
-	assert(def->cookie == PLUME_DEF_COOKIE && "plume_mesh_def not from plume_mesh_default_def()");
+	PLUME_ASSERT(guides != NULL && out != NULL);
+	PLUME_ASSERT_DEF(def);
 	memset(out, 0, sizeof *out);
 	mesh_input input;
 	plume_status status = mesh_input_from_guides(guides, def, &input, err);
