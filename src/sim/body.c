@@ -761,7 +761,17 @@ plume_status plume_body_capsule(plume_vec3 a, plume_vec3 b, double radius, int s
 	plume_vec3 u = plume_v3_normalize(plume_v3_cross(d, e));
 	plume_vec3 v = plume_v3_cross(d, u);
 	int cap = segments / 4 > 1 ? segments / 4 : 1;
-	double z[2 * 1024 + 2], rho[2 * 1024 + 2];
+	// Bands along the cylinder no longer than the edges around it (2 pi r / segments), so
+	// that a capsule skinned to a chain of bones bends between rings.
+	double along = ceil(length * segments / (2 * acos(-1.0) * radius));
+	int cylinder = along < 1 ? 1 : along > 4096 ? 4096 : (int)along;
+	double *z = plume_alloc(sizeof(double) * (size_t)(2 * cap + cylinder));
+	double *rho = plume_alloc(sizeof(double) * (size_t)(2 * cap + cylinder));
+	if (z == NULL || rho == NULL) {
+		plume_free(z);
+		plume_free(rho);
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory meshing a capsule");
+	}
 	const double half_pi = acos(-1.0) / 2;
 	int rings = 0;
 	for (int k = 1; k <= cap; ++k) { // the cap at a, up to its equator
@@ -769,10 +779,17 @@ plume_status plume_body_capsule(plume_vec3 a, plume_vec3 b, double radius, int s
 		z[rings] = k == cap ? 0 : -radius * cos(theta);
 		rho[rings++] = k == cap ? radius : radius * sin(theta);
 	}
+	for (int k = 1; k < cylinder; ++k) { // the cylinder's inner rings
+		z[rings] = length * k / cylinder;
+		rho[rings++] = radius;
+	}
 	for (int k = 0; k < cap; ++k) { // the cap at b, from its equator
 		double theta = half_pi * k / cap;
 		z[rings] = length + radius * sin(theta);
 		rho[rings++] = radius * cos(theta);
 	}
-	return lathe(a, u, v, d, -radius, length + radius, rings, z, rho, segments, out, err);
+	plume_status status = lathe(a, u, v, d, -radius, length + radius, rings, z, rho, segments, out, err);
+	plume_free(z);
+	plume_free(rho);
+	return status;
 }
