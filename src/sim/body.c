@@ -562,6 +562,7 @@ void plume_body_bone_transform(const plume_body *body, int bone, double t, plume
 {
 	PLUME_ASSERT_HANDLE(body);
 	PLUME_ASSERT(bone >= -1 && bone < body->bone_count);
+	PLUME_ASSERT(isfinite(t));
 	// The chain from the bone up to its root, then composed from the root down.
 	int chain[PLUME_BODY_MAX_BONES], depth = 0;
 	for (int b = bone; b >= 0; b = body->bones[b].parent)
@@ -578,7 +579,7 @@ void plume_body_bone_transform(const plume_body *body, int bone, double t, plume
 void plume_body_pose(const plume_body *body, double t, plume_vec3 *out)
 {
 	PLUME_ASSERT_HANDLE(body);
-	PLUME_ASSERT(out != NULL);
+	PLUME_ASSERT(out != NULL && isfinite(t));
 	if (body->bone_count == 0) {
 		rigid motion = body_motion(body, t);
 		for (int v = 0; v < body->vertex_count; ++v)
