@@ -659,6 +659,23 @@ static void test_json(void **state)
 	free(b);
 	plume_body_destroy(expected);
 	plume_body_destroy(body);
+
+	// "nearest" is PLUME_BODY_SKIN_NEAREST: every vertex moves rigidly with one bone.
+	char text[2048];
+	snprintf(text, sizeof text, "%.*s\"nearest\"}", (int)(strstr(arm_json, "\"auto\"") - arm_json), arm_json);
+	if (plume_body_parse(text, "arm.json", &body, &err) != PLUME_OK)
+		fail_msg("%s", err.message);
+	def.skinning = PLUME_BODY_SKIN_NEAREST;
+	expected = create(&def);
+	a = malloc(sizeof *a * (size_t)n), b = malloc(sizeof *b * (size_t)n);
+	plume_body_pose(body, 0.6, a);
+	plume_body_pose(expected, 0.6, b);
+	for (int v = 0; v < n; ++v)
+		assert_vec_close(a[v], b[v], 1e-15);
+	free(a);
+	free(b);
+	plume_body_destroy(expected);
+	plume_body_destroy(body);
 	plume_body_mesh_free(&mesh);
 
 	// Inline meshes; a scene's "body" member names its path.
@@ -668,6 +685,8 @@ static void test_json(void **state)
 	assert_int_equal(plume_spec_body("scene.json", json_object_get(root, "body"), "$.body", NULL, &body, &err),
 	                 PLUME_OK);
 	assert_int_equal(plume_body_triangle_count(body), 4);
+	assert_int_equal(plume_body_bone_count(body), 0);
+	assert_int_equal(plume_body_nearest_bone(body, plume_v3(0.2, 0.2, 0.2)), -1);
 	assert_close(plume_body_rest_distance(body, plume_v3(1, 1, 1), NULL), sqrt(3) - 1 / sqrt(3), 1e-15);
 	plume_body_destroy(body);
 	json_decref(root);
