@@ -138,6 +138,18 @@ static void test_rigid_keyframes(void **state)
 		assert_vec_close(posed[v], rotate_z(rest[v], pi / 2), 1e-14);
 	plume_body_destroy(body);
 
+	// Opposite axes are one axis with the angle's sign changed: from 10 degrees about z to
+	// 270 about -z (-270 about z) passes -130 degrees half-way (the shorter arc would not).
+	plume_keyframe opposite[] = {{.time = 0, .axis = {0, 0, 1}, .angle = pi / 18},
+	                             {.time = 1, .axis = {0, 0, -3}, .angle = 1.5 * pi}};
+	def.keyframes = opposite;
+	body = create(&def);
+	rest = plume_body_rest_positions(body);
+	plume_body_pose(body, 0.5, posed);
+	for (int v = 0; v < n; ++v)
+		assert_vec_close(posed[v], rotate_z(rest[v], -13 * pi / 18), 1e-14);
+	plume_body_destroy(body);
+
 	// Two axes: the slerp half-way between 90 degrees about x and 90 degrees about y is the
 	// normalised sum of the quaternions, (sqrt2, sqrt2/2, sqrt2/2, 0) / sqrt3: the angle
 	// 2 acos(sqrt(2/3)) about (1, 1, 0).
