@@ -126,8 +126,8 @@ static void test_two_tree_overlaps_match_brute_force(void **state)
 	(void)state;
 	int64_t bytes = plume_bytes_in_use();
 	plume_rng rng = plume_rng_seed(1414);
-	const int sizes[][2] = {{1, 1}, {1, 50}, {50, 1}, {300, 700}, {700, 300}};
-	for (int s = 0; s < 5; ++s) {
+	const int sizes[][2] = {{1, 1}, {1, 50}, {50, 1}, {300, 700}, {700, 300}, {3000, 800}, {800, 3000}};
+	for (int s = 0; s < 7; ++s) {
 		int na = sizes[s][0], nb = sizes[s][1];
 		plume_aabb *boxes_a = random_boxes(&rng, na, 0.08, 1), *boxes_b = random_boxes(&rng, nb, 0.05, 0);
 		plume_bvh *a = NULL, *b = NULL;
