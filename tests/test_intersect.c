@@ -704,6 +704,42 @@ static void test_spheres_against_reference(void **state)
 	assert_true(found_count > 0);
 }
 
+static void test_broad_phase_misses_nothing(void **state)
+{
+	(void)state;
+	// 3000 small triangles in a unit cube, corners on a grid of 1/32 so that many boxes touch
+	// exactly (closed comparisons) and many pairs touch: the pairs found through Embree's BVH
+	// against every pair of the soup by the reference (boxes first, in the reference's code).
+	enum { count = 3000 };
+	static plume_vec3 positions[3 * count];
+	static int triangles[3 * count];
+	rng_state = 0x0123456789abcdefull;
+	for (int t = 0; t < count; ++t) {
+		plume_vec3 base = plume_v3(below(32) / 32.0, below(32) / 32.0, below(32) / 32.0);
+		do {
+			for (int k = 0; k < 3; ++k)
+				positions[3 * t + k] =
+				    plume_v3_add(base, plume_v3((below(3) - 1) / 32.0, (below(3) - 1) / 32.0, (below(3) - 1) / 32.0));
+		} while (exact_collinear(positions[3 * t], positions[3 * t + 1], positions[3 * t + 2]));
+		for (int k = 0; k < 3; ++k)
+			triangles[3 * t + k] = 3 * t + k;
+	}
+	static int found[2 * 20000], expected[2 * 20000];
+	int found_count = 0;
+	plume_error err;
+	assert_int_equal(plume_find_intersections(positions, 3 * count, triangles, count, 20000, found, &found_count, &err),
+	                 PLUME_OK);
+	reference r;
+	reference_init(&r);
+	int expected_count = reference_pairs(&r, positions, triangles, count, expected);
+	reference_clear(&r);
+	print_message("broad phase: %d triangles on a grid, %d intersecting pairs, the reference %d\n", count, found_count,
+	              expected_count);
+	assert_true(expected_count > 100 && expected_count <= 20000);
+	assert_int_equal(found_count, expected_count);
+	assert_memory_equal(found, expected, (size_t)found_count * 2 * sizeof(int));
+}
+
 // ---------------------------------------------------------------------------
 // Determinism, capacity, errors, memory
 
@@ -819,6 +855,7 @@ int main(void)
 	    cmocka_unit_test(test_sheets),
 	    cmocka_unit_test(test_random_against_reference),
 	    cmocka_unit_test(test_spheres_against_reference),
+	    cmocka_unit_test(test_broad_phase_misses_nothing),
 	    cmocka_unit_test(test_deterministic),
 	    cmocka_unit_test(test_errors),
 	    cmocka_unit_test(test_no_leak),

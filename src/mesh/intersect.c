@@ -612,7 +612,8 @@ static plume_status broad_phase_pairs(const check_triangle *triangles, int trian
 		status = plume_error_set(err, PLUME_ERROR_MEMORY, "intersection check: out of memory for candidate pairs");
 		goto done;
 	}
-	qsort(b.pairs, (size_t)b.count, sizeof *b.pairs, compare_candidates);
+	if (b.count > 0) // qsort wants a valid pointer even for no elements
+		qsort(b.pairs, (size_t)b.count, sizeof *b.pairs, compare_candidates);
 	int unique = 0;
 	for (int k = 0; k < b.count; ++k)
 		if (unique == 0 || compare_candidates(&b.pairs[unique - 1], &b.pairs[k]) != 0)
