@@ -779,6 +779,17 @@ static void test_projected_hessian(void **state)
 			double e = plume_contact_pair_energy(type, x, rest, dhat, 1e4, false, g_exact, exact);
 			assert_true(plume_contact_pair_energy(type, x, rest, dhat, 1e4, true, g_projected, projected) == e);
 			assert_memory_equal(g_exact, g_projected, sizeof g_exact);
+			// Moving all four points together changes nothing (what lets the projection
+			// drop the translations): the gradient's and the Hessian's rows' sums over
+			// the points vanish.
+			for (int c = 0; c < 3; ++c) {
+				assert_close(g_exact[c] + g_exact[3 + c] + g_exact[6 + c] + g_exact[9 + c], 0.0,
+				             1e-12 * norm(g_exact, 12));
+				for (int row = 0; row < 12; ++row)
+					assert_close(exact[row * 12 + c] + exact[row * 12 + 3 + c] + exact[row * 12 + 6 + c] +
+					                 exact[row * 12 + 9 + c],
+					             0.0, 1e-12 * norm(exact, 144));
+			}
 			// P is the Frobenius-nearest PSD matrix to H iff P >= 0, P - H >= 0 and
 			// P (P - H) = 0 (the two parts of H's spectral split are orthogonal).
 			double values[12], difference[144], product_norm = 0;
