@@ -329,12 +329,12 @@ static void test_distances_against_minimisation(void **state)
 	plume_rng rng = plume_rng_seed(14);
 	int seen[PLUME_EE_LINES + 1] = {0};
 	double worst = 0;
-	for (int trial = 0; trial < 700; ++trial) {
+	for (int trial = 0; trial < 2100; ++trial) {
 		plume_vec3 x[4];
 		random_point_triangle(&rng, trial % 7, x);
 		seen[check_distance(PLUME_CONTACT_POINT_TRIANGLE, x, &worst)]++;
 	}
-	for (int trial = 0; trial < 700; ++trial) {
+	for (int trial = 0; trial < 2100; ++trial) {
 		plume_vec3 x[4];
 		random_edge_edge(&rng, trial % 7, x);
 		plume_distance_kind kind = check_distance(PLUME_CONTACT_EDGE_EDGE, x, &worst);
@@ -364,7 +364,7 @@ static void test_distances_against_minimisation(void **state)
 	for (int kind = 0; kind <= PLUME_EE_LINES; ++kind)
 		if (seen[kind] == 0)
 			fail_msg("region %d never met", kind);
-	printf("distances: 1800 configurations, worst difference from the reference %.2g of its tolerance\n", worst);
+	printf("distances: 4600 configurations, worst difference from the reference %.2g of its tolerance\n", worst);
 }
 
 // ---------------------------------------------------------------------------
