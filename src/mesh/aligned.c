@@ -374,7 +374,81 @@ static bool trace_line(const mesher *m, int side, int r, mesh_trace *trace)
 	return true;
 }
 
-/// Places the vertices of a row's guide on one side (none when it has no guide).
+/// Arc length along a trace (from its root) of the point nearest p; the first nearest on ties.
+static double trace_project(const mesh_trace *trace, plume_vec3 p)
+{
+	double best = INFINITY, where = 0.0, start = 0.0;
+	for (int k = 0; k + 1 < trace->count; ++k) {
+		plume_vec3 a = trace->p[k], b = trace->p[k + 1];
+		double dx = b.x - a.x, dy = b.y - a.y, length2 = dx * dx + dy * dy, length = sqrt(length2);
+		double u = length2 > 0.0 ? ((p.x - a.x) * dx + (p.y - a.y) * dy) / length2 : 0.0;
+		u = u < 0.0 ? 0.0 : u > 1.0 ? 1.0 : u;
+		double x = a.x + u * dx - p.x, y = a.y + u * dy - p.y, d2 = x * x + y * y;
+		if (d2 < best) {
+			best = d2;
+			where = start + u * length;
+		}
+		start += length;
+	}
+	return where;
+}
+
+/// Appends steps equal steps from the last position to `to`.
+static int fill_positions(double *positions, int count, double to, int steps)
+{
+	double from = positions[count - 1];
+	for (int j = 1; j <= steps; ++j)
+		positions[count++] = from + (to - from) * j / steps;
+	return count;
+}
+
+/// Where the vertices of a guide go, as arc lengths from its root (0) to its tip
+/// (trace->total), staggered against the guide below it on the same vane (the
+/// previous row's): one vertex at the point nearest the middle of each step of
+/// that guide. Two neighbouring guides then form a zigzag of near-isosceles
+/// triangles of base s (the step) and height h (the gap), whose smallest angle
+/// atan(2 h / s) stays above 20 degrees down to h = 0.18 s, where vertices
+/// placed independently (each guide from its own root) meet almost side by side
+/// and make right triangles with a smallest angle atan(h / s): 20 degrees needs
+/// h = 0.36 s, and barbs at less than about 20 degrees to the rachis, whose
+/// guides lie e sin(theta) apart, fall short of it.
+///
+/// Steps stay between 0.5 e and 1.5 e: a middle closer than 0.5 e to the last
+/// vertex is skipped (the guides converge), a gap over 1.5 e gets vertices about
+/// e apart (they diverge, or this guide is longer). The first vertex after the
+/// root is at least 0.75 e out, so that the triangle on the rachis edge (root
+/// spacing e) is not a sliver; the tip is always a vertex. Returns the count of
+/// positions, or 0 to place the guide's vertices evenly instead (no guide below,
+/// or more vertices than the estimate allows).
+static int stagger_positions(const mesher *m, const mesh_trace *trace, const mesh_line *below, double *positions,
+                             int capacity)
+{
+	if (below == NULL || !below->present || below->count < 2)
+		return 0;
+	double e = m->e, total = trace->total;
+	int count = 1;
+	positions[0] = 0.0;
+	const plume_vec3 *nodes = m->points + below->first;
+	for (int i = 0; i + 1 < below->count; ++i) {
+		double q = trace_project(trace, plume_v3_lerp(nodes[i], nodes[i + 1], 0.5));
+		double last = positions[count - 1];
+		if (q >= total - 0.5 * e)
+			break;
+		if (q - last < (count == 1 ? 0.75 * e : 0.5 * e))
+			continue;
+		int steps = (int)fmax(1.0, round((q - last) / e));
+		if (count + steps + 1 > capacity)
+			return 0;
+		count = fill_positions(positions, count, q, steps);
+	}
+	int steps = (int)fmax(1.0, round((total - positions[count - 1]) / e));
+	if (count + steps > capacity)
+		return 0;
+	return fill_positions(positions, count, total, steps);
+}
+
+/// Places the vertices of a row's guide on one side (none when it has no guide),
+/// staggered against the guide of the row below when there is one.
 static bool build_line(mesher *m, int side, int r)
 {
 	mesh_line *line = m->lines + line_index(m, side, r);
@@ -386,18 +460,28 @@ static bool build_line(mesher *m, int side, int r)
 	const plume_vec2 *uv = trace.uv;
 	int count = trace.count;
 	double total = trace.total;
-	if (!(m->point_count + trace.steps + 1.0 <= MESH_MAX_VERTICES))
+	if (!(m->point_count + trace.steps + 2.0 <= MESH_MAX_VERTICES))
 		return false;
-	int steps = (int)trace.steps;
+	// At most the estimate's steps + 1 vertices after the root (count_mesh).
+	int capacity = (int)trace.steps + 2;
+	double *positions = plume_alloc((size_t)capacity * sizeof *positions);
+	if (positions == NULL)
+		return false;
+	const mesh_line *below = r > 0 ? m->lines + line_index(m, side, r - 1) : NULL;
+	int placed = stagger_positions(m, &trace, below, positions, capacity);
+	if (placed == 0) {
+		positions[0] = 0.0;
+		placed = fill_positions(positions, 1, total, (int)trace.steps);
+	}
+	int steps = placed - 1;
 	line->present = true;
 	line->first = m->point_count;
 	line->count = line->full = steps + 1;
-	if (!push_point(m, p[0], uv[0]))
-		return false;
+	bool ok = push_point(m, p[0], uv[0]);
 	int segment = 0;
 	double start = 0.0;
-	for (int i = 1; i <= steps; ++i) {
-		double target = total * i / steps;
+	for (int i = 1; ok && i <= steps; ++i) {
+		double target = positions[i];
 		double length = sqrt(dist2(p[segment], p[segment + 1]));
 		while (segment + 2 < count && start + length < target) {
 			start += length;
@@ -411,11 +495,45 @@ static bool build_line(mesher *m, int side, int r)
 			a = 1.0;
 		}
 		plume_vec2 u0 = uv[segment], u1 = uv[segment + 1];
-		if (!push_point(m, plume_v3_lerp(p[segment], p[segment + 1], a),
-		                (plume_vec2){u0.x + a * (u1.x - u0.x), u0.y + a * (u1.y - u0.y)}))
-			return false;
+		ok = push_point(m, plume_v3_lerp(p[segment], p[segment + 1], a),
+		                (plume_vec2){u0.x + a * (u1.x - u0.x), u0.y + a * (u1.y - u0.y)});
 	}
-	return true;
+	plume_free(positions);
+	return ok;
+}
+
+/// Plane length of a placed guide, root to tip.
+static double line_length(const mesher *m, const mesh_line *line)
+{
+	double length = 0.0;
+	for (int i = 0; i + 1 < line->count; ++i)
+		length += sqrt(dist2(m->points[line->first + i], m->points[line->first + i + 1]));
+	return length;
+}
+
+/// Leaves out the guides at either end of a vane that are shorter than half an
+/// edge length: the first barbs at the vane's base and the last at the rachis
+/// tip are often a millimetre long, and the strip between such a stub and its
+/// neighbour, e away along the rachis, is a sliver whatever the walk does. The
+/// vane then starts (ends) one row further in; the stub's points stay in the pool.
+static void drop_short_end_guides(mesher *m)
+{
+	for (int side = 0; side < 2; ++side) {
+		int present = 0; // a vane keeps two guides at least: one strip
+		for (int r = 0; r < m->row_count; ++r)
+			present += m->lines[line_index(m, side, r)].present;
+		for (int end = 0; end < 2; ++end)
+			for (int j = 0; j < m->row_count; ++j) {
+				mesh_line *line = m->lines + line_index(m, side, end == 0 ? j : m->row_count - 1 - j);
+				if (!line->present)
+					continue;
+				if (present <= 2 || line_length(m, line) >= 0.75 * m->e)
+					break;
+				--present;
+				line->present = false;
+				line->count = line->full = 0;
+			}
+	}
 }
 
 // ---------------------------------------------------------------------------
@@ -1219,6 +1337,8 @@ static plume_status assemble(mesher *m, plume_mesh **out, plume_mesh_report *rep
 		plume_mesh_report measured = plume_mesh_measure(mesh);
 		report->min_angle = measured.min_angle;
 		report->aligned_fraction = measured.aligned_fraction;
+		report->vane_min_angle = measured.vane_min_angle;
+		report->excepted_count = measured.excepted_count;
 		report->guides_dropped = m->input->guides_dropped;
 		report->barbs_averaged = m->input->barbs_averaged;
 		report->vertices_trimmed = m->trimmed;
@@ -1246,7 +1366,7 @@ static void count_mesh(const mesher *m, plume_mesh_estimate *out)
 			mesh_trace trace;
 			if (!trace_line(m, side, r, &trace))
 				continue;
-			pool += trace.steps + 1.0;
+			pool += trace.steps + 2.0; // build_line places at most steps + 1 after the root
 			out->longest_guide = fmax(out->longest_guide, trace.total);
 		}
 	out->vertices = 2.0 * m->row_count + pool;
@@ -1302,6 +1422,8 @@ static plume_status mesh_run(const mesh_input *input, const plume_mesh_def *def,
 				                               "edge_length %g m is too small for this feather (over %d vertices)", m.e,
 				                               MESH_MAX_VERTICES)
 				             : plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory placing guide vertices");
+	if (status == PLUME_OK)
+		drop_short_end_guides(&m);
 	if (status == PLUME_OK && !(collect_strips(&m) && build_index(&m)))
 		status = plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory");
 	if (status == PLUME_OK)
