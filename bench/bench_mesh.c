@@ -75,7 +75,10 @@ static void measure(const char *spec, double e)
 				plume_vec2 p = mesh->reference[v[k]], a = mesh->reference[v[(k + 1) % 3]],
 				           b = mesh->reference[v[(k + 2) % 3]];
 				double ax = a.x - p.x, ay = a.y - p.y, bx = b.x - p.x, by = b.y - p.y;
-				printf(" v%d%s (%.4f %.4f) %.1fdeg", v[k], mark[v[k]] & 1 ? "R" : mark[v[k]] & 2 ? "E" : "",
+				printf(" v%d%s (%.4f %.4f) %.1fdeg", v[k],
+				       mark[v[k]] & 1   ? "R"
+				       : mark[v[k]] & 2 ? "E"
+				                        : "",
 				       p.x, p.y, atan2(fabs(ax * by - ay * bx), ax * bx + ay * by) * 180 / pi);
 			}
 			printf("\n");

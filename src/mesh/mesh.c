@@ -180,8 +180,8 @@ static bool on_vane_border(const plume_mesh *mesh, const long long *keys, int co
 
 plume_mesh_report plume_mesh_measure(const plume_mesh *mesh)
 {
-	plume_mesh_report report = {.min_angle = mesh->face_count > 0 ? pi : 0.0, .aligned_fraction = 1.0,
-	                            .vane_min_angle = pi};
+	plume_mesh_report report = {
+	    .min_angle = mesh->face_count > 0 ? pi : 0.0, .aligned_fraction = 1.0, .vane_min_angle = pi};
 	const double quality = PLUME_MESH_QUALITY_ANGLE_DEG * pi / 180.0;
 	int vane_faces = 0, aligned = 0;
 	// The vane faces' edges, to tell the vane's border edges (used by one vane face).
