@@ -374,8 +374,9 @@ static bool trace_line(const mesher *m, int side, int r, mesh_trace *trace)
 	return true;
 }
 
-/// Arc length along a trace (from its root) of the point nearest p; the first nearest on ties.
-static double trace_project(const mesh_trace *trace, plume_vec3 p)
+/// Arc length along a trace (from its root) of the point nearest p, the first
+/// nearest on ties; *distance (may be NULL) gets how far p is from it.
+static double trace_project(const mesh_trace *trace, plume_vec3 p, double *distance)
 {
 	double best = INFINITY, where = 0.0, start = 0.0;
 	for (int k = 0; k + 1 < trace->count; ++k) {
@@ -390,6 +391,8 @@ static double trace_project(const mesh_trace *trace, plume_vec3 p)
 		}
 		start += length;
 	}
+	if (distance != NULL)
+		*distance = sqrt(best);
 	return where;
 }
 
@@ -419,18 +422,31 @@ static int fill_positions(double *positions, int count, double to, int steps)
 /// root is at least 0.75 e out, so that the triangle on the rachis edge (root
 /// spacing e) is not a sliver; the tip is always a vertex. Returns the count of
 /// positions, or 0 to place the guide's vertices evenly instead (no guide below,
-/// or more vertices than the estimate allows).
+/// guides 0.6 e apart or more, or more vertices than the estimate allows).
 static int stagger_positions(const mesher *m, const mesh_trace *trace, const mesh_line *below, double *positions,
                              int capacity)
 {
 	if (below == NULL || !below->present || below->count < 2)
 		return 0;
 	double e = m->e, total = trace->total;
+	const plume_vec3 *nodes = m->points + below->first;
+	// Guides at least 0.6 e apart on average keep the even placement: their
+	// near-right triangles are no slivers (measured on the example feathers:
+	// Zhang-Kanai's smallest vane angles are 36-47 degrees placed evenly,
+	// 27-36 staggered), and a coarse mesh of the hawk stays as it was, which a
+	// pulled Figure 1 at e = 1 cm needs to converge (tests/test_scene.c).
+	double gap = 0.0;
+	for (int i = 0; i + 1 < below->count; ++i) {
+		double h;
+		trace_project(trace, plume_v3_lerp(nodes[i], nodes[i + 1], 0.5), &h);
+		gap += h / (below->count - 1);
+	}
+	if (gap >= 0.6 * e)
+		return 0;
 	int count = 1;
 	positions[0] = 0.0;
-	const plume_vec3 *nodes = m->points + below->first;
 	for (int i = 0; i + 1 < below->count; ++i) {
-		double q = trace_project(trace, plume_v3_lerp(nodes[i], nodes[i + 1], 0.5));
+		double q = trace_project(trace, plume_v3_lerp(nodes[i], nodes[i + 1], 0.5), NULL);
 		double last = positions[count - 1];
 		if (q >= total - 0.5 * e)
 			break;
@@ -511,29 +527,49 @@ static double line_length(const mesher *m, const mesh_line *line)
 	return length;
 }
 
-/// Leaves out the guides at either end of a vane that are shorter than half an
-/// edge length: the first barbs at the vane's base and the last at the rachis
-/// tip are often a millimetre long, and the strip between such a stub and its
-/// neighbour, e away along the rachis, is a sliver whatever the walk does. The
-/// vane then starts (ends) one row further in; the stub's points stay in the pool.
-static void drop_short_end_guides(mesher *m)
+/// A stub: a guide shorter than 0.75 e, or than half the next guide inwards.
+static bool is_stub(const double *lengths, int count, int i, double e)
 {
-	for (int side = 0; side < 2; ++side) {
-		int present = 0; // a vane keeps two guides at least: one strip
-		for (int r = 0; r < m->row_count; ++r)
-			present += m->lines[line_index(m, side, r)].present;
-		for (int end = 0; end < 2; ++end)
+	return i < count && (lengths[i] < 0.75 * e || (i + 1 < count && lengths[i] < 0.5 * lengths[i + 1]));
+}
+
+/// Leaves out the guides at either end of a vane up to the last stub among
+/// them (a stub with no other stub within four guides inwards ends the run):
+/// the first barbs at the vane's base and the last at the rachis tip are often
+/// a millimetre long, and guides cut where random barbs cross leave stubs at
+/// the base. The strip between a stub and its neighbour, e away along the
+/// rachis, is a fan of slivers from the stub's tip whatever the walk does. The
+/// vane then starts (ends) further in; a vane keeps two guides at least; the
+/// stubs' points stay in the pool. Returns whether any guide was left out.
+static bool drop_short_end_guides(mesher *m)
+{
+	bool dropped = false;
+	int *order = plume_alloc((size_t)m->row_count * sizeof *order);
+	double *lengths = plume_alloc((size_t)m->row_count * sizeof *lengths);
+	for (int side = 0; order != NULL && lengths != NULL && side < 2; ++side)
+		for (int end = 0; end < 2; ++end) {
+			int count = 0; // the present guides from this end inwards
 			for (int j = 0; j < m->row_count; ++j) {
-				mesh_line *line = m->lines + line_index(m, side, end == 0 ? j : m->row_count - 1 - j);
-				if (!line->present)
-					continue;
-				if (present <= 2 || line_length(m, line) >= 0.75 * m->e)
-					break;
-				--present;
-				line->present = false;
-				line->count = line->full = 0;
+				int index = line_index(m, side, end == 0 ? j : m->row_count - 1 - j);
+				if (m->lines[index].present) {
+					order[count] = index;
+					lengths[count++] = line_length(m, m->lines + index);
+				}
 			}
-	}
+			for (int i = 0; i + 2 < count; ++i) {
+				bool stubs_ahead = false;
+				for (int k = i; k < i + 4; ++k)
+					stubs_ahead |= is_stub(lengths, count, k, m->e);
+				if (!stubs_ahead)
+					break;
+				m->lines[order[i]].present = false;
+				m->lines[order[i]].count = m->lines[order[i]].full = 0;
+				dropped = true;
+			}
+		}
+	plume_free(order);
+	plume_free(lengths);
+	return dropped;
 }
 
 // ---------------------------------------------------------------------------
@@ -964,6 +1000,29 @@ static int settle_strips(mesher *m)
 	return faces;
 }
 
+/// Once the strips are walked, cutting guides where they cross can leave new
+/// stubs at a vane's ends (random Franco-Walter barbs at the base): those are
+/// left out as well (drop_short_end_guides), with their strips, whose
+/// neighbours are unchanged. Returns the vane's face count then.
+static int forget_dropped_strips(mesher *m)
+{
+	int kept = 0, faces = 0;
+	for (int s = 0; s < m->strip_count; ++s) {
+		mesh_strip strip = m->strip_list[s];
+		if (!m->lines[strip.a].present || !m->lines[strip.b].present)
+			continue;
+		strip_out dry = {NULL, 0};
+		int i, k;
+		bool ok = walk_strip(m, &strip, &dry, &i, &k);
+		assert(ok);
+		(void)ok;
+		faces += dry.faces;
+		m->strip_list[kept++] = strip;
+	}
+	m->strip_count = kept;
+	return faces;
+}
+
 // ---------------------------------------------------------------------------
 // Assembly
 
@@ -1269,6 +1328,8 @@ static plume_status assemble(mesher *m, plume_mesh **out, plume_mesh_report *rep
 	int vane_faces = settle_strips(m);
 	if (vane_faces < 0)
 		return plume_error_set(m->err, PLUME_ERROR_MEMORY, "out of memory walking the strips");
+	if (drop_short_end_guides(m))
+		vane_faces = forget_dropped_strips(m);
 	int vertex_count = number_vertices(m);
 	if (vertex_count == 2 * m->row_count || vane_faces == 0)
 		return plume_error_set(m->err, PLUME_ERROR_SPEC,
@@ -1423,7 +1484,7 @@ static plume_status mesh_run(const mesh_input *input, const plume_mesh_def *def,
 				                               MESH_MAX_VERTICES)
 				             : plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory placing guide vertices");
 	if (status == PLUME_OK)
-		drop_short_end_guides(&m);
+		(void)drop_short_end_guides(&m);
 	if (status == PLUME_OK && !(collect_strips(&m) && build_index(&m)))
 		status = plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory");
 	if (status == PLUME_OK)
