@@ -546,13 +546,16 @@ static bool is_stub(const double *lengths, int count, int i, double e)
 /// the base. The strip between a stub and its neighbour, e away along the
 /// rachis, is a fan of slivers from the stub's tip whatever the walk does. The
 /// vane then starts (ends) further in; a vane keeps two guides at least; the
-/// stubs' points stay in the pool. Returns whether any guide was left out.
-static bool drop_short_end_guides(mesher *m)
+/// stubs' points stay in the pool. Returns 1 when any guide was left out, 0
+/// when none, -1 out of memory.
+static int drop_short_end_guides(mesher *m)
 {
-	bool dropped = false;
+	int dropped = 0;
 	int *order = plume_alloc((size_t)m->row_count * sizeof *order);
 	double *lengths = plume_alloc((size_t)m->row_count * sizeof *lengths);
-	for (int side = 0; order != NULL && lengths != NULL && side < 2; ++side)
+	if (order == NULL || lengths == NULL)
+		dropped = -1;
+	for (int side = 0; dropped >= 0 && side < 2; ++side)
 		for (int end = 0; end < 2; ++end) {
 			int count = 0; // the present guides from this end inwards
 			for (int j = 0; j < m->row_count; ++j) {
@@ -570,7 +573,7 @@ static bool drop_short_end_guides(mesher *m)
 					break;
 				m->lines[order[i]].present = false;
 				m->lines[order[i]].count = m->lines[order[i]].full = 0;
-				dropped = true;
+				dropped = 1;
 			}
 		}
 	plume_free(order);
@@ -1334,7 +1337,10 @@ static plume_status assemble(mesher *m, plume_mesh **out, plume_mesh_report *rep
 	int vane_faces = settle_strips(m);
 	if (vane_faces < 0)
 		return plume_error_set(m->err, PLUME_ERROR_MEMORY, "out of memory walking the strips");
-	if (drop_short_end_guides(m))
+	int dropped = drop_short_end_guides(m);
+	if (dropped < 0)
+		return plume_error_set(m->err, PLUME_ERROR_MEMORY, "out of memory checking the guides' ends");
+	if (dropped > 0)
 		vane_faces = forget_dropped_strips(m);
 	int vertex_count = number_vertices(m);
 	if (vertex_count == 2 * m->row_count || vane_faces == 0)
@@ -1401,7 +1407,11 @@ static plume_status assemble(mesher *m, plume_mesh **out, plume_mesh_report *rep
 			return plume_error_set(m->err, PLUME_ERROR_NUMERIC, "mesh vertex %d is not finite", v);
 		}
 	if (report != NULL) {
-		plume_mesh_report measured = plume_mesh_measure(mesh);
+		plume_mesh_report measured;
+		if (!mesh_measure(mesh, &measured)) {
+			plume_mesh_destroy(mesh);
+			return plume_error_set(m->err, PLUME_ERROR_MEMORY, "out of memory measuring the mesh");
+		}
 		report->min_angle = measured.min_angle;
 		report->aligned_fraction = measured.aligned_fraction;
 		report->vane_min_angle = measured.vane_min_angle;
@@ -1489,8 +1499,8 @@ static plume_status mesh_run(const mesh_input *input, const plume_mesh_def *def,
 				                               "edge_length %g m is too small for this feather (over %d vertices)", m.e,
 				                               MESH_MAX_VERTICES)
 				             : plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory placing guide vertices");
-	if (status == PLUME_OK)
-		(void)drop_short_end_guides(&m);
+	if (status == PLUME_OK && drop_short_end_guides(&m) < 0)
+		status = plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory checking the guides' ends");
 	if (status == PLUME_OK && !(collect_strips(&m) && build_index(&m)))
 		status = plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory");
 	if (status == PLUME_OK)

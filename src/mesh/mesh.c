@@ -6,6 +6,7 @@
 
 #include "../core/asserts.h"
 #include "../core/alloc.h"
+#include "aligned_internal.h"
 #include "plume/mesh.h"
 
 static const double pi = 3.14159265358979323846;
@@ -178,7 +179,7 @@ static bool on_vane_border(const plume_mesh *mesh, const long long *keys, int co
 	return lo < count && keys[lo] == key && (lo + 1 == count || keys[lo + 1] != key);
 }
 
-plume_mesh_report plume_mesh_measure(const plume_mesh *mesh)
+bool mesh_measure(const plume_mesh *mesh, plume_mesh_report *out)
 {
 	plume_mesh_report report = {
 	    .min_angle = mesh->face_count > 0 ? pi : 0.0, .aligned_fraction = 1.0, .vane_min_angle = pi};
@@ -191,8 +192,9 @@ plume_mesh_report plume_mesh_measure(const plume_mesh *mesh)
 		if (mesh->material[f] == PLUME_MATERIAL_VANE)
 			for (int k = 0; k < 3; ++k)
 				keys[key_count++] = edge_key(mesh, mesh->faces[3 * f + k], mesh->faces[3 * f + (k + 1) % 3]);
-	if (keys != NULL)
-		qsort(keys, (size_t)key_count, sizeof *keys, compare_keys);
+	if (keys == NULL)
+		return false;
+	qsort(keys, (size_t)key_count, sizeof *keys, compare_keys);
 	for (int f = 0; f < mesh->face_count; ++f) {
 		const int *v = mesh->faces + 3 * f;
 		double angles[3];
@@ -219,8 +221,7 @@ plume_mesh_report plume_mesh_measure(const plume_mesh *mesh)
 				continue;
 			++small;
 			int other = barb == k ? (k + 2) % 3 : barb == (k + 2) % 3 ? k : -1;
-			junction += barb >= 0 && other >= 0 && keys != NULL &&
-			            on_vane_border(mesh, keys, key_count, v[other], v[(other + 1) % 3]);
+			junction += barb >= 0 && other >= 0 && on_vane_border(mesh, keys, key_count, v[other], v[(other + 1) % 3]);
 		}
 		if (small > 0 && junction == small) {
 			++report.excepted_count;
@@ -231,6 +232,35 @@ plume_mesh_report plume_mesh_measure(const plume_mesh *mesh)
 	}
 	plume_free(keys);
 	report.aligned_fraction = vane_faces > 0 ? (double)aligned / vane_faces : 1.0;
+	*out = report;
+	return true;
+}
+
+plume_mesh_report plume_mesh_measure(const plume_mesh *mesh)
+{
+	plume_mesh_report report;
+	if (!mesh_measure(mesh, &report)) { // out of memory: no face is told a junction face
+		plume_mesh_report plain = {.min_angle = mesh->face_count > 0 ? pi : 0.0, .vane_min_angle = pi};
+		report = plain;
+		int vane_faces = 0, aligned = 0;
+		for (int f = 0; f < mesh->face_count; ++f) {
+			for (int k = 0; k < 3; ++k) {
+				plume_vec2 p = mesh->reference[mesh->faces[3 * f + k]],
+				           a = mesh->reference[mesh->faces[3 * f + (k + 1) % 3]],
+				           b = mesh->reference[mesh->faces[3 * f + (k + 2) % 3]];
+				double ax = a.x - p.x, ay = a.y - p.y, bx = b.x - p.x, by = b.y - p.y;
+				double angle = atan2(fabs(ax * by - ay * bx), ax * bx + ay * by);
+				report.min_angle = fmin(report.min_angle, angle);
+				if (mesh->material[f] == PLUME_MATERIAL_VANE)
+					report.vane_min_angle = fmin(report.vane_min_angle, angle);
+			}
+			if (mesh->material[f] == PLUME_MATERIAL_VANE) {
+				++vane_faces;
+				aligned += mesh->barb_edge[f] >= 0;
+			}
+		}
+		report.aligned_fraction = vane_faces > 0 ? (double)aligned / vane_faces : 1.0;
+	}
 	return report;
 }
 
