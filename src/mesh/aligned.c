@@ -19,9 +19,11 @@
 //
 // Quality (issue 13): a guide closer than 0.6 e to the guide below has its
 // vertices staggered against that guide's (stagger_positions), and stub guides
-// at a vane's ends are left out (drop_short_end_guides), so that vane faces
-// keep their smallest angle at 20 degrees or more outside the junctions where
-// a guide meets the rachis or the outline at a shallow angle (plume_mesh_measure).
+// at a vane's ends are left out (drop_short_end_guides), and the vertices of
+// faces under 25 degrees slide along their guides (slide_vertices), so that
+// vane faces keep their smallest angle at 20 degrees or more outside the
+// junctions where a guide meets the rachis or the outline at a shallow angle
+// (plume_mesh_measure).
 //
 // A step that would make an inverted or degenerate triangle (two guides
 // touching) is never taken: both guides are cut there and every strip is
