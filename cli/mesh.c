@@ -151,6 +151,8 @@ static plume_status write_report(const plume_mesh *mesh, const plume_mesh_report
 	        "  \"vane_face_count\": %d,\n"
 	        "  \"barb_edge_count\": %d,\n"
 	        "  \"min_angle_deg\": %.6f,\n"
+	        "  \"vane_min_angle_deg\": %.6f,\n"
+	        "  \"excepted_count\": %d,\n"
 	        "  \"aligned_fraction\": %.17g,\n"
 	        "  \"guides_dropped\": %d,\n"
 	        "  \"barbs_averaged\": %d,\n"
@@ -158,7 +160,8 @@ static plume_status write_report(const plume_mesh *mesh, const plume_mesh_report
 	        "  \"guide_count\": [%d, %d],\n"
 	        "  \"groups\": {",
 	        report->edge_length, mesh->vertex_count, mesh->face_count, rachis_faces, mesh->face_count - rachis_faces,
-	        mesh->barb_edge_count, report->min_angle * 180.0 / 3.14159265358979323846, report->aligned_fraction,
+	        mesh->barb_edge_count, report->min_angle * 180.0 / 3.14159265358979323846,
+	        report->vane_min_angle * 180.0 / 3.14159265358979323846, report->excepted_count, report->aligned_fraction,
 	        report->guides_dropped, report->barbs_averaged, report->vertices_trimmed, report->guide_count[0],
 	        report->guide_count[1]);
 	for (int g = 0; g < mesh->group_count; ++g)

@@ -243,6 +243,151 @@ static void test_examples_are_aligned(void **state)
 	assert_int_equal(plume_bytes_in_use(), before);
 }
 
+/// Issue 13: the vane's quality on every example feather of the three generators
+/// at e = 5 mm and 2.5 mm. Outside junction faces (a shallow angle between a
+/// guide and the rachis or the outline, plume_mesh_report.excepted_count) the
+/// smallest vane angle must reach 20 degrees; the rows below 20 are the measured
+/// floor, pinned so that a change that makes them worse fails (docs/meshing.md
+/// lists what still makes them: fans at guides cut short, the narrow strips of
+/// Streit-Heidrich barbs at a few degrees to the rachis). Junction faces stay
+/// at most 4 % of the vane where it has 100 faces or more.
+typedef struct quality_row {
+	const char *spec;
+	double edge_length;
+	double min_angle_deg; ///< vane_min_angle must reach it
+	int excepted;         ///< excepted_count, at most
+} quality_row;
+
+static const quality_row quality_rows[] = {
+    {"franco-walter/blue.json", 5e-3, 20.0, 0},
+    {"franco-walter/blue.json", 2.5e-3, 20.0, 0},
+    {"franco-walter/figure6a.json", 5e-3, 6.79, 4},
+    {"franco-walter/figure6a.json", 2.5e-3, 12.89, 8},
+    {"franco-walter/figure6b.json", 5e-3, 1.13, 0},
+    {"franco-walter/figure6b.json", 2.5e-3, 14.46, 1},
+    {"franco-walter/filoplume.json", 5e-3, 0.47, 0},
+    {"franco-walter/filoplume.json", 2.5e-3, 3.82, 0},
+    {"franco-walter/hawk.json", 5e-3, 20.0, 0},
+    {"franco-walter/hawk.json", 2.5e-3, 19.06, 0},
+    {"franco-walter/peacock.json", 5e-3, 7.21, 1},
+    {"franco-walter/peacock.json", 2.5e-3, 3.39, 10},
+    {"streit-heidrich/bristle.json", 5e-3, 4.33, 0},
+    {"streit-heidrich/bristle.json", 2.5e-3, 15.33, 0},
+    {"streit-heidrich/continuum.json", 5e-3, 20.0, 0},
+    {"streit-heidrich/continuum.json", 2.5e-3, 1.03, 1},
+    {"streit-heidrich/contour.json", 5e-3, 20.0, 0},
+    {"streit-heidrich/contour.json", 2.5e-3, 20.0, 0},
+    {"streit-heidrich/down.json", 5e-3, 20.0, 0},
+    {"streit-heidrich/down.json", 2.5e-3, 20.0, 0},
+    {"streit-heidrich/filoplume.json", 5e-3, 0.29, 4},
+    {"streit-heidrich/filoplume.json", 2.5e-3, 1.28, 6},
+    {"streit-heidrich/flight.json", 5e-3, 16.59, 19},
+    {"streit-heidrich/flight.json", 2.5e-3, 0.94, 43},
+    {"streit-heidrich/peacock.json", 5e-3, 1.03, 45},
+    {"streit-heidrich/peacock.json", 2.5e-3, 0.24, 107},
+    {"streit-heidrich/semiplume.json", 5e-3, 20.0, 4},
+    {"streit-heidrich/semiplume.json", 2.5e-3, 5.37, 6},
+    {"zhang-kanai/figure10-asymmetry-020.json", 5e-3, 20.0, 0},
+    {"zhang-kanai/figure10-asymmetry-020.json", 2.5e-3, 20.0, 0},
+    {"zhang-kanai/figure10-asymmetry-040.json", 5e-3, 20.0, 0},
+    {"zhang-kanai/figure10-asymmetry-040.json", 2.5e-3, 20.0, 0},
+    {"zhang-kanai/figure10-asymmetry-050.json", 5e-3, 20.0, 0},
+    {"zhang-kanai/figure10-asymmetry-050.json", 2.5e-3, 20.0, 0},
+    {"zhang-kanai/figure11-expansion.json", 5e-3, 20.0, 0},
+    {"zhang-kanai/figure11-expansion.json", 2.5e-3, 20.0, 0},
+    {"zhang-kanai/figure11-split.json", 5e-3, 20.0, 0},
+    {"zhang-kanai/figure11-split.json", 2.5e-3, 20.0, 0},
+    {"zhang-kanai/figure11-without-expansion.json", 5e-3, 20.0, 0},
+    {"zhang-kanai/figure11-without-expansion.json", 2.5e-3, 20.0, 0},
+    {"zhang-kanai/figure13-crest.json", 5e-3, 20.0, 0},
+    {"zhang-kanai/figure13-crest.json", 2.5e-3, 20.0, 0},
+    {"zhang-kanai/figure8-contour.json", 5e-3, 20.0, 0},
+    {"zhang-kanai/figure8-contour.json", 2.5e-3, 20.0, 0},
+    {"zhang-kanai/figure9-tip-angular.json", 5e-3, 20.0, 0},
+    {"zhang-kanai/figure9-tip-angular.json", 2.5e-3, 20.0, 0},
+    {"zhang-kanai/figure9-tip-pointed.json", 5e-3, 20.0, 0},
+    {"zhang-kanai/figure9-tip-pointed.json", 2.5e-3, 20.0, 0},
+    {"zhang-kanai/figure9-tip-rounded.json", 5e-3, 20.0, 0},
+    {"zhang-kanai/figure9-tip-rounded.json", 2.5e-3, 20.0, 0},
+};
+
+static void test_example_quality(void **state)
+{
+	(void)state;
+	int64_t before = plume_bytes_in_use();
+	int meeting = 0;
+	for (size_t i = 0; i < sizeof quality_rows / sizeof quality_rows[0]; ++i) {
+		const quality_row *row = quality_rows + i;
+		char path[640];
+		snprintf(path, sizeof path, "%s/examples/%s", PLUME_SOURCE_DIR, row->spec);
+		plume_mesh_spec_options options = plume_mesh_spec_default_options();
+		options.edge_length = row->edge_length;
+		plume_mesh *mesh = NULL;
+		plume_mesh_report report;
+		plume_error err;
+		if (plume_mesh_spec_read(path, &options, &mesh, &report, &err) != PLUME_OK)
+			fail_msg("%s: %s", row->spec, err.message);
+		assert_valid_mesh(mesh);
+		assert_true(report.aligned_fraction == 1.0);
+		int vane = 0;
+		for (int f = 0; f < mesh->face_count; ++f)
+			if (mesh->material[f] == PLUME_MATERIAL_VANE) {
+				++vane;
+				assert_true(mesh->barb_edge[f] >= 0 && mesh->barb_edge[f] < 3);
+			}
+		plume_mesh_report measured = plume_mesh_measure(mesh);
+		assert_true(measured.vane_min_angle == report.vane_min_angle);
+		assert_int_equal(measured.excepted_count, report.excepted_count);
+		double angle = report.vane_min_angle * 180.0 / pi;
+		if (angle < row->min_angle_deg || report.excepted_count > row->excepted)
+			fail_msg("%s at e = %g: vane min angle %.3f deg (bound %.2f), %d junction faces (at most %d)", row->spec,
+			         row->edge_length, angle, row->min_angle_deg, report.excepted_count, row->excepted);
+		if (vane >= 100)
+			assert_true(report.excepted_count <= 0.04 * vane);
+		meeting += angle >= PLUME_MESH_QUALITY_ANGLE_DEG;
+		plume_mesh_destroy(mesh);
+	}
+	print_message("%d of %d example meshes reach %.0f degrees outside junction faces\n", meeting,
+	              (int)(sizeof quality_rows / sizeof quality_rows[0]), PLUME_MESH_QUALITY_ANGLE_DEG);
+	assert_int_equal(meeting, 31);
+	assert_int_equal(plume_bytes_in_use(), before);
+}
+
+/// The junction test of plume_mesh_measure against a closed form: a vane face
+/// (0,0) (1,0) (1,0.2) has atan(0.2) = 11.3 degrees at its first vertex, between
+/// its barb edge (local 0) and edge 2. Alone, edge 2 is on the vane's border: a
+/// junction face. With a second vane face across edge 2 it is an ordinary sliver.
+static void test_junction_faces(void **state)
+{
+	(void)state;
+	plume_mesh *mesh = plume_mesh_create(4, 2);
+	assert_non_null(mesh);
+	mesh->reference[0] = (plume_vec2){0.0, 0.0};
+	mesh->reference[1] = (plume_vec2){1.0, 0.0};
+	mesh->reference[2] = (plume_vec2){1.0, 0.2};
+	mesh->reference[3] = (plume_vec2){0.0, 1.0};
+	int faces[6] = {0, 1, 2, 0, 2, 3};
+	memcpy(mesh->faces, faces, sizeof faces);
+	mesh->barb_edge[0] = 0;
+	mesh->barb_edge[1] = 1;
+	mesh->material[0] = PLUME_MATERIAL_VANE;
+	mesh->material[1] = PLUME_MATERIAL_RACHIS; // not part of the vane: edge 2 of face 0 is on the border
+	plume_mesh_report report = plume_mesh_measure(mesh);
+	assert_int_equal(report.excepted_count, 1);
+	assert_true(report.vane_min_angle == pi); // no other vane face
+	assert_close(report.min_angle, atan(0.2), 1e-15);
+	mesh->material[1] = PLUME_MATERIAL_VANE; // now edge 2 is inside the vane
+	report = plume_mesh_measure(mesh);
+	assert_int_equal(report.excepted_count, 0);
+	assert_close(report.vane_min_angle, atan(0.2), 1e-15);
+	mesh->barb_edge[0] = 1; // barb edge not at the small angle: never a junction
+	mesh->material[1] = PLUME_MATERIAL_RACHIS;
+	report = plume_mesh_measure(mesh);
+	assert_int_equal(report.excepted_count, 0);
+	assert_close(report.vane_min_angle, atan(0.2), 1e-15);
+	plume_mesh_destroy(mesh);
+}
+
 /// The default hawk with many seeds (random barb shapes that cross) and two
 /// edge lengths: always a valid, fully aligned mesh.
 static void test_random_seeds_and_edge_lengths(void **state)
@@ -561,7 +706,9 @@ static void test_guides_spec_splines(void **state)
 
 /// A feather five times the example's size: the strip walk's spatial index
 /// (src/mesh/aligned.c) gives the scan's mesh. The counts are those the
-/// mesher gave before the index (it took 5x longer here, 150x at 20x the size).
+/// mesher gives with every query scanned (MESH_SCAN_MAX raised past the pool;
+/// re-measured so for the staggered guide vertices of issue 13). The index took
+/// the time from 5x down here, 150x at 20x the size.
 static void test_tall_guides(void **state)
 {
 	(void)state;
@@ -574,12 +721,12 @@ static void test_tall_guides(void **state)
 	plume_error err;
 	if (plume_mesh_spec_read(path, &options, &mesh, &report, &err) != PLUME_OK)
 		fail_msg("%s", err.message);
-	assert_int_equal(mesh->vertex_count, 10024);
-	assert_int_equal(mesh->face_count, 19735);
-	assert_int_equal(mesh->barb_edge_count, 9722);
-	assert_int_equal(report.vertices_trimmed, 98);
-	assert_int_equal(report.guide_count[0], 149);
-	assert_int_equal(report.guide_count[1], 150);
+	assert_int_equal(mesh->vertex_count, 10031);
+	assert_int_equal(mesh->face_count, 19747);
+	assert_int_equal(mesh->barb_edge_count, 9729);
+	assert_int_equal(report.vertices_trimmed, 96);
+	assert_int_equal(report.guide_count[0], 148);
+	assert_int_equal(report.guide_count[1], 149);
 	assert_true(report.aligned_fraction == 1.0);
 	plume_mesh_destroy(mesh);
 	assert_int_equal(plume_bytes_in_use(), before);
@@ -761,6 +908,8 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test(test_examples_are_aligned),
+	    cmocka_unit_test(test_example_quality),
+	    cmocka_unit_test(test_junction_faces),
 	    cmocka_unit_test(test_random_seeds_and_edge_lengths),
 	    cmocka_unit_test(test_deterministic),
 	    cmocka_unit_test(test_one_sided_feather),

@@ -80,6 +80,9 @@ typedef struct plume_mesh_def {
 
 plume_mesh_def plume_mesh_default_def(void);
 
+/// The smallest vane angle the aligned mesher keeps outside junction faces, degrees.
+#define PLUME_MESH_QUALITY_ANGLE_DEG 20.0
+
 /// What the mesher measured.
 typedef struct plume_mesh_report {
 	/// Smallest interior angle over all faces, radians.
@@ -100,6 +103,14 @@ typedef struct plume_mesh_report {
 	int vertices_trimmed;
 	/// The target edge length e used, m.
 	double edge_length;
+	/// Smallest interior angle over the vane faces that are not junction faces, radians
+	/// (pi when there are none). The aligned mesher keeps it at or above PLUME_MESH_QUALITY_ANGLE_DEG.
+	double vane_min_angle;
+	/// Junction faces: vane faces with an angle under PLUME_MESH_QUALITY_ANGLE_DEG where every such angle
+	/// lies between the face's barb edge and an edge on the vane's border (the rachis
+	/// band or the outline), that is where a guide meets the rachis or the outline at a
+	/// shallow angle that the feather's shape, not the mesher, sets (docs/meshing.md).
+	int excepted_count;
 } plume_mesh_report;
 
 /// Meshes a generated feather: the shaft is the rachis centre line, the barbs are
@@ -190,7 +201,8 @@ plume_status plume_mesh_collect_barb_edges(plume_mesh *mesh, plume_error *err);
 /// The group with that name, or NULL.
 const plume_vertex_group *plume_mesh_find_group(const plume_mesh *mesh, const char *name);
 
-/// Minimum angle and aligned fraction of any mesh.
+/// Minimum angle, aligned fraction, vane minimum angle and junction faces of any mesh
+/// (faces with no barb edge are never junction faces).
 plume_mesh_report plume_mesh_measure(const plume_mesh *mesh);
 
 void plume_mesh_destroy(plume_mesh *mesh);

@@ -63,4 +63,8 @@ void mesh_centre_eval(const mesh_centre *centre, double sigma, plume_vec3 *p, pl
 /// True when the open polylines a and b (plane coordinates) properly cross.
 bool mesh_polylines_cross(const plume_vec3 *a, int a_count, const plume_vec3 *b, int b_count);
 
+/// plume_mesh_measure, or false when out of memory (the junction faces need the
+/// vane's edges sorted): the mesher fails then rather than report less.
+bool mesh_measure(const plume_mesh *mesh, plume_mesh_report *out);
+
 #endif

@@ -301,6 +301,12 @@ static plume_status finish_widths(mesh_input *input, const plume_mesh_def *def, 
 	input->width_base = def->rachis_width_base > 0.0 ? def->rachis_width_base : width;
 	input->width_tip =
 	    def->rachis_width_tip > 0.0 ? def->rachis_width_tip : input->rachis.width[input->rachis.count - 1];
+	if (!(def->rachis_width_tip > 0.0) && !(input->width_tip > 0.0)) {
+		// A shaft that ends in a point (Streit & Heidrich's taper to zero): the band
+		// takes the shaft's width one edge length below the tip, at the last row.
+		double end = input->rachis.sigma[input->rachis.count - 1];
+		mesh_centre_eval(&input->rachis, fmax(0.0, end - def->edge_length), &p, &tangent, &input->width_tip, &t, &lift);
+	}
 	if (!(input->width_base > 0.0) || !(input->width_tip > 0.0) || !isfinite(input->width_base) ||
 	    !isfinite(input->width_tip))
 		return plume_error_set(err, PLUME_ERROR_SPEC,

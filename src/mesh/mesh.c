@@ -6,6 +6,7 @@
 
 #include "../core/asserts.h"
 #include "../core/alloc.h"
+#include "aligned_internal.h"
 #include "plume/mesh.h"
 
 static const double pi = 3.14159265358979323846;
@@ -151,27 +152,115 @@ plume_status plume_mesh_collect_barb_edges(plume_mesh *mesh, plume_error *err)
 	return PLUME_OK;
 }
 
-plume_mesh_report plume_mesh_measure(const plume_mesh *mesh)
+static int compare_keys(const void *a, const void *b)
 {
-	plume_mesh_report report = {.min_angle = mesh->face_count > 0 ? pi : 0.0, .aligned_fraction = 1.0};
+	long long x = *(const long long *)a, y = *(const long long *)b;
+	return (x > y) - (x < y);
+}
+
+static long long edge_key(const plume_mesh *mesh, int a, int b)
+{
+	return a < b ? (long long)a * mesh->vertex_count + b : (long long)b * mesh->vertex_count + a;
+}
+
+/// True when edge (a, b) belongs to exactly one vane face: it lies on the vane's
+/// border, against the rachis band or on the outline. keys: the vane faces' edges, sorted.
+static bool on_vane_border(const plume_mesh *mesh, const long long *keys, int count, int a, int b)
+{
+	long long key = edge_key(mesh, a, b);
+	int lo = 0, hi = count; // first index with keys[i] >= key
+	while (lo < hi) {
+		int mid = lo + (hi - lo) / 2;
+		if (keys[mid] < key)
+			lo = mid + 1;
+		else
+			hi = mid;
+	}
+	return lo < count && keys[lo] == key && (lo + 1 == count || keys[lo + 1] != key);
+}
+
+bool mesh_measure(const plume_mesh *mesh, plume_mesh_report *out)
+{
+	plume_mesh_report report = {
+	    .min_angle = mesh->face_count > 0 ? pi : 0.0, .aligned_fraction = 1.0, .vane_min_angle = pi};
+	const double quality = PLUME_MESH_QUALITY_ANGLE_DEG * pi / 180.0;
 	int vane_faces = 0, aligned = 0;
+	// The vane faces' edges, to tell the vane's border edges (used by one vane face).
+	long long *keys = plume_alloc(3 * (size_t)(mesh->face_count > 0 ? mesh->face_count : 1) * sizeof *keys);
+	int key_count = 0;
+	for (int f = 0; keys != NULL && f < mesh->face_count; ++f)
+		if (mesh->material[f] == PLUME_MATERIAL_VANE)
+			for (int k = 0; k < 3; ++k)
+				keys[key_count++] = edge_key(mesh, mesh->faces[3 * f + k], mesh->faces[3 * f + (k + 1) % 3]);
+	if (keys == NULL)
+		return false;
+	qsort(keys, (size_t)key_count, sizeof *keys, compare_keys);
 	for (int f = 0; f < mesh->face_count; ++f) {
 		const int *v = mesh->faces + 3 * f;
+		double angles[3];
 		for (int k = 0; k < 3; ++k) {
 			plume_vec2 p = mesh->reference[v[k]], a = mesh->reference[v[(k + 1) % 3]],
 			           b = mesh->reference[v[(k + 2) % 3]];
 			double ax = a.x - p.x, ay = a.y - p.y, bx = b.x - p.x, by = b.y - p.y;
 			// atan2(|a x b|, a . b) is accurate for small and near-pi angles alike.
-			double angle = atan2(fabs(ax * by - ay * bx), ax * bx + ay * by);
-			if (angle < report.min_angle)
-				report.min_angle = angle;
+			angles[k] = atan2(fabs(ax * by - ay * bx), ax * bx + ay * by);
+			if (angles[k] < report.min_angle)
+				report.min_angle = angles[k];
 		}
-		if (mesh->material[f] == PLUME_MATERIAL_VANE) {
-			++vane_faces;
-			aligned += mesh->barb_edge[f] >= 0;
+		if (mesh->material[f] != PLUME_MATERIAL_VANE)
+			continue;
+		++vane_faces;
+		int barb = mesh->barb_edge[f];
+		aligned += barb >= 0;
+		// A junction face: each angle under the quality bound lies at a vertex where the
+		// face's barb edge (local edge k or k + 2 at vertex k) meets a border edge, the
+		// other edge at that vertex: the angle between a guide and the rachis or the outline.
+		int small = 0, junction = 0;
+		for (int k = 0; k < 3; ++k) {
+			if (!(angles[k] < quality))
+				continue;
+			++small;
+			int other = barb == k ? (k + 2) % 3 : barb == (k + 2) % 3 ? k : -1;
+			junction += barb >= 0 && other >= 0 && on_vane_border(mesh, keys, key_count, v[other], v[(other + 1) % 3]);
 		}
+		if (small > 0 && junction == small) {
+			++report.excepted_count;
+			continue;
+		}
+		for (int k = 0; k < 3; ++k)
+			report.vane_min_angle = fmin(report.vane_min_angle, angles[k]);
 	}
+	plume_free(keys);
 	report.aligned_fraction = vane_faces > 0 ? (double)aligned / vane_faces : 1.0;
+	*out = report;
+	return true;
+}
+
+plume_mesh_report plume_mesh_measure(const plume_mesh *mesh)
+{
+	plume_mesh_report report;
+	if (!mesh_measure(mesh, &report)) { // out of memory: no face is told a junction face
+		plume_mesh_report plain = {.min_angle = mesh->face_count > 0 ? pi : 0.0, .vane_min_angle = pi};
+		report = plain;
+		int vane_faces = 0, aligned = 0;
+		for (int f = 0; f < mesh->face_count; ++f) {
+			for (int k = 0; k < 3; ++k) {
+				plume_vec2 p = mesh->reference[mesh->faces[3 * f + k]],
+				           a = mesh->reference[mesh->faces[3 * f + (k + 1) % 3]],
+				           b = mesh->reference[mesh->faces[3 * f + (k + 2) % 3]];
+				double ax = a.x - p.x, ay = a.y - p.y, bx = b.x - p.x, by = b.y - p.y;
+				double angle = atan2(fabs(ax * by - ay * bx), ax * bx + ay * by);
+				report.min_angle = fmin(report.min_angle, angle);
+				if (mesh->material[f] == PLUME_MATERIAL_VANE)
+					report.vane_min_angle = fmin(report.vane_min_angle, angle);
+			}
+			if (mesh->material[f] == PLUME_MATERIAL_VANE) {
+				++vane_faces;
+				aligned += mesh->barb_edge[f] >= 0;
+			}
+		}
+		report.aligned_fraction = vane_faces > 0 ? (double)aligned / vane_faces : 1.0;
+	}
 	return report;
 }
 
