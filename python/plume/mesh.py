@@ -100,6 +100,8 @@ def _report(r: Any) -> dict:
         "barbs_averaged": r.barbs_averaged,
         "vertices_trimmed": r.vertices_trimmed,
         "edge_length": r.edge_length,
+        "vane_min_angle": r.vane_min_angle,
+        "excepted_count": r.excepted_count,
     }
 
 

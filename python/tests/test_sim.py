@@ -1,6 +1,7 @@
 """Meshes and simulations from the binding against `plume mesh` and `plume simulate`."""
 
 import gc
+import math
 import json
 
 import numpy as np
@@ -131,6 +132,9 @@ def test_mesh_matches_plume_mesh(source, cli, tmp_path):
     assert ((shell.barb_angles >= 0) & (shell.barb_angles < np.pi)).all()
     assert set(np.unique(shell.materials)) <= {0, 1}
     assert shell.report["aligned_fraction"] == 1.0
+    # The mesher's quality floor outside junction faces (docs/meshing.md), in radians.
+    assert shell.report["vane_min_angle"] >= math.radians(20.0) - 1e-12
+    assert 0 <= shell.report["excepted_count"] < shell.face_count
     assert {"rachis_clamp", "rachis_tip"} <= set(shell.groups)
     assert shell.barb_edges.shape[1] == 2 and len(shell.barb_edges) > 0
 
