@@ -1,4 +1,4 @@
-// plume simulate SCENE.json -o DIR [--seed N] [--png] [--size WxH]
+// plume simulate SCENE.json -o DIR [--seed N] [--duration T] [--frames-every N] [--png] [--size WxH]
 #define _POSIX_C_SOURCE 200809L
 #include <getopt.h>
 #include <math.h>
@@ -21,6 +21,8 @@ void cli_help_simulate(void)
 	     "  DIR/mesh.obj          the rest shell (UVs, rachis and vane groups)\n"
 	     "  DIR/feather.json      the generated feather (barb-level geometry; its numbers\n"
 	     "                        in DIR/feather.bin, docs/feather-json.md)\n"
+	     "  DIR/feathers/NAME.json  instead, for a scene that lists \"feathers\": each\n"
+	     "                        feather placed at rest (world coordinates, like mesh.obj)\n"
 	     "  DIR/frames/NNNN.obj   the shell at every written step (0000: the start)\n"
 	     "  DIR/sim.glb           all frames as one animated glTF 2.0 file (morph\n"
 	     "                        targets, animation \"simulation\"; Blender, three.js)\n"
@@ -32,7 +34,7 @@ void cli_help_simulate(void)
 	     "                        per handle N (in the scene's order) the reaction force\n"
 	     "                        handleN_f{x,y,z} (N) and displacement handleN_d{x,y,z} (m)\n"
 	     "  DIR/summary.json      steps, iterations, timings, largest barb strain,\n"
-	     "                        rachis tip deflection\n"
+	     "                        rachis tip deflection, feather and vertex counts\n"
 	     "Bad input writes nothing. If a step fails even with substeps, the frames\n"
 	     "before it are kept, summary.json says where it stopped, and the exit\n"
 	     "status is 1.\n"
@@ -40,6 +42,9 @@ void cli_help_simulate(void)
 	     "Options:\n"
 	     "  -o, --output DIR    output folder (created if missing)\n"
 	     "  -s, --seed N        seed of the scene's feather (overrides the specs)\n"
+	     "      --duration T    simulate T seconds instead of the scene's $.duration (> 0)\n"
+	     "      --frames-every N  write every N-th step instead of the scene's\n"
+	     "                      $.frame_every (N >= 1; the last step is always written)\n"
 	     "      --png           also write a shaded PNG of every frame\n"
 	     "      --size WxH      PNG size (default 800x800)\n"
 	     "      --view AZ,EL    PNG camera azimuth about +y and elevation, degrees\n"
@@ -179,7 +184,10 @@ static void write_handle_columns(run_state *run, double time, const plume_sim *s
 static void show_progress(run_state *run, int step, double time)
 {
 	char note[64];
-	snprintf(note, sizeof note, "t = %.3f s", time);
+	if (run->scene->feather_count > 1)
+		snprintf(note, sizeof note, "t = %.3f s, %d feathers", time, run->scene->feather_count);
+	else
+		snprintf(note, sizeof note, "t = %.3f s", time);
 	cli_progress_update_note(&run->bar, step, note);
 }
 
@@ -270,6 +278,36 @@ static plume_status write_summary(cli_output *output, const plume_scene *scene, 
 	json_object_set_new(root, "max_barb_strain", json_real(summary->max_barb_strain));
 	json_object_set_new(root, "rachis_tip_deflection", json_real(summary->rachis_tip_deflection));
 	json_object_set_new(root, "vertices", json_integer(summary->vertex_count));
+	json_object_set_new(root, "vertex_count", json_integer(summary->vertex_count));
+	json_object_set_new(root, "feather_count", json_integer(scene->feather_count));
+	json_object_set_new(root, "duration", json_real(scene->duration));
+	// The cost of one cycle of a cyclic scene: the wall time over the cycles simulated.
+	double simulated = fmin(summary->steps * scene->sim.time_step, scene->duration);
+	if (scene->cycle_period > 0) {
+		json_object_set_new(root, "cycle_period", json_real(scene->cycle_period));
+		if (simulated > 0)
+			json_object_set_new(root, "seconds_per_cycle",
+			                    json_real(summary->wall_seconds / (simulated / scene->cycle_period)));
+	}
+	// Written only by runs that measure them (contact, the independent intersection check).
+	if (summary->contact_measured) {
+		json_object_set_new(root, "contact_pairs_max", json_integer(summary->contact_pairs_max));
+		json_object_set_new(root, "min_distance", json_measure(summary->min_distance));
+	}
+	if (summary->intersections_checked)
+		json_object_set_new(root, "intersecting_pairs", json_integer(summary->intersecting_pairs));
+	json_t *feathers = json_array();
+	for (int i = 0; i < scene->feather_count; ++i) {
+		const plume_scene_feather *f = scene->feathers + i;
+		json_t *entry = json_object();
+		json_object_set_new(entry, "name", json_string(f->name));
+		json_object_set_new(entry, "vertex_offset", json_integer(f->vertex_offset));
+		json_object_set_new(entry, "vertex_count", json_integer(f->vertex_count));
+		json_object_set_new(entry, "face_offset", json_integer(f->face_offset));
+		json_object_set_new(entry, "face_count", json_integer(f->face_count));
+		json_array_append_new(feathers, entry);
+	}
+	json_object_set_new(root, "feathers", feathers);
 	json_object_set_new(root, "faces", json_integer(summary->face_count));
 	json_object_set_new(root, "barb_constraints", json_integer(summary->constraint_count));
 	json_object_set_new(root, "vane_min_principal_stretch", json_measure(run->min_stretch));
@@ -311,6 +349,24 @@ static void make_movie(cli_output *output)
 	}
 }
 
+/// A scene that lists "feathers": DIR/feathers/NAME.json (and .bin), each feather placed at rest.
+static plume_status write_feathers(const plume_scene *scene, cli_output *output, plume_error *err)
+{
+	char path[4352], name[64];
+	snprintf(path, sizeof path, "%s/feathers", output->stage);
+	if (mkdir(path, 0777) != 0)
+		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot create: %s", path, "mkdir failed");
+	plume_status status = PLUME_OK;
+	for (int i = 0; i < scene->feather_count && status == PLUME_OK; ++i) {
+		if (scene->feathers[i].feather == NULL)
+			continue;
+		snprintf(name, sizeof name, "feathers/%s.json", scene->feathers[i].name);
+		status =
+		    plume_write_json_binary(scene->feathers[i].feather, cli_output_path(output, name, path, sizeof path), err);
+	}
+	return status;
+}
+
 /// Writes the rest shell and the feather, then runs the scene into frames/ and stats.csv.
 static plume_status simulate(const plume_scene *scene, cli_output *output, run_state *run, plume_scene_summary *summary,
                              plume_error *failure, plume_error *err)
@@ -322,6 +378,8 @@ static plume_status simulate(const plume_scene *scene, cli_output *output, run_s
 	if (status == PLUME_OK && scene->feather != NULL)
 		status =
 		    plume_write_json_binary(scene->feather, cli_output_path(output, "feather.json", path, sizeof path), err);
+	else if (status == PLUME_OK)
+		status = write_feathers(scene, output, err);
 	if (status != PLUME_OK)
 		return status;
 	snprintf(path, sizeof path, "%s/frames", output->stage);
@@ -392,6 +450,8 @@ int cli_simulate(int argc, char **argv)
 	    {"glb-feather", no_argument, NULL, 'G'},
 	    {"help", no_argument, NULL, 'h'},
 	    {"max-memory", required_argument, NULL, 'M'},
+	    {"duration", required_argument, NULL, 'D'},
+	    {"frames-every", required_argument, NULL, 'E'},
 	    {NULL, 0, NULL, 0},
 	};
 	const char *output_dir = NULL;
@@ -400,6 +460,8 @@ int cli_simulate(int argc, char **argv)
 	run_state run = {0};
 	run.view = plume_shell_view_default_def();
 	int spp = 4;
+	double duration = 0; // 0: the scene's
+	int frames_every = 0;
 	int option;
 	optind = 1;
 	opterr = 0;
@@ -441,6 +503,22 @@ int cli_simulate(int argc, char **argv)
 			if (!cli_parse_memory("simulate", optarg, &max_bytes))
 				return CLI_EXIT_USAGE;
 			break;
+		case 'D': {
+			char *end = NULL;
+			duration = strtod(optarg, &end);
+			if (end == optarg || *end != '\0' || !(duration > 0) || !isfinite(duration))
+				return cli_usage_error("simulate", "--duration takes a time in seconds > 0, got '%s'", optarg);
+			break;
+		}
+		case 'E': {
+			char *end = NULL;
+			long value = strtol(optarg, &end, 10);
+			if (end == optarg || *end != '\0' || value < 1 || value > PLUME_SCENE_MAX_STEPS)
+				return cli_usage_error("simulate", "--frames-every takes a whole number in [1, %d], got '%s'",
+				                       PLUME_SCENE_MAX_STEPS, optarg);
+			frames_every = (int)value;
+			break;
+		}
 		case 'h': cli_help_simulate(); return CLI_EXIT_OK;
 		case ':': return cli_usage_error("simulate", "option '%s' needs a value", argv[optind - 1]);
 		default: return cli_usage_error("simulate", "unknown option '%s'", argv[optind - 1]);
@@ -455,6 +533,19 @@ int cli_simulate(int argc, char **argv)
 	plume_status status = plume_scene_load(argv[optind], &spec_options, &scene, &err);
 	if (status != PLUME_OK)
 		return cli_fail(&err);
+	if (duration > 0) {
+		// The scene's own duration passed the same limit when it was read (spec_scene.c).
+		double dt = scene->sim.time_step;
+		if (!(duration / dt <= PLUME_SCENE_MAX_STEPS)) {
+			plume_scene_destroy(scene);
+			return cli_usage_error("simulate",
+			                       "--duration %g s in steps of %g s ($.time_step) is %.3g steps; allowed at most %.0e",
+			                       duration, dt, duration / dt, (double)PLUME_SCENE_MAX_STEPS);
+		}
+		scene->duration = duration;
+	}
+	if (frames_every > 0)
+		scene->frame_every = frames_every;
 	run.scene = scene;
 	run.total_steps = (int)ceil(scene->duration / scene->sim.time_step - 1e-9);
 	// The frames' bytes before the run: an OBJ line is at most about 80 bytes
@@ -482,12 +573,16 @@ int cli_simulate(int argc, char **argv)
 	}
 	if (run.glb_feather && scene->feather == NULL) {
 		plume_scene_destroy(scene);
-		return cli_usage_error("simulate", "--glb-feather needs a scene whose feather is generated (not guides)");
+		return cli_usage_error(
+		    "simulate",
+		    "--glb-feather needs a scene with one generated feather (\"feather\", not guides or \"feathers\")");
 	}
 	if (run.render) {
 		if (scene->feather == NULL) {
 			plume_scene_destroy(scene);
-			return cli_usage_error("simulate", "--render needs a scene whose feather is generated (not guides)");
+			return cli_usage_error(
+			    "simulate",
+			    "--render needs a scene with one generated feather (\"feather\", not guides or \"feathers\")");
 		}
 		status = cli_barb_renderer_begin(&run.renderer, scene->feather, scene->mesh, lo, hi, run.view.width,
 		                                 run.view.height, spp, &err);

@@ -5,7 +5,9 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "../model/feather_internal.h"
 #include "core/alloc.h"
+#include "plume/coat.h"
 #include "plume/io.h"
 #include "plume/scene.h"
 #include "spec.h"
@@ -13,9 +15,13 @@
 #include "spec_models.h"
 
 static const char *const top_keys[] = {
-    "description", "feather", "guides",       "seed",     "mesh",        "materials", "handles", "forces", "gravity",
-    "drag",        "bending", "time_step",    "duration", "frame_every", "quasi_static", "solver", "integrator", "air", NULL,
+    "description", "feather",      "feathers", "guides",     "seed",    "mesh",         "materials",
+    "handles",     "forces",       "gravity",  "drag",       "bending", "time_step",    "duration",
+    "frame_every", "quasi_static", "solver",   "integrator", "air",     "cycle_period", NULL,
 };
+static const char *const feather_entry_keys[] = {"name",          "feather",      "coat",     "mesh", "position",
+                                                 "rotation_axis", "rotation_deg", "follicle", NULL};
+static const char *const follicle_keys[] = {"bone", NULL};
 static const char *const material_keys[] = {
     "model",
     "E_vv",
@@ -38,8 +44,8 @@ static const char *const solver_keys[] = {"tolerance", "max_iterations", "max_su
 static const char *const material_models[] = {"orthotropic", "isotropic", NULL};
 static const char *const interpolations[] = {"linear", "smooth", NULL};
 static const char *const integrators[] = {"implicit-euler", "bdf2", NULL};
-static const char *const air_keys[] = {"density", "normal_drag", "tangential_drag", "centre_of_pressure", "wind",
-                                       "gusts", "seed", NULL};
+static const char *const air_keys[] = {
+    "density", "normal_drag", "tangential_drag", "centre_of_pressure", "wind", "gusts", "seed", NULL};
 static const char *const gust_keys[] = {"speed", "length", "time", NULL};
 /// Indexed by plume_bending_model.
 static const char *const bending_models[] = {"fundamental-form", "paper-hinge", NULL};
@@ -351,26 +357,30 @@ static void read_forces(plume_spec_reader *reader, const json_t *root, plume_sce
 	}
 }
 
-/// Generates (or reads) the feather named by "feather": a generator spec inline or by path
-/// (relative to the scene), or a feather written by `plume generate --format json`.
-static plume_status load_feather(const char *file, const json_t *root, const plume_spec_options *options,
-                                 plume_feather **out, plume_error *err)
+/// The path of a file named in the scene: absolute, or relative to the scene's folder.
+static void scene_relative(const char *file, const char *name, char *out, size_t size)
 {
-	const json_t *value = json_object_get(root, "feather");
-	if (json_is_object(value))
-		return plume_spec_generate_json(file, value, options, out, err);
-	if (!json_is_string(value))
-		return plume_error_set(err, PLUME_ERROR_SPEC,
-		                       "%s: $.feather: expected a feather spec (an object) or the path of one", file);
-	const char *name = json_string_value(value);
-	char path[4096];
 	if (name[0] == '/') {
-		snprintf(path, sizeof path, "%s", name);
+		snprintf(out, size, "%s", name);
 	} else {
 		char copy[4096];
 		snprintf(copy, sizeof copy, "%s", file);
-		snprintf(path, sizeof path, "%s/%s", dirname(copy), name);
+		snprintf(out, size, "%s/%s", dirname(copy), name);
 	}
+}
+
+/// Generates (or reads) the feather of value (at JSON path `where`): a generator spec inline or
+/// by path (relative to the scene), or a feather written by `plume generate --format json`.
+static plume_status load_feather(const char *file, const json_t *value, const char *where,
+                                 const plume_spec_options *options, plume_feather **out, plume_error *err)
+{
+	if (json_is_object(value))
+		return plume_spec_generate_json(file, value, options, out, err);
+	if (!json_is_string(value))
+		return plume_error_set(err, PLUME_ERROR_SPEC, "%s: %s: expected a feather spec (an object) or the path of one",
+		                       file, where);
+	char path[4096];
+	scene_relative(file, json_string_value(value), path, sizeof path);
 	json_t *spec = plume_spec_load(path, err);
 	if (spec == NULL) {
 		plume_error_prefix(err, file);
@@ -383,6 +393,347 @@ static plume_status load_feather(const char *file, const json_t *root, const plu
 	return status;
 }
 
+// ---------------------------------------------------------------------------
+// Many feathers (docs/scene.md "Many feathers")
+
+/// Moves a feather (and its afterfeather) rigidly: every point p goes to rotation p + translation.
+static void move_feather(plume_feather *feather, plume_mat3 rotation, plume_vec3 translation)
+{
+	for (int i = 0; i < feather->shaft_count; ++i) {
+		plume_shaft_sample *s = feather->shaft + i;
+		s->position = plume_v3_add(plume_m3_apply(rotation, s->position), translation);
+		s->tangent = plume_m3_apply(rotation, s->tangent);
+		s->normal = plume_m3_apply(rotation, s->normal);
+		s->binormal = plume_m3_apply(rotation, s->binormal);
+	}
+	for (int i = 0; i < feather->point_count; ++i) {
+		feather->points[i] = plume_v3_add(plume_m3_apply(rotation, feather->points[i]), translation);
+		feather->normals[i] = plume_m3_apply(rotation, feather->normals[i]);
+	}
+	if (feather->afterfeather != NULL)
+		move_feather(feather->afterfeather, rotation, translation);
+}
+
+/// A feather of "feathers" while the scene is read: in its own frame until it is meshed.
+typedef struct pending_feather {
+	plume_feather *feather;
+	plume_mesh *mesh;
+	plume_mesh_def mesh_def;
+	plume_mat3 rotation;
+	plume_vec3 translation;
+	plume_mesh_report report;
+	char name[16];
+	bool named;
+	bool follicle;
+	char bone[32];
+	char where[64]; ///< its JSON path, for messages ("$.feathers[2]", "$.feathers[2] (coat feather 5)")
+} pending_feather;
+
+typedef struct pending_list {
+	pending_feather *items;
+	int count, capacity;
+} pending_list;
+
+static pending_feather *pending_add(pending_list *list)
+{
+	if (list->count == list->capacity) {
+		int capacity = list->capacity > 0 ? 2 * list->capacity : 8;
+		pending_feather *items = plume_realloc(list->items, sizeof *items * (size_t)capacity);
+		if (items == NULL)
+			return NULL;
+		list->items = items;
+		list->capacity = capacity;
+	}
+	pending_feather *item = list->items + list->count++;
+	memset(item, 0, sizeof *item);
+	return item;
+}
+
+static void pending_free(pending_list *list)
+{
+	for (int i = 0; i < list->count; ++i) {
+		plume_feather_destroy(list->items[i].feather);
+		plume_mesh_destroy(list->items[i].mesh);
+	}
+	plume_free(list->items);
+}
+
+/// Letters, digits, '-' and '_', 1 to 15 bytes: a group prefix and a file name.
+static bool valid_name(const char *name)
+{
+	size_t length = strlen(name);
+	if (length == 0 || length > 15)
+		return false;
+	for (size_t i = 0; i < length; ++i) {
+		char c = name[i];
+		if (!((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' || c == '_'))
+			return false;
+	}
+	return true;
+}
+
+/// The attachment of an entry: name, mesh settings, placement and follicle, into item.
+static void read_attachment(plume_spec_reader *reader, const json_t *object, const char *path,
+                            const plume_mesh_def *scene_mesh, pending_feather *item)
+{
+	item->mesh_def = *scene_mesh;
+	const json_t *mesh = plume_spec_object(reader, object, path, "mesh");
+	if (mesh != NULL) {
+		char mesh_path[96];
+		plume_spec_path(mesh_path, sizeof mesh_path, path, "mesh");
+		plume_spec_mesh_def(reader, mesh, mesh_path, &item->mesh_def);
+	}
+	plume_vec3 axis = plume_v3(0, 0, 1);
+	double degrees = 0;
+	read_vec3(reader, object, path, "position", &item->translation);
+	read_vec3(reader, object, path, "rotation_axis", &axis);
+	plume_spec_number(reader, object, path, "rotation_deg", &degrees);
+	item->rotation = plume_m3_identity();
+	if (reader->status == PLUME_OK && degrees != 0) {
+		if (plume_v3_length(axis) == 0) {
+			char axis_path[96];
+			plume_spec_path(axis_path, sizeof axis_path, path, "rotation_axis");
+			plume_spec_fail(reader, axis_path, "is the zero vector; a rotation needs an axis");
+			return;
+		}
+		item->rotation = plume_m3_rotation(plume_v3_normalize(axis), degrees * acos(-1.0) / 180);
+	}
+	const char *name = NULL;
+	if (plume_spec_string(reader, object, path, "name", &name)) {
+		char name_path[96];
+		plume_spec_path(name_path, sizeof name_path, path, "name");
+		if (!valid_name(name)) {
+			plume_spec_fail(reader, name_path,
+			                "\"%s\" is not a feather name; allowed 1 to 15 letters, digits, '-' or '_'", name);
+			return;
+		}
+		snprintf(item->name, sizeof item->name, "%s", name);
+		item->named = true;
+	}
+	const json_t *follicle = plume_spec_object(reader, object, path, "follicle");
+	if (follicle != NULL) {
+		char follicle_path[96];
+		plume_spec_path(follicle_path, sizeof follicle_path, path, "follicle");
+		plume_spec_check_keys(reader, follicle, follicle_path, follicle_keys);
+		const char *bone = NULL;
+		if (plume_spec_string(reader, follicle, follicle_path, "bone", &bone))
+			snprintf(item->bone, sizeof item->bone, "%s", bone);
+		item->follicle = true;
+	}
+}
+
+/// Every feather of a coat spec becomes an entry: taken back to its own frame (for the
+/// mesher) and placed by the coat's frame at its follicle, then by the entry's placement.
+static plume_status expand_coat(const char *file, const char *name, const char *where, const pending_feather *entry,
+                                const plume_spec_options *options, pending_list *list, plume_error *err)
+{
+	char path[4096];
+	scene_relative(file, name, path, sizeof path);
+	plume_coat *coat = NULL;
+	plume_status status = plume_coat_spec_generate(path, options, &coat, err);
+	if (status != PLUME_OK) {
+		char prefix[4200];
+		snprintf(prefix, sizeof prefix, "%s: %s.coat", file, where);
+		plume_error_prefix(err, prefix);
+		return status;
+	}
+	int count = plume_coat_feather_count(coat);
+	for (int k = 0; k < count && status == PLUME_OK; ++k) {
+		pending_feather *item = pending_add(list);
+		plume_feather *feather = plume_feather_clone(plume_coat_feather(coat, k));
+		if (item == NULL || feather == NULL) {
+			plume_feather_destroy(feather);
+			status = plume_error_set(err, PLUME_ERROR_MEMORY, "%s: %s: out of memory", file, where);
+			break;
+		}
+		*item = *entry;
+		item->feather = feather;
+		plume_mat3 rotation;
+		plume_vec3 origin;
+		plume_coat_feather_frame(coat, k, &rotation, &origin);
+		plume_mat3 inverse = plume_m3_transpose(rotation);
+		move_feather(feather, inverse, plume_v3_scale(plume_m3_apply(inverse, origin), -1));
+		item->rotation = plume_m3_mul(entry->rotation, rotation);
+		item->translation = plume_v3_add(plume_m3_apply(entry->rotation, origin), entry->translation);
+		snprintf(item->where, sizeof item->where, "%.24s (coat feather %d)", where, k);
+		if (entry->named) {
+			char composed[64];
+			snprintf(composed, sizeof composed, "%s-%d", entry->name, k);
+			if (!valid_name(composed)) {
+				status = plume_error_set(err, PLUME_ERROR_SPEC,
+				                         "%s: %s.name: \"%s\" with the coat feather's number (\"%s\") passes 15 bytes",
+				                         file, where, entry->name, composed);
+				break;
+			}
+			snprintf(item->name, sizeof item->name, "%s", composed);
+		}
+	}
+	plume_coat_destroy(coat);
+	return status;
+}
+
+/// Reads the entries of "feathers" into list (own-frame feathers, placements, names).
+static plume_status read_feather_entries(const char *file, const json_t *array, const plume_mesh_def *scene_mesh,
+                                         const plume_spec_options *options, pending_list *list, plume_error *err)
+{
+	plume_spec_reader reader = plume_spec_reader_begin(file, err);
+	size_t count = json_array_size(array);
+	if (count == 0)
+		return plume_error_set(err, PLUME_ERROR_SPEC, "%s: $.feathers: is empty; list at least one feather", file);
+	for (size_t i = 0; i < count; ++i) {
+		char path[48];
+		plume_spec_index_path(path, sizeof path, "$.feathers", i);
+		const json_t *object = json_array_get(array, i);
+		if (!json_is_object(object))
+			return plume_error_set(err, PLUME_ERROR_SPEC,
+			                       "%s: %s: expected an object {\"feather\": ..., \"position\": [x, y, z], ...}", file,
+			                       path);
+		plume_spec_check_keys(&reader, object, path, feather_entry_keys);
+		pending_feather entry;
+		memset(&entry, 0, sizeof entry);
+		read_attachment(&reader, object, path, scene_mesh, &entry);
+		if (reader.status != PLUME_OK)
+			return reader.status;
+		snprintf(entry.where, sizeof entry.where, "%s", path);
+		const json_t *feather = json_object_get(object, "feather"), *coat = json_object_get(object, "coat");
+		if ((feather == NULL) == (coat == NULL))
+			return plume_error_set(err, PLUME_ERROR_SPEC,
+			                       "%s: %s: an entry needs exactly one of \"feather\" (a feather spec or dump) or "
+			                       "\"coat\" (the path of a coat spec)",
+			                       file, path);
+		plume_status status;
+		if (coat != NULL) {
+			if (!json_is_string(coat))
+				return plume_error_set(err, PLUME_ERROR_SPEC, "%s: %s.coat: expected the path of a coat spec", file,
+				                       path);
+			status = expand_coat(file, json_string_value(coat), path, &entry, options, list, err);
+		} else {
+			char where[64];
+			plume_spec_path(where, sizeof where, path, "feather");
+			pending_feather *item = pending_add(list);
+			if (item == NULL)
+				return plume_error_set(err, PLUME_ERROR_MEMORY, "%s: %s: out of memory", file, path);
+			*item = entry;
+			status = load_feather(file, feather, where, options, &item->feather, err);
+		}
+		if (status != PLUME_OK)
+			return status;
+	}
+	return PLUME_OK;
+}
+
+/// Default names, then no two alike.
+static plume_status name_feathers(const char *file, pending_list *list, plume_error *err)
+{
+	for (int i = 0; i < list->count; ++i)
+		if (!list->items[i].named)
+			snprintf(list->items[i].name, sizeof list->items[i].name, "f%d", i);
+	for (int i = 0; i < list->count; ++i)
+		for (int j = 0; j < i; ++j)
+			if (strcmp(list->items[i].name, list->items[j].name) == 0)
+				return plume_error_set(err, PLUME_ERROR_SPEC,
+				                       "%s: %s: the feather name \"%s\" is also the name of %s; names must differ "
+				                       "(unnamed feathers are f0, f1, ... by their place in the list)",
+				                       file, list->items[i].where, list->items[i].name, list->items[j].where);
+	return PLUME_OK;
+}
+
+/// "feathers": every feather meshed in its own frame, placed, and the meshes joined.
+static plume_status build_many(const char *file, const json_t *array, const plume_mesh_def *scene_mesh,
+                               const plume_spec_options *options, plume_scene *scene, plume_error *err)
+{
+	pending_list list = {0};
+	plume_status status = read_feather_entries(file, array, scene_mesh, options, &list, err);
+	if (status == PLUME_OK)
+		status = name_feathers(file, &list, err);
+	for (int i = 0; i < list.count && status == PLUME_OK; ++i) {
+		pending_feather *item = list.items + i;
+		status = plume_mesh_from_feather(item->feather, &item->mesh_def, &item->mesh, &item->report, err);
+		if (status != PLUME_OK) {
+			char prefix[4200];
+			snprintf(prefix, sizeof prefix, "%s: %s (feather \"%s\"): meshing", file, item->where, item->name);
+			plume_error_prefix(err, prefix);
+			break;
+		}
+		move_feather(item->feather, item->rotation, item->translation);
+		plume_mesh_report report = item->report;
+		if (i == 0) {
+			scene->mesh_report = report;
+		} else {
+			scene->mesh_report.min_angle = fmin(scene->mesh_report.min_angle, report.min_angle);
+			scene->mesh_report.aligned_fraction = fmin(scene->mesh_report.aligned_fraction, report.aligned_fraction);
+			scene->mesh_report.guides_dropped += report.guides_dropped;
+			scene->mesh_report.barbs_averaged += report.barbs_averaged;
+			scene->mesh_report.vertices_trimmed += report.vertices_trimmed;
+		}
+	}
+	if (status == PLUME_OK) {
+		scene->feathers = plume_calloc((size_t)list.count, sizeof *scene->feathers);
+		plume_mesh_part *parts = plume_calloc((size_t)list.count, sizeof *parts);
+		if (scene->feathers == NULL || parts == NULL)
+			status =
+			    plume_error_set(err, PLUME_ERROR_MEMORY, "%s: out of memory joining %d feathers", file, list.count);
+		int vertex_offset = 0, face_offset = 0;
+		for (int i = 0; i < list.count && status == PLUME_OK; ++i) {
+			pending_feather *item = list.items + i;
+			plume_scene_feather *f = scene->feathers + i;
+			parts[i] = (plume_mesh_part){item->mesh, item->rotation, item->translation, item->name};
+			snprintf(f->name, sizeof f->name, "%s", item->name);
+			f->rotation = item->rotation;
+			f->translation = item->translation;
+			f->follicle_point = item->translation;
+			f->vertex_offset = vertex_offset;
+			f->vertex_count = item->mesh->vertex_count;
+			f->face_offset = face_offset;
+			f->face_count = item->mesh->face_count;
+			f->mesh_report = item->report;
+			snprintf(f->bone_name, sizeof f->bone_name, "%s", item->bone);
+			f->follicle = item->follicle;
+			f->bone = -1;
+			vertex_offset += f->vertex_count;
+			face_offset += f->face_count;
+			scene->feather_count = i + 1;
+		}
+		if (status == PLUME_OK) {
+			status = plume_mesh_concatenate(parts, list.count, &scene->mesh, err);
+			if (status != PLUME_OK)
+				plume_error_prefix(err, file);
+		}
+		// The feathers move to the scene (placed at rest, like their meshes).
+		for (int i = 0; i < scene->feather_count; ++i) {
+			scene->feathers[i].feather = list.items[i].feather;
+			list.items[i].feather = NULL;
+		}
+		plume_free(parts);
+	}
+	// Follicles are checked against the body once it is read (it needs the scene's body).
+	for (int i = 0; i < list.count && status == PLUME_OK; ++i)
+		if (list.items[i].follicle)
+			status = plume_error_set(err, PLUME_ERROR_SPEC,
+			                         "%s: %s.follicle: the scene has no \"body\" to carry feather \"%s\"", file,
+			                         list.items[i].where, list.items[i].name);
+	pending_free(&list);
+	return status;
+}
+
+/// A scene written with "feather" or "guides" is one feather, its mesh as the mesher made it.
+static plume_status one_feather(const char *file, plume_scene *scene, plume_error *err)
+{
+	scene->feathers = plume_calloc(1, sizeof *scene->feathers);
+	if (scene->feathers == NULL)
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "%s: out of memory", file);
+	plume_scene_feather *f = scene->feathers;
+	scene->feather_count = 1;
+	snprintf(f->name, sizeof f->name, "f0");
+	f->feather = scene->feather;
+	f->rotation = plume_m3_identity();
+	f->vertex_count = scene->mesh->vertex_count;
+	f->face_count = scene->mesh->face_count;
+	f->mesh_report = scene->mesh_report;
+	f->bone = -1;
+	return PLUME_OK;
+}
+
 static plume_status build_mesh(const char *file, const json_t *root, const plume_spec_options *options,
                                plume_scene *scene, plume_error *err)
 {
@@ -393,14 +744,19 @@ static plume_status build_mesh(const char *file, const json_t *root, const plume
 	if (mesh != NULL)
 		plume_spec_mesh_def(&reader, mesh, "$.mesh", &mesh_def);
 	const json_t *feather = json_object_get(root, "feather"), *guides = plume_spec_object(&reader, root, "$", "guides");
+	const json_t *feathers = plume_spec_array(&reader, root, "$", "feathers");
 	if (reader.status != PLUME_OK)
 		return reader.status;
-	if ((feather == NULL) == (guides == NULL))
+	if ((feather != NULL) + (guides != NULL) + (feathers != NULL) != 1)
 		return plume_error_set(err, PLUME_ERROR_SPEC,
-		                       "%s: $: a scene needs exactly one of \"feather\" (a feather spec) or \"guides\"", file);
+		                       "%s: $: a scene needs exactly one of \"feather\" (a feather spec), \"feathers\" (a "
+		                       "list of them) or \"guides\"",
+		                       file);
+	if (feathers != NULL)
+		return build_many(file, feathers, &mesh_def, options, scene, err);
 	plume_status status;
 	if (feather != NULL) {
-		status = load_feather(file, root, options, &scene->feather, err);
+		status = load_feather(file, feather, "$.feather", options, &scene->feather, err);
 		if (status == PLUME_OK)
 			status = plume_mesh_from_feather(scene->feather, &mesh_def, &scene->mesh, &scene->mesh_report, err);
 	} else {
@@ -413,6 +769,8 @@ static plume_status build_mesh(const char *file, const json_t *root, const plume
 	}
 	if (status != PLUME_OK && err != NULL && strncmp(err->message, file, strlen(file)) != 0)
 		plume_error_prefix(err, file);
+	if (status == PLUME_OK)
+		status = one_feather(file, scene, err);
 	return status;
 }
 
@@ -487,6 +845,8 @@ static plume_status scene_from_json(const char *path, json_t *root, const plume_
 	plume_spec_number(&reader, root, "$", "time_step", &scene->sim.time_step);
 	plume_spec_number(&reader, root, "$", "duration", &scene->duration);
 	plume_spec_int(&reader, root, "$", "frame_every", &scene->frame_every);
+	if (plume_spec_number(&reader, root, "$", "cycle_period", &scene->cycle_period) && !(scene->cycle_period > 0))
+		plume_spec_fail(&reader, "$.cycle_period", "is %g, allowed > 0 (seconds)", scene->cycle_period);
 	plume_spec_bool(&reader, root, "$", "quasi_static", &scene->quasi_static);
 	read_solver(&reader, root, &scene->sim);
 	read_dynamics(&reader, root, &scene->sim);

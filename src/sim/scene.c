@@ -12,7 +12,13 @@ void plume_scene_destroy(plume_scene *scene)
 {
 	if (scene == NULL)
 		return;
-	plume_feather_destroy(scene->feather);
+	if (scene->feathers != NULL) { // scene->feather is feathers[0]'s when there is one
+		for (int i = 0; i < scene->feather_count; ++i)
+			plume_feather_destroy(scene->feathers[i].feather);
+		plume_free(scene->feathers);
+	} else {
+		plume_feather_destroy(scene->feather);
+	}
 	plume_mesh_destroy(scene->mesh);
 	for (int h = 0; h < scene->handle_count; ++h)
 		plume_free(scene->handles[h].keyframes);
@@ -100,6 +106,7 @@ plume_status plume_scene_run(const plume_scene *scene, plume_scene_step_fn *on_s
 		status = plume_sim_set_group_load(sim, scene->forces[l].group, scene->forces[l].force, err);
 
 	summary->vertex_count = scene->mesh->vertex_count;
+	summary->feather_count = scene->feather_count;
 	summary->face_count = scene->mesh->face_count;
 	summary->constraint_count = plume_sim_constraint_count(sim);
 	if (status == PLUME_OK && on_step != NULL)
