@@ -16,6 +16,7 @@
 #include "plume/raytrace.h"
 #include "plume/render.h"
 #include "plume/scene.h"
+#include "plume/body.h"
 #include "plume/sim.h"
 
 #endif // PLUME_H
