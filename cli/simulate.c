@@ -23,7 +23,10 @@ void cli_help_simulate(void)
 	     "                        in DIR/feather.bin, docs/feather-json.md)\n"
 	     "  DIR/feathers/NAME.json  instead, for a scene that lists \"feathers\": each\n"
 	     "                        feather placed at rest (world coordinates, like mesh.obj)\n"
-	     "  DIR/frames/NNNN.obj   the shell at every written step (0000: the start)\n"
+	     "  DIR/frames/NNNN.obj   the shell at every written step (0000: the start); every\n"
+	     "                        feather of the scene in one mesh\n"
+	     "  DIR/body.obj, DIR/frames/body-NNNN.obj  the scene's body at rest and at every\n"
+	     "                        written step, when it has one\n"
 	     "  DIR/sim.glb           all frames as one animated glTF 2.0 file (morph\n"
 	     "                        targets, animation \"simulation\"; Blender, three.js)\n"
 	     "  DIR/sim.usda          the same as USD text: time-sampled points\n"
@@ -124,8 +127,27 @@ typedef struct run_state {
 	double max_out_of_plane;
 	double max_kinetic;
 	double max_elastic;
-	double *max_reaction; ///< per handle: the largest |reaction|, N
+	double *max_reaction;       ///< per handle: the largest |reaction|, N
+	plume_vec3 *body_positions; ///< the scene's body posed at a frame's time
 } run_state;
+
+/// The body at the given positions as Wavefront OBJ (object "body", metres), for renders.
+static plume_status write_body_obj(const plume_body *body, const plume_vec3 *positions, const char *path,
+                                   plume_error *err)
+{
+	FILE *file = fopen(path, "wb");
+	if (file == NULL)
+		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write", path);
+	fputs("o body\n", file);
+	for (int v = 0; v < plume_body_vertex_count(body); ++v)
+		fprintf(file, "v %.17g %.17g %.17g\n", positions[v].x, positions[v].y, positions[v].z);
+	const int *triangles = plume_body_triangles(body);
+	for (int f = 0; f < plume_body_triangle_count(body); ++f)
+		fprintf(file, "f %d %d %d\n", triangles[3 * f] + 1, triangles[3 * f + 1] + 1, triangles[3 * f + 2] + 1);
+	if (fclose(file) != 0)
+		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write", path);
+	return PLUME_OK;
+}
 
 // time: the scene's time of the step (plume_sim_time stays 0 in quasi-static scenes,
 // whose keyframed handles still move with it).
@@ -135,6 +157,12 @@ static plume_status write_frame(run_state *run, int frame, double time, const pl
 	snprintf(name, sizeof name, "frames/%04d.obj", frame);
 	cli_output_path(run->output, name, path, sizeof path);
 	plume_status status = plume_mesh_obj_writer_write(run->obj, plume_sim_positions(sim), path, err);
+	if (status == PLUME_OK && run->scene->body != NULL) {
+		snprintf(name, sizeof name, "frames/body-%04d.obj", frame);
+		plume_scene_body_pose(run->scene, time, run->body_positions);
+		status = write_body_obj(run->scene->body, run->body_positions,
+		                        cli_output_path(run->output, name, path, sizeof path), err);
+	}
 	if (status == PLUME_OK)
 		status = plume_mesh_animation_add_frame(run->animation, time, plume_sim_positions(sim), err);
 	if (status == PLUME_OK && run->fields) {
@@ -380,6 +408,13 @@ static plume_status simulate(const plume_scene *scene, cli_output *output, run_s
 		    plume_write_json_binary(scene->feather, cli_output_path(output, "feather.json", path, sizeof path), err);
 	else if (status == PLUME_OK)
 		status = write_feathers(scene, output, err);
+	if (status == PLUME_OK && scene->body != NULL) {
+		run->body_positions = malloc(sizeof(plume_vec3) * (size_t)plume_body_vertex_count(scene->body));
+		if (run->body_positions == NULL)
+			return plume_error_set(err, PLUME_ERROR_MEMORY, "simulate: out of memory");
+		status = write_body_obj(scene->body, plume_body_rest_positions(scene->body),
+		                        cli_output_path(output, "body.obj", path, sizeof path), err);
+	}
 	if (status != PLUME_OK)
 		return status;
 	snprintf(path, sizeof path, "%s/frames", output->stage);
@@ -615,6 +650,7 @@ int cli_simulate(int argc, char **argv)
 	plume_embedding_destroy(run.carried);
 	free(run.field_times);
 	free(run.max_reaction);
+	free(run.body_positions);
 	cli_barb_renderer_end(&run.renderer);
 	if (status != PLUME_OK)
 		return cli_fail(status == PLUME_ERROR_NUMERIC && failure.message[0] ? &failure : &err);

@@ -394,6 +394,69 @@ static void test_coat_entry(void **state)
 	assert_int_equal(plume_bytes_in_use(), 0);
 }
 
+/// A sphere of radius 5 cm turning about z (30 degrees in 0.1 s) with a bone "crest" at its top
+/// that nods about x (-20 degrees in 0.1 s); one feather rides on the crest, one on the body
+/// as a whole (on its bottom pole). Their calamus vertices must follow, at every step,
+/// Rz(theta) Rx(phi) (x - h) + h for the crest and Rz(theta) x for the body, computed here.
+#define BODY                                                                                                           \
+	"\"body\": {\"mesh\": {\"shape\": \"ellipsoid\", \"center\": [0, 0, 0], \"radii\": [0.05, 0.05, 0.05], "           \
+	"\"segments\": 16}, \"keyframes\": [{\"time\": 0}, {\"time\": 0.1, \"rotation_axis\": [0, 0, 1], "                 \
+	"\"rotation_deg\": 30}], \"bones\": [{\"name\": \"crest\", \"head\": [0, 0, 0.05], \"keyframes\": [{\"time\": "    \
+	"0}, "                                                                                                             \
+	"{\"time\": 0.1, \"rotation_axis\": [1, 0, 0], \"rotation_deg\": -20}]}]}"
+
+static plume_vec3 turn_z(plume_vec3 p, double angle)
+{
+	return plume_v3(cos(angle) * p.x - sin(angle) * p.y, sin(angle) * p.x + cos(angle) * p.y, p.z);
+}
+
+static plume_vec3 turn_x(plume_vec3 p, double angle)
+{
+	return plume_v3(p.x, cos(angle) * p.y - sin(angle) * p.z, sin(angle) * p.y + cos(angle) * p.z);
+}
+
+static void test_follicles_follow_the_body(void **state)
+{
+	(void)state;
+	plume_scene *scene = NULL;
+	trajectory path = run_text("{" BODY ", \"feathers\": [{\"feather\": " BLUE ", \"position\": [0, 0, 0.05], "
+	                           "\"follicle\": {\"bone\": \"crest\"}}, {\"feather\": " BLUE
+	                           ", \"position\": [0, 0, -0.05], \"rotation_axis\": [1, 0, 0], \"rotation_deg\": 180, "
+	                           "\"follicle\": {}}], \"mesh\": {\"edge_length\": 0.01}, \"gravity\": [0, 0, -9.81], "
+	                           "\"duration\": 0.121}",
+	                           &scene);
+	assert_non_null(scene->body);
+	assert_int_equal(scene->feathers[0].bone, 0);
+	assert_int_equal(scene->feathers[1].bone, -1); // the body as a whole
+	const plume_vertex_group *clamps[2] = {plume_mesh_find_group(scene->mesh, "f0/rachis_clamp"),
+	                                       plume_mesh_find_group(scene->mesh, "f1/rachis_clamp")};
+	const double degree = acos(-1.0) / 180, dt = scene->sim.time_step;
+	double worst = 0;
+	assert_int_equal(path.states, 12);
+	for (int s = 0; s < path.states; ++s) {
+		double t = s * dt, key = fmin(t / 0.1, 1.0); // linear keys, held after the last
+		const plume_vec3 *x = path.positions + (size_t)s * (size_t)path.vertex_count;
+		for (int f = 0; f < 2; ++f)
+			for (int i = 0; i < clamps[f]->count; ++i) {
+				int v = clamps[f]->vertices[i];
+				plume_vec3 rest = scene->mesh->rest[v], expected;
+				if (f == 0) {
+					plume_vec3 head = plume_v3(0, 0, 0.05);
+					expected = turn_z(plume_v3_add(turn_x(plume_v3_sub(rest, head), -20 * degree * key), head),
+					                  30 * degree * key);
+				} else {
+					expected = turn_z(rest, 30 * degree * key);
+				}
+				worst = fmax(worst, plume_v3_distance(x[v], expected));
+			}
+	}
+	printf("calamus vertices against the body's motion computed by hand: largest difference %.3g m\n", worst);
+	assert_true(worst < 1e-12);
+	free(path.positions);
+	plume_scene_destroy(scene);
+	assert_int_equal(plume_bytes_in_use(), 0);
+}
+
 static void expect_error(const char *text, plume_status status, const char *message)
 {
 	char dir[512], path[1024];
@@ -459,6 +522,20 @@ static void test_bad_scenes(void **state)
 	             PLUME_ERROR_SPEC, "$.handles[0].group: unknown vertex group \"f2/rachis_clamp\"");
 	expect_error("{\"feathers\": [{\"feather\": " BLUE ", \"follicle\": {\"bone\": \"wrist\"}}]}", PLUME_ERROR_SPEC,
 	             "$.feathers[0].follicle: the scene has no \"body\" to carry feather \"f0\"");
+	expect_error("{" BODY ", \"feathers\": [{\"feather\": " BLUE ", \"position\": [0, 0, 0.06], \"follicle\": {}}]}",
+	             PLUME_ERROR_SPEC,
+	             "$.feathers[0].follicle: feather \"f0\"'s follicle (0, 0, 0.06) is 0.01 m from the body's rest "
+	             "surface; allowed at most 0.001 m");
+	expect_error("{" BODY ", \"feathers\": [{\"feather\": " BLUE
+	             ", \"position\": [0, 0, 0.05], \"follicle\": {\"bone\": \"cret\"}}]}",
+	             PLUME_ERROR_SPEC,
+	             "$.feathers[0].follicle.bone: unknown bone \"cret\"; did you mean \"crest\"? (the body has: crest)");
+	expect_error("{" BODY ", \"feathers\": [{\"feather\": " BLUE
+	             ", \"position\": [0, 0, 0.05], \"follicle\": {}}], \"handles\": [{\"group\": \"rachis_clamp\"}]}",
+	             PLUME_ERROR_SPEC, "$.handles[0].group: \"rachis_clamp\" holds feather \"f0\"'s calamus");
+	expect_error("{\"body\": {\"mesh\": {\"shape\": \"ellipsoid\", \"radii\": [0.05, -1, 0.05]}}, \"feather\": " BLUE
+	             "}",
+	             PLUME_ERROR_SPEC, "$.body.mesh.radii");
 	expect_error("{\"feathers\": [{\"coat\": \"missing-coat.json\"}]}", PLUME_ERROR_IO, "$.feathers[0].coat");
 	expect_error("{" FEATHER ", \"cycle_period\": 0}", PLUME_ERROR_SPEC, "$.cycle_period: is 0, allowed > 0");
 }
@@ -499,6 +576,7 @@ int main(void)
 	    cmocka_unit_test(test_far_apart_feathers_do_not_interact),
 	    cmocka_unit_test(test_prefixed_group_handle),
 	    cmocka_unit_test(test_coat_entry),
+	    cmocka_unit_test(test_follicles_follow_the_body),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -13,6 +13,12 @@ extern "C" {
 #endif
 PLUME_API_BEGIN
 
+typedef struct plume_body plume_body; // plume/body.h
+
+/// A follicle may lie this far from the body's rest surface, m: feathers are attached at their
+/// calamus, on the skin (docs/scene.md "Bodies").
+#define PLUME_SCENE_FOLLICLE_TOLERANCE 1e-3
+
 /// One key of a handle's scripted motion: at `time` the handle's vertices are at
 /// rotation(axis, angle) (rest - pivot) + pivot + translation.
 typedef struct plume_keyframe {
@@ -94,6 +100,8 @@ typedef struct plume_scene {
 	/// At least 1.
 	int feather_count;
 	plume_scene_feather *feathers;
+	/// The body the feathers hang on ("body"), or NULL. Its pose at time t: plume_scene_body_pose.
+	plume_body *body;
 	plume_sim_def sim;
 	int handle_count;
 	plume_scene_handle *handles;
@@ -122,6 +130,11 @@ void plume_scene_destroy(plume_scene *scene);
 
 /// Where a handle is at time t: translation and rotation for plume_sim_set_handle.
 void plume_scene_handle_pose(const plume_scene_handle *handle, double t, plume_vec3 *translation, plume_mat3 *rotation);
+
+/// The body's vertex positions at time t (plume_body_pose) into out[plume_body_vertex_count];
+/// the scene must have a body. The run poses it at every step's time, where contact with
+/// the body takes its obstacle.
+void plume_scene_body_pose(const plume_scene *scene, double t, plume_vec3 *out);
 
 /// What a run measured.
 typedef struct plume_scene_summary {

@@ -7,21 +7,23 @@
 
 #include "../model/feather_internal.h"
 #include "core/alloc.h"
+#include "plume/body.h"
 #include "plume/coat.h"
 #include "plume/io.h"
 #include "plume/scene.h"
 #include "spec.h"
+#include "spec_body.h"
 #include "spec_mesh.h"
 #include "spec_models.h"
 
 static const char *const top_keys[] = {
-    "description", "feather",      "feathers", "guides",     "seed",    "mesh",         "materials",
-    "handles",     "forces",       "gravity",  "drag",       "bending", "time_step",    "duration",
-    "frame_every", "quasi_static", "solver",   "integrator", "air",     "cycle_period", NULL,
+    "description", "feather",    "feathers", "guides",       "seed",      "mesh",     "materials",   "handles",
+    "forces",      "gravity",    "drag",     "bending",      "time_step", "duration", "frame_every", "quasi_static",
+    "solver",      "integrator", "air",      "cycle_period", "body",      NULL,
 };
 static const char *const feather_entry_keys[] = {"name",          "feather",      "coat",     "mesh", "position",
                                                  "rotation_axis", "rotation_deg", "follicle", NULL};
-static const char *const follicle_keys[] = {"bone", NULL};
+static const char *const follicle_keys[] = {"bone", "nearest_bone", NULL};
 static const char *const material_keys[] = {
     "model",
     "E_vv",
@@ -320,6 +322,38 @@ static void read_handles(plume_spec_reader *reader, const json_t *root, plume_sc
 	}
 }
 
+/// A vertex may be in one handle: the scene's handles must leave alone the calamus of every
+/// feather its follicle moves with the body.
+static void check_follicle_handles(plume_spec_reader *reader, const plume_scene *scene)
+{
+	for (int i = 0; i < scene->feather_count && reader->status == PLUME_OK; ++i) {
+		if (!scene->feathers[i].follicle)
+			continue;
+		char name[64];
+		snprintf(name, sizeof name, "%s/rachis_clamp", scene->feathers[i].name);
+		const plume_vertex_group *clamp = plume_mesh_find_group(scene->mesh, name);
+		for (int h = 0; h < scene->handle_count && reader->status == PLUME_OK; ++h) {
+			const plume_vertex_group *group = plume_mesh_find_group(scene->mesh, scene->handles[h].group);
+			for (int a = 0; clamp != NULL && group != NULL && a < group->count; ++a) {
+				bool shared = false;
+				for (int b = 0; b < clamp->count && !shared; ++b)
+					shared = group->vertices[a] == clamp->vertices[b];
+				if (shared) {
+					char path[64];
+					snprintf(path, sizeof path, "$.handles[%d].group", h);
+					plume_spec_fail(reader, path,
+					                "\"%s\" holds feather \"%s\"'s calamus, which its follicle moves with the body; "
+					                "hold another group, or one feather's (\"f1/left_edge\")",
+					                scene->handles[h].source_group[0] ? scene->handles[h].source_group
+					                                                  : scene->handles[h].group,
+					                scene->feathers[i].name);
+					break;
+				}
+			}
+		}
+	}
+}
+
 static void read_forces(plume_spec_reader *reader, const json_t *root, plume_scene *scene)
 {
 	const json_t *array = plume_spec_array(reader, root, "$", "forces");
@@ -425,6 +459,7 @@ typedef struct pending_feather {
 	char name[16];
 	bool named;
 	bool follicle;
+	bool nearest_bone;
 	char bone[32];
 	char where[64]; ///< its JSON path, for messages ("$.feathers[2]", "$.feathers[2] (coat feather 5)")
 } pending_feather;
@@ -518,6 +553,9 @@ static void read_attachment(plume_spec_reader *reader, const json_t *object, con
 		const char *bone = NULL;
 		if (plume_spec_string(reader, follicle, follicle_path, "bone", &bone))
 			snprintf(item->bone, sizeof item->bone, "%s", bone);
+		plume_spec_bool(reader, follicle, follicle_path, "nearest_bone", &item->nearest_bone);
+		if (reader->status == PLUME_OK && bone != NULL && item->nearest_bone)
+			plume_spec_fail(reader, follicle_path, "names a bone and asks for the nearest one; give one of the two");
 		item->follicle = true;
 	}
 }
@@ -638,6 +676,55 @@ static plume_status name_feathers(const char *file, pending_list *list, plume_er
 	return PLUME_OK;
 }
 
+/// Ties a feather with a "follicle" to the body: its bone (named; the one the follicle rides on,
+/// for "nearest_bone"; else the body's motion as a whole), and the follicle within PLUME_SCENE_FOLLICLE_TOLERANCE of
+/// the rest surface.
+static plume_status attach_follicle(const char *file, const plume_scene *scene, const pending_feather *item,
+                                    plume_scene_feather *feather, plume_error *err)
+{
+	if (scene->body == NULL)
+		return plume_error_set(err, PLUME_ERROR_SPEC,
+		                       "%s: %s.follicle: the scene has no \"body\" to carry feather \"%s\"", file, item->where,
+		                       item->name);
+	const plume_body *body = scene->body;
+	if (item->bone[0] != '\0') {
+		feather->bone = plume_body_find_bone(body, item->bone);
+		if (feather->bone < 0) {
+			int count = plume_body_bone_count(body);
+			const char *names[PLUME_BODY_MAX_BONES + 1];
+			char list[512] = "";
+			for (int b = 0; b < count; ++b) {
+				names[b] = plume_body_bone_name(body, b);
+				size_t used = strlen(list);
+				snprintf(list + used, sizeof list - used, "%s%s", b > 0 ? ", " : "", names[b]);
+			}
+			names[count] = NULL;
+			if (count == 0)
+				return plume_error_set(err, PLUME_ERROR_SPEC,
+				                       "%s: %s.follicle.bone: unknown bone \"%s\": the body has no bones (leave "
+				                       "\"bone\" out to follow the body as a whole)",
+				                       file, item->where, item->bone);
+			return plume_error_set(err, PLUME_ERROR_SPEC,
+			                       "%s: %s.follicle.bone: unknown bone \"%s\"; did you mean \"%s\"? (the body has: %s)",
+			                       file, item->where, item->bone, plume_spec_nearest(item->bone, names), list);
+		}
+	} else if (item->nearest_bone) {
+		feather->bone = plume_body_nearest_bone(body, feather->follicle_point);
+	} else {
+		feather->bone = -1; // the body's motion as a whole
+	}
+	double distance = plume_body_rest_distance(body, feather->follicle_point, NULL);
+	if (!(distance <= PLUME_SCENE_FOLLICLE_TOLERANCE)) {
+		plume_vec3 p = feather->follicle_point;
+		return plume_error_set(
+		    err, PLUME_ERROR_SPEC,
+		    "%s: %s.follicle: feather \"%s\"'s follicle (%.6g, %.6g, %.6g) is %.3g m from the body's "
+		    "rest surface; allowed at most %g m (place the feather's calamus on the body)",
+		    file, item->where, item->name, p.x, p.y, p.z, distance, PLUME_SCENE_FOLLICLE_TOLERANCE);
+	}
+	return PLUME_OK;
+}
+
 /// "feathers": every feather meshed in its own frame, placed, and the meshes joined.
 static plume_status build_many(const char *file, const json_t *array, const plume_mesh_def *scene_mesh,
                                const plume_spec_options *options, plume_scene *scene, plume_error *err)
@@ -706,12 +793,9 @@ static plume_status build_many(const char *file, const json_t *array, const plum
 		}
 		plume_free(parts);
 	}
-	// Follicles are checked against the body once it is read (it needs the scene's body).
 	for (int i = 0; i < list.count && status == PLUME_OK; ++i)
 		if (list.items[i].follicle)
-			status = plume_error_set(err, PLUME_ERROR_SPEC,
-			                         "%s: %s.follicle: the scene has no \"body\" to carry feather \"%s\"", file,
-			                         list.items[i].where, list.items[i].name);
+			status = attach_follicle(file, scene, list.items + i, scene->feathers + i, err);
 	pending_free(&list);
 	return status;
 }
@@ -818,6 +902,31 @@ static void read_bending(plume_spec_reader *reader, const json_t *root, plume_si
 		def->bending_model = (plume_bending_model)model;
 }
 
+/// "body": an object (docs/scene.md "Bodies") or the path of a body file, relative to the scene.
+static plume_status read_body(const char *file, const json_t *root, plume_scene *scene, plume_error *err)
+{
+	const json_t *body = json_object_get(root, "body");
+	if (body == NULL)
+		return PLUME_OK;
+	char copy[4096];
+	snprintf(copy, sizeof copy, "%s", file);
+	const char *folder = dirname(copy);
+	if (json_is_object(body))
+		return plume_spec_body(file, body, "$.body", folder, &scene->body, err);
+	if (!json_is_string(body))
+		return plume_error_set(err, PLUME_ERROR_SPEC,
+		                       "%s: $.body: expected a body (an object) or the path of a body file", file);
+	char path[4096];
+	scene_relative(file, json_string_value(body), path, sizeof path);
+	plume_status status = plume_body_load(path, &scene->body, err);
+	if (status != PLUME_OK) {
+		char prefix[4200];
+		snprintf(prefix, sizeof prefix, "%s: $.body", file);
+		plume_error_prefix(err, prefix);
+	}
+	return status;
+}
+
 /// Reads the scene and releases root.
 static plume_status scene_from_json(const char *path, json_t *root, const plume_spec_options *options,
                                     plume_scene **out, plume_error *err)
@@ -869,9 +978,12 @@ static plume_status scene_from_json(const char *path, json_t *root, const plume_
 		status = reader.status;
 	}
 	if (status == PLUME_OK)
+		status = read_body(path, root, scene, err);
+	if (status == PLUME_OK)
 		status = build_mesh(path, root, &feather_options, scene, err);
 	if (status == PLUME_OK) {
 		read_handles(&reader, root, scene);
+		check_follicle_handles(&reader, scene);
 		read_forces(&reader, root, scene);
 		status = reader.status;
 	}
