@@ -565,7 +565,13 @@ int cli_simulate(int argc, char **argv)
 	plume_error err = {0}, failure = {0};
 	plume_scene *scene = NULL;
 	spec_options.max_memory = max_bytes; // the feather and its mesh too
+	// Many feathers take a while to generate and mesh: a progress line of its own.
+	cli_progress meshing;
+	cli_progress_begin(&meshing, "simulate: meshing feathers", 1);
+	spec_options.progress = cli_progress_callback;
+	spec_options.progress_user = &meshing;
 	plume_status status = plume_scene_load(argv[optind], &spec_options, &scene, &err);
+	cli_progress_end(&meshing);
 	if (status != PLUME_OK)
 		return cli_fail(&err);
 	if (duration > 0) {

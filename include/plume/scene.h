@@ -120,7 +120,8 @@ typedef struct plume_scene {
 } plume_scene;
 
 /// Reads a scene: generates its feather (seed from options or the feather spec)
-/// and meshes it. Errors name the file and the JSON path.
+/// and meshes it. Errors name the file and the JSON path. For a scene that lists
+/// "feathers", options->progress (when set) is called after each feather is meshed.
 plume_status plume_scene_load(const char *path, const plume_spec_options *options, plume_scene **out, plume_error *err);
 /// The same from JSON text; name stands for the file in messages, and relative paths
 /// in the text are relative to the current folder.

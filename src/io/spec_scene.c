@@ -730,7 +730,10 @@ static plume_status build_many(const char *file, const json_t *array, const plum
                                const plume_spec_options *options, plume_scene *scene, plume_error *err)
 {
 	pending_list list = {0};
-	plume_status status = read_feather_entries(file, array, scene_mesh, options, &list, err);
+	// options->progress counts the feathers meshed; a coat's own count would restart it.
+	plume_spec_options quiet = options != NULL ? *options : (plume_spec_options){0};
+	quiet.progress = NULL;
+	plume_status status = read_feather_entries(file, array, scene_mesh, &quiet, &list, err);
 	if (status == PLUME_OK)
 		status = name_feathers(file, &list, err);
 	for (int i = 0; i < list.count && status == PLUME_OK; ++i) {
@@ -743,6 +746,8 @@ static plume_status build_many(const char *file, const json_t *array, const plum
 			break;
 		}
 		move_feather(item->feather, item->rotation, item->translation);
+		if (options != NULL && options->progress != NULL)
+			options->progress(options->progress_user, i + 1, list.count);
 		plume_mesh_report report = item->report;
 		if (i == 0) {
 			scene->mesh_report = report;

@@ -71,6 +71,10 @@ worst = max(max(abs(x - y) for x, y in zip(turn(rest[i]), last[i])) for i in cla
 assert worst < 1e-12, worst
 ' "$out"
 check "stdout reports the run" grep -q "5 steps" "$scratch/out.txt"
+# On a terminal (script(1)): the feathers meshed, then the steps with the feather count.
+script -qec "'$plume' simulate '$scratch/three.json' -o '$scratch/tty' --duration 0.022 >/dev/null" /dev/null >"$scratch/tty.txt"
+check "progress of the meshing" grep -aq 'plume simulate: meshing feathers: 3/3 (100%)' "$scratch/tty.txt"
+check "progress of the steps" grep -aq 'plume simulate: 2/2 (100%), [0-9]* s elapsed, t = 0.022 s, 3 feathers' "$scratch/tty.txt"
 
 # The example runs as it is.
 "$plume" simulate "$source_dir/examples/scenes/two-feathers.json" -o "$scratch/two" >/dev/null 2>"$scratch/err.txt"
