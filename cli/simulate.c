@@ -53,8 +53,9 @@ void cli_help_simulate(void)
 	     "      --view AZ,EL    PNG camera azimuth about +y and elevation, degrees\n"
 	     "                      (default 34,20; 0,0 looks at the vane face on)\n"
 	     "      --render        ray-trace every frame at barb level (the feather's barbs\n"
-	     "                      carried by the shell) to frames/NNNN-rt.png, and make\n"
-	     "                      DIR/movie.mp4 when ffmpeg is installed\n"
+	     "                      carried by the shell; every feather, and the body) to\n"
+	     "                      frames/NNNN-rt.png, and make DIR/movie.mp4 when ffmpeg\n"
+	     "                      is installed\n"
 	     "      --spp N         samples per pixel of --render (default 4)\n"
 	     "      --glb-feather   sim.glb also carries the feather's barbs (line segments\n"
 	     "                      moved by the shell, one morph target per frame; large:\n"
@@ -129,7 +130,84 @@ typedef struct run_state {
 	double max_elastic;
 	double *max_reaction;       ///< per handle: the largest |reaction|, N
 	plume_vec3 *body_positions; ///< the scene's body posed at a frame's time
+	/// --render of a scene that lists "feathers" or has a body: each feather's barbs embedded
+	/// in the joined shell (NULL for guides), the body drawn as a shell.
+	plume_barb_embedding **embeddings;
+	int embedding_count;
+	plume_mesh *body_shell;
 } run_state;
+
+/// Sets up --render for many feathers and a body: the camera as cli_barb_renderer_begin
+/// frames it, one embedding per feather in the joined rest shell (each feather's barbs lie
+/// on its own piece of it), and the body as a plain shell.
+static plume_status many_renderer_begin(run_state *run, plume_vec3 lo, plume_vec3 hi, int spp, plume_error *err)
+{
+	const plume_scene *scene = run->scene;
+	run->renderer.embedding = NULL;
+	run->renderer.def = plume_raytrace_default_def();
+	run->renderer.def.camera.width = run->view.width;
+	run->renderer.def.camera.height = run->view.height;
+	run->renderer.def.spp = spp;
+	run->renderer.def.camera = plume_camera_frame_bounds(&run->renderer.def.camera, lo, hi);
+	run->embeddings = calloc((size_t)scene->feather_count, sizeof *run->embeddings);
+	if (run->embeddings == NULL)
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "simulate: out of memory");
+	run->embedding_count = scene->feather_count;
+	for (int i = 0; i < scene->feather_count; ++i) {
+		if (scene->feathers[i].feather == NULL)
+			continue;
+		plume_status status = plume_embedding_create(scene->feathers[i].feather, scene->mesh, &run->embeddings[i], err);
+		if (status != PLUME_OK)
+			return status;
+	}
+	if (scene->body != NULL) {
+		const plume_body *body = scene->body;
+		run->body_shell = plume_mesh_create(plume_body_vertex_count(body), plume_body_triangle_count(body));
+		if (run->body_shell == NULL)
+			return plume_error_set(err, PLUME_ERROR_MEMORY, "simulate: out of memory");
+		memcpy(run->body_shell->rest, plume_body_rest_positions(body),
+		       sizeof(plume_vec3) * (size_t)plume_body_vertex_count(body));
+		memcpy(run->body_shell->faces, plume_body_triangles(body),
+		       sizeof(int) * 3 * (size_t)plume_body_triangle_count(body));
+	}
+	return PLUME_OK;
+}
+
+static void many_renderer_end(run_state *run)
+{
+	for (int i = 0; i < run->embedding_count; ++i)
+		plume_embedding_destroy(run->embeddings[i]);
+	free(run->embeddings);
+	run->embeddings = NULL;
+	plume_mesh_destroy(run->body_shell);
+	run->body_shell = NULL;
+}
+
+/// Every feather carried by the shell at positions, and the body posed at time, to path (PNG).
+static plume_status many_renderer_frame(run_state *run, const plume_vec3 *positions, double time, const char *path,
+                                        plume_error *err)
+{
+	const plume_scene *scene = run->scene;
+	plume_feather **moved = calloc((size_t)scene->feather_count, sizeof *moved);
+	if (moved == NULL)
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "simulate: out of memory");
+	plume_status status = PLUME_OK;
+	int count = 0;
+	for (int i = 0; i < scene->feather_count && status == PLUME_OK; ++i)
+		if (run->embeddings[i] != NULL)
+			status = plume_embedding_apply(run->embeddings[i], positions, &moved[count++], err);
+	if (status == PLUME_OK) {
+		if (scene->body != NULL)
+			plume_scene_body_pose(scene, time, run->body_positions);
+		plume_raytrace_scene picture = {count, (const plume_feather *const *)moved, run->body_shell,
+		                                scene->body != NULL ? run->body_positions : NULL};
+		status = plume_raytrace_render_png(&picture, &run->renderer.def, path, NULL, err);
+	}
+	for (int i = 0; i < count; ++i)
+		plume_feather_destroy(moved[i]);
+	free(moved);
+	return status;
+}
 
 /// The body at the given positions as Wavefront OBJ (object "body", metres), for renders.
 static plume_status write_body_obj(const plume_body *body, const plume_vec3 *positions, const char *path,
@@ -185,7 +263,8 @@ static plume_status write_frame(run_state *run, int frame, double time, const pl
 	if (status == PLUME_OK && run->render) {
 		snprintf(name, sizeof name, "frames/%04d-rt.png", frame);
 		cli_output_path(run->output, name, path, sizeof path);
-		status = cli_barb_renderer_frame(&run->renderer, plume_sim_positions(sim), path, err);
+		status = run->embeddings != NULL ? many_renderer_frame(run, plume_sim_positions(sim), time, path, err)
+		                                 : cli_barb_renderer_frame(&run->renderer, plume_sim_positions(sim), path, err);
 	}
 	run->frames = frame + 1;
 	return status;
@@ -619,15 +698,26 @@ int cli_simulate(int argc, char **argv)
 		    "--glb-feather needs a scene with one generated feather (\"feather\", not guides or \"feathers\")");
 	}
 	if (run.render) {
-		if (scene->feather == NULL) {
+		bool many = scene->feather_count > 1 || scene->feather == NULL || scene->body != NULL;
+		bool generated = false;
+		for (int i = 0; i < scene->feather_count; ++i)
+			generated = generated || scene->feathers[i].feather != NULL;
+		if (!generated) {
 			plume_scene_destroy(scene);
-			return cli_usage_error(
-			    "simulate",
-			    "--render needs a scene with one generated feather (\"feather\", not guides or \"feathers\")");
+			return cli_usage_error("simulate", "--render needs a scene whose feathers are generated (not guides)");
 		}
-		status = cli_barb_renderer_begin(&run.renderer, scene->feather, scene->mesh, lo, hi, run.view.width,
-		                                 run.view.height, spp, &err);
+		if (scene->body != NULL) // the camera sees the body too
+			for (int v = 0; v < plume_body_vertex_count(scene->body); ++v) {
+				plume_vec3 p = plume_body_rest_positions(scene->body)[v];
+				lo = plume_v3(fmin(lo.x, p.x), fmin(lo.y, p.y), fmin(lo.z, p.z));
+				hi = plume_v3(fmax(hi.x, p.x), fmax(hi.y, p.y), fmax(hi.z, p.z));
+			}
+		run.scene = scene;
+		status = many ? many_renderer_begin(&run, lo, hi, spp, &err)
+		              : cli_barb_renderer_begin(&run.renderer, scene->feather, scene->mesh, lo, hi, run.view.width,
+		                                        run.view.height, spp, &err);
 		if (status != PLUME_OK) {
+			many_renderer_end(&run);
 			plume_scene_destroy(scene);
 			cli_barb_renderer_end(&run.renderer);
 			return cli_fail(&err);
@@ -658,6 +748,7 @@ int cli_simulate(int argc, char **argv)
 	free(run.max_reaction);
 	free(run.body_positions);
 	cli_barb_renderer_end(&run.renderer);
+	many_renderer_end(&run);
 	if (status != PLUME_OK)
 		return cli_fail(status == PLUME_ERROR_NUMERIC && failure.message[0] ? &failure : &err);
 	return CLI_EXIT_OK;

@@ -76,6 +76,11 @@ script -qec "'$plume' simulate '$scratch/three.json' -o '$scratch/tty' --duratio
 check "progress of the meshing" grep -aq 'plume simulate: meshing feathers: 3/3 (100%)' "$scratch/tty.txt"
 check "progress of the steps" grep -aq 'plume simulate: 2/2 (100%), [0-9]* s elapsed, t = 0.022 s, 3 feathers' "$scratch/tty.txt"
 
+# --render draws every feather at barb level and the body.
+"$plume" simulate "$scratch/three.json" -o "$scratch/render" --duration 0.011 --render --size 64x64 --spp 1 >/dev/null 2>"$scratch/err.txt"
+succeeded "--render with three feathers and a body"
+check "ray-traced frames" test -s "$scratch/render/frames/0001-rt.png"
+
 # The example runs as it is.
 "$plume" simulate "$source_dir/examples/scenes/two-feathers.json" -o "$scratch/two" >/dev/null 2>"$scratch/err.txt"
 succeeded "examples/scenes/two-feathers.json runs"
