@@ -349,9 +349,12 @@ void cli_scene_bounds(const plume_scene *scene, plume_vec3 *lo, plume_vec3 *hi)
 
 /// The group whose rigid motion carries the rest vane's plane for vane_max_out_of_plane: the
 /// rachis clamp (the first two rows of rachis vertices at the calamus) when the mesh has it,
-/// else the first handle's group (docs/simulation.md).
+/// else the first handle's group (docs/simulation.md). Many feathers have no one vane plane:
+/// a group the mesh lacks leaves the measure undefined (NaN, null in summary.json).
 static const char *vane_base_group(const plume_scene *scene)
 {
+	if (scene->feather_count > 1)
+		return "";
 	if (plume_mesh_find_group(scene->mesh, "rachis_clamp") != NULL || scene->handle_count == 0)
 		return "rachis_clamp";
 	return scene->handles[0].group;
@@ -671,7 +674,9 @@ int cli_simulate(int argc, char **argv)
 	// The frames' bytes before the run: an OBJ line is at most about 80 bytes
 	// (three %.17g coordinates), a PNG at most its raw pixels.
 	double frame_count = (double)run.total_steps / scene->frame_every + 2.0;
-	double frame_bytes = 80.0 * (scene->mesh->vertex_count + scene->mesh->face_count) +
+	double body_elements =
+	    scene->body != NULL ? plume_body_vertex_count(scene->body) + plume_body_triangle_count(scene->body) : 0;
+	double frame_bytes = 80.0 * (scene->mesh->vertex_count + scene->mesh->face_count + body_elements) +
 	                     ((run.png ? 1 : 0) + (run.render ? 1 : 0)) * 4.0 * run.view.width * run.view.height;
 	if (frame_count * frame_bytes > (double)max_bytes) {
 		fprintf(stderr,

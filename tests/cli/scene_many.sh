@@ -47,6 +47,7 @@ assert names == ["top", "bottom", "f2"], names
 assert s["vertex_count"] == sum(f["vertex_count"] for f in s["feathers"]) == s["vertices"], s
 assert s["feathers"][1]["vertex_offset"] == s["feathers"][0]["vertex_count"], s
 assert s["newton_iterations"] >= 5 and s["wall_seconds"] > 0, s
+assert s["vane_max_out_of_plane"] is None and 0.99 < s["vane_min_principal_stretch"] <= 1 + 1e-9, s
 # 0.055 s simulated of a 0.2 s cycle: the wall time of a cycle is wall_seconds * 0.2 / 0.055.
 assert abs(s["seconds_per_cycle"] - s["wall_seconds"] * 0.2 / 0.055) <= 1e-6 * s["seconds_per_cycle"], s
 # Nothing measured them: contact and the intersection check leave no made-up numbers.
