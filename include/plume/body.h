@@ -114,8 +114,10 @@ typedef struct plume_body_mesh {
 plume_status plume_body_ellipsoid(plume_vec3 center, plume_vec3 radii, int segments, plume_body_mesh *out,
                                   plume_error *err);
 /// A capsule: the points within radius of the segment a–b, `segments` (>= 3) vertices
-/// around, max(1, segments / 4) bands of latitude on each hemispherical cap, every vertex
-/// on the surface; closed, counter-clockwise seen from outside. a != b.
+/// around, max(1, segments / 4) bands of latitude on each hemispherical cap and, along the
+/// cylinder, bands no longer than the edges around it (at most 4096), so that a capsule
+/// skinned to a chain of bones bends between rings; every vertex on the surface; closed,
+/// counter-clockwise seen from outside. a != b.
 plume_status plume_body_capsule(plume_vec3 a, plume_vec3 b, double radius, int segments, plume_body_mesh *out,
                                 plume_error *err);
 void plume_body_mesh_free(plume_body_mesh *mesh);

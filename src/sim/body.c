@@ -562,6 +562,7 @@ void plume_body_bone_transform(const plume_body *body, int bone, double t, plume
 {
 	PLUME_ASSERT_HANDLE(body);
 	PLUME_ASSERT(bone >= -1 && bone < body->bone_count);
+	PLUME_ASSERT(isfinite(t));
 	// The chain from the bone up to its root, then composed from the root down.
 	int chain[PLUME_BODY_MAX_BONES], depth = 0;
 	for (int b = bone; b >= 0; b = body->bones[b].parent)
@@ -578,7 +579,7 @@ void plume_body_bone_transform(const plume_body *body, int bone, double t, plume
 void plume_body_pose(const plume_body *body, double t, plume_vec3 *out)
 {
 	PLUME_ASSERT_HANDLE(body);
-	PLUME_ASSERT(out != NULL);
+	PLUME_ASSERT(out != NULL && isfinite(t));
 	if (body->bone_count == 0) {
 		rigid motion = body_motion(body, t);
 		for (int v = 0; v < body->vertex_count; ++v)
@@ -761,7 +762,17 @@ plume_status plume_body_capsule(plume_vec3 a, plume_vec3 b, double radius, int s
 	plume_vec3 u = plume_v3_normalize(plume_v3_cross(d, e));
 	plume_vec3 v = plume_v3_cross(d, u);
 	int cap = segments / 4 > 1 ? segments / 4 : 1;
-	double z[2 * 1024 + 2], rho[2 * 1024 + 2];
+	// Bands along the cylinder no longer than the edges around it (2 pi r / segments), so
+	// that a capsule skinned to a chain of bones bends between rings.
+	double along = ceil(length * segments / (2 * acos(-1.0) * radius));
+	int cylinder = along < 1 ? 1 : along > 4096 ? 4096 : (int)along;
+	double *z = plume_alloc(sizeof(double) * (size_t)(2 * cap + cylinder));
+	double *rho = plume_alloc(sizeof(double) * (size_t)(2 * cap + cylinder));
+	if (z == NULL || rho == NULL) {
+		plume_free(z);
+		plume_free(rho);
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory meshing a capsule");
+	}
 	const double half_pi = acos(-1.0) / 2;
 	int rings = 0;
 	for (int k = 1; k <= cap; ++k) { // the cap at a, up to its equator
@@ -769,10 +780,17 @@ plume_status plume_body_capsule(plume_vec3 a, plume_vec3 b, double radius, int s
 		z[rings] = k == cap ? 0 : -radius * cos(theta);
 		rho[rings++] = k == cap ? radius : radius * sin(theta);
 	}
+	for (int k = 1; k < cylinder; ++k) { // the cylinder's inner rings
+		z[rings] = length * k / cylinder;
+		rho[rings++] = radius;
+	}
 	for (int k = 0; k < cap; ++k) { // the cap at b, from its equator
 		double theta = half_pi * k / cap;
 		z[rings] = length + radius * sin(theta);
 		rho[rings++] = radius * cos(theta);
 	}
-	return lathe(a, u, v, d, -radius, length + radius, rings, z, rho, segments, out, err);
+	plume_status status = lathe(a, u, v, d, -radius, length + radius, rings, z, rho, segments, out, err);
+	plume_free(z);
+	plume_free(rho);
+	return status;
 }
