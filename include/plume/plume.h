@@ -6,6 +6,7 @@
 #include "plume/feather.h"
 #include "plume/io.h"
 #include "plume/gltf.h"
+#include "plume/intersect.h"
 #include "plume/lab.h"
 #include "plume/mesh.h"
 #include "plume/model.h"
