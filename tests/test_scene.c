@@ -457,6 +457,38 @@ static void test_follicles_follow_the_body(void **state)
 	assert_int_equal(plume_bytes_in_use(), 0);
 }
 
+/// Feathers that pass through each other at rest are refused with the pair and where
+/// (plume_find_intersections, exact); one 1 mm above the other is fine.
+static void test_rest_intersections(void **state)
+{
+	(void)state;
+	plume_scene *scene = load_text("{\"feathers\": [{\"feather\": " HAWK "}, {\"feather\": " HAWK
+	                               ", \"position\": [0, 0, 0.001]}], \"mesh\": {\"edge_length\": 0.01}}");
+	assert_int_equal(scene->feather_count, 2);
+	plume_scene_destroy(scene);
+	// The second one turned a quarter about its shaft (+y) and lifted 5 cm along it: the two
+	// vanes cross along the shaft line x = z = 0, from y = 5 cm up.
+	char dir[512], path[1024];
+	test_make_temp_dir(dir, sizeof dir);
+	snprintf(path, sizeof path, "%s/scene.json", dir);
+	test_write_file(path, "{\"feathers\": [{\"feather\": " HAWK "}, {\"feather\": " HAWK
+	                      ", \"name\": \"crossed\", \"position\": [0, 0.05, 0], \"rotation_axis\": [0, 1, 0], "
+	                      "\"rotation_deg\": 90}], \"mesh\": {\"edge_length\": 0.01}}");
+	plume_error err = {0};
+	assert_int_equal(plume_scene_load(path, NULL, &scene, &err), PLUME_ERROR_SPEC);
+	assert_null(scene);
+	printf("%s\n", err.message);
+	assert_non_null(strstr(err.message, "$.feathers: feathers \"f0\" and \"crossed\" intersect at rest: face "));
+	double x, y, z;
+	const char *near = strstr(err.message, "near (");
+	assert_non_null(near);
+	assert_int_equal(sscanf(near, "near (%lf, %lf, %lf)", &x, &y, &z), 3);
+	// The midpoint of two crossing faces' centroids: within an edge length of the crossing line.
+	assert_true(fabs(x) < 0.01 && fabs(z) < 0.01 && y > 0.04);
+	test_remove_tree(dir);
+	assert_int_equal(plume_bytes_in_use(), 0);
+}
+
 static void expect_error(const char *text, plume_status status, const char *message)
 {
 	char dir[512], path[1024];
@@ -518,7 +550,7 @@ static void test_bad_scenes(void **state)
 	expect_error("{\"feathers\": [{\"feather\": " BLUE ", \"rotation_deg\": 10, \"rotation_axis\": [0, 0, 0]}]}",
 	             PLUME_ERROR_SPEC, "$.feathers[0].rotation_axis: is the zero vector");
 	expect_error("{\"feathers\": [{\"feather\": " BLUE "}, {\"feather\": " BLUE
-	             "}], \"handles\": [{\"group\": \"f2/rachis_clamp\"}]}",
+	             ", \"position\": [0.1, 0, 0]}], \"handles\": [{\"group\": \"f2/rachis_clamp\"}]}",
 	             PLUME_ERROR_SPEC, "$.handles[0].group: unknown vertex group \"f2/rachis_clamp\"");
 	expect_error("{\"feathers\": [{\"feather\": " BLUE ", \"follicle\": {\"bone\": \"wrist\"}}]}", PLUME_ERROR_SPEC,
 	             "$.feathers[0].follicle: the scene has no \"body\" to carry feather \"f0\"");
@@ -577,6 +609,7 @@ int main(void)
 	    cmocka_unit_test(test_prefixed_group_handle),
 	    cmocka_unit_test(test_coat_entry),
 	    cmocka_unit_test(test_follicles_follow_the_body),
+	    cmocka_unit_test(test_rest_intersections),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

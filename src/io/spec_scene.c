@@ -9,6 +9,7 @@
 #include "core/alloc.h"
 #include "plume/body.h"
 #include "plume/coat.h"
+#include "plume/intersect.h"
 #include "plume/io.h"
 #include "plume/scene.h"
 #include "spec.h"
@@ -456,12 +457,18 @@ typedef struct pending_feather {
 	plume_mat3 rotation;
 	plume_vec3 translation;
 	plume_mesh_report report;
+	/// The entry's "feather" value: entries with equal values (the same spec file or the same
+	/// inline spec) get copies of one generated feather, and of one mesh (`shared_mesh`, owned
+	/// by the first) when their mesh settings are equal too. Generating and meshing are
+	/// deterministic, so this only saves the time (a wing of one spec).
+	const json_t *source;
+	bool shared_mesh;
 	char name[16];
 	bool named;
 	bool follicle;
 	bool nearest_bone;
 	char bone[32];
-	char where[64]; ///< its JSON path, for messages ("$.feathers[2]", "$.feathers[2] (coat feather 5)")
+	char where[48]; ///< its entry's JSON path, for messages ("$.feathers[2]"; a coat's feathers share it)
 } pending_feather;
 
 typedef struct pending_list {
@@ -488,7 +495,8 @@ static void pending_free(pending_list *list)
 {
 	for (int i = 0; i < list->count; ++i) {
 		plume_feather_destroy(list->items[i].feather);
-		plume_mesh_destroy(list->items[i].mesh);
+		if (!list->items[i].shared_mesh)
+			plume_mesh_destroy(list->items[i].mesh);
 	}
 	plume_free(list->items);
 }
@@ -593,7 +601,6 @@ static plume_status expand_coat(const char *file, const char *name, const char *
 		move_feather(feather, inverse, plume_v3_scale(plume_m3_apply(inverse, origin), -1));
 		item->rotation = plume_m3_mul(entry->rotation, rotation);
 		item->translation = plume_v3_add(plume_m3_apply(entry->rotation, origin), entry->translation);
-		snprintf(item->where, sizeof item->where, "%.24s (coat feather %d)", where, k);
 		if (entry->named) {
 			char composed[64];
 			snprintf(composed, sizeof composed, "%s-%d", entry->name, k);
@@ -652,12 +659,31 @@ static plume_status read_feather_entries(const char *file, const json_t *array, 
 			if (item == NULL)
 				return plume_error_set(err, PLUME_ERROR_MEMORY, "%s: %s: out of memory", file, path);
 			*item = entry;
-			status = load_feather(file, feather, where, options, &item->feather, err);
+			item->source = feather;
+			const pending_feather *same = NULL;
+			for (int k = 0; k + 1 < list->count && same == NULL; ++k)
+				if (list->items[k].source != NULL && json_equal(list->items[k].source, feather))
+					same = list->items + k;
+			if (same != NULL) {
+				item->feather = plume_feather_clone(same->feather);
+				status = item->feather != NULL
+				             ? PLUME_OK
+				             : plume_error_set(err, PLUME_ERROR_MEMORY, "%s: %s: out of memory", file, path);
+			} else {
+				status = load_feather(file, feather, where, options, &item->feather, err);
+			}
 		}
 		if (status != PLUME_OK)
 			return status;
 	}
 	return PLUME_OK;
+}
+
+static bool same_mesh_def(const plume_mesh_def *a, const plume_mesh_def *b)
+{
+	return a->edge_length == b->edge_length && a->rachis_width_base == b->rachis_width_base &&
+	       a->rachis_width_tip == b->rachis_width_tip && a->include_calamus == b->include_calamus &&
+	       a->max_memory == b->max_memory;
 }
 
 /// Default names, then no two alike.
@@ -725,6 +751,80 @@ static plume_status attach_follicle(const char *file, const plume_scene *scene, 
 	return PLUME_OK;
 }
 
+/// The feather a face of the joined mesh belongs to (feathers' faces are consecutive).
+static int feather_of_face(const plume_scene *scene, int face)
+{
+	int lo = 0, hi = scene->feather_count - 1;
+	while (lo < hi) {
+		int mid = (lo + hi + 1) / 2;
+		if (scene->feathers[mid].face_offset <= face)
+			lo = mid;
+		else
+			hi = mid - 1;
+	}
+	return lo;
+}
+
+static plume_vec3 face_centroid(const plume_mesh *mesh, int face)
+{
+	const int *v = mesh->faces + 3 * face;
+	plume_vec3 sum = plume_v3_add(plume_v3_add(mesh->rest[v[0]], mesh->rest[v[1]]), mesh->rest[v[2]]);
+	return plume_v3_scale(sum, 1.0 / 3.0);
+}
+
+/// Feathers that intersect each other at rest (exactly, plume_find_intersections) are an error
+/// naming the first pair of feathers, their faces and where: a simulation cannot start from
+/// surfaces that already pass through each other. A feather's own faces are the mesher's.
+static plume_status check_rest_intersections(const char *file, const plume_scene *scene, plume_error *err)
+{
+	if (scene->feather_count < 2)
+		return PLUME_OK;
+	const plume_mesh *mesh = scene->mesh;
+	int count = 0, capacity = 1024;
+	int *pairs = NULL;
+	plume_status status = PLUME_OK;
+	for (int attempt = 0; attempt < 2; ++attempt) {
+		plume_free(pairs);
+		pairs = plume_alloc(sizeof(int) * 2 * (size_t)capacity);
+		if (pairs == NULL)
+			return plume_error_set(err, PLUME_ERROR_MEMORY, "%s: out of memory checking the feathers at rest", file);
+		status = plume_find_intersections(mesh->rest, mesh->vertex_count, mesh->faces, mesh->face_count, capacity,
+		                                  pairs, &count, err);
+		if (status != PLUME_OK || count <= capacity)
+			break;
+		capacity = count; // every pair, so that no pair between two feathers is left out
+	}
+	if (status != PLUME_OK) {
+		plume_free(pairs);
+		char prefix[4200];
+		snprintf(prefix, sizeof prefix, "%s: $.feathers: checking the feathers at rest", file);
+		plume_error_prefix(err, prefix);
+		return status;
+	}
+	int first = -1, between = 0;
+	for (int k = 0; k < count && k < capacity; ++k)
+		if (feather_of_face(scene, pairs[2 * k]) != feather_of_face(scene, pairs[2 * k + 1])) {
+			between++;
+			if (first < 0)
+				first = k;
+		}
+	if (first >= 0) {
+		int a = pairs[2 * first], b = pairs[2 * first + 1];
+		const plume_scene_feather *fa = scene->feathers + feather_of_face(scene, a);
+		const plume_scene_feather *fb = scene->feathers + feather_of_face(scene, b);
+		plume_vec3 at = plume_v3_scale(plume_v3_add(face_centroid(mesh, a), face_centroid(mesh, b)), 0.5);
+		status =
+		    plume_error_set(err, PLUME_ERROR_SPEC,
+		                    "%s: $.feathers: feathers \"%s\" and \"%s\" intersect at rest: face %d of \"%s\" meets "
+		                    "face %d of \"%s\" near (%.6g, %.6g, %.6g) m (%d pairs of faces between feathers in "
+		                    "all); place them apart",
+		                    file, fa->name, fb->name, a - fa->face_offset, fa->name, b - fb->face_offset, fb->name,
+		                    at.x, at.y, at.z, between);
+	}
+	plume_free(pairs);
+	return status;
+}
+
 /// "feathers": every feather meshed in its own frame, placed, and the meshes joined.
 static plume_status build_many(const char *file, const json_t *array, const plume_mesh_def *scene_mesh,
                                const plume_spec_options *options, plume_scene *scene, plume_error *err)
@@ -738,7 +838,19 @@ static plume_status build_many(const char *file, const json_t *array, const plum
 		status = name_feathers(file, &list, err);
 	for (int i = 0; i < list.count && status == PLUME_OK; ++i) {
 		pending_feather *item = list.items + i;
-		status = plume_mesh_from_feather(item->feather, &item->mesh_def, &item->mesh, &item->report, err);
+		const pending_feather *same = NULL;
+		for (int k = 0; k < i && same == NULL && item->source != NULL; ++k)
+			if (list.items[k].source != NULL && !list.items[k].shared_mesh &&
+			    json_equal(list.items[k].source, item->source) &&
+			    same_mesh_def(&list.items[k].mesh_def, &item->mesh_def))
+				same = list.items + k;
+		if (same != NULL) {
+			item->mesh = same->mesh;
+			item->report = same->report;
+			item->shared_mesh = true;
+		} else {
+			status = plume_mesh_from_feather(item->feather, &item->mesh_def, &item->mesh, &item->report, err);
+		}
 		if (status != PLUME_OK) {
 			char prefix[4200];
 			snprintf(prefix, sizeof prefix, "%s: %s (feather \"%s\"): meshing", file, item->where, item->name);
@@ -798,6 +910,8 @@ static plume_status build_many(const char *file, const json_t *array, const plum
 		}
 		plume_free(parts);
 	}
+	if (status == PLUME_OK)
+		status = check_rest_intersections(file, scene, err);
 	for (int i = 0; i < list.count && status == PLUME_OK; ++i)
 		if (list.items[i].follicle)
 			status = attach_follicle(file, scene, list.items + i, scene->feathers + i, err);

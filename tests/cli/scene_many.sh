@@ -112,7 +112,9 @@ bad "unknown bone" '$.feathers[0].follicle.bone: unknown bone "nek"; did you mea
 bad "follicle without a body" '$.feathers[0].follicle: the scene has no "body"' \
 	"{\"feathers\": [{\"feather\": \"$blue\", \"follicle\": {}}]}"
 bad "unknown feather group" '$.handles[0].group: unknown vertex group "f3/rachis_clamp"' \
-	"{\"feathers\": [{\"feather\": \"$blue\"}, {\"feather\": \"$blue\"}], \"handles\": [{\"group\": \"f3/rachis_clamp\"}]}"
+	"{\"feathers\": [{\"feather\": \"$blue\"}, {\"feather\": \"$blue\", \"position\": [0.1, 0, 0]}], \"handles\": [{\"group\": \"f3/rachis_clamp\"}]}"
+bad "feathers through each other at rest" '$.feathers: feathers "f0" and "f1" intersect at rest: face ' \
+	"{\"feathers\": [{\"feather\": \"$blue\"}, {\"feather\": \"$blue\", \"position\": [0, 0.01, 0], \"rotation_axis\": [0, 1, 0], \"rotation_deg\": 90}]}"
 bad "feather and feathers" 'a scene needs exactly one of "feather" (a feather spec), "feathers"' \
 	"{\"feather\": \"$blue\", \"feathers\": [{\"feather\": \"$blue\"}]}"
 bad "bad body mesh" '$.body.mesh.radii' \
