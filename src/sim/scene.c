@@ -173,8 +173,8 @@ plume_status plume_scene_run(const plume_scene *scene, plume_scene_step_fn *on_s
 		double t = n * dt;
 		pose_handles(scene, sim, ids, t);
 		// The body where it is at the end of the step: with contact, the obstacle's positions
-		// for this step (plume_sim_set_obstacle_positions, after plume_sim_add_obstacle of the
-		// rest pose at creation).
+		// for this step (plume_sim_set_obstacle_positions; plume_sim_add_obstacle takes the
+		// pose at t = 0 when the simulation is created).
 		if (body_positions != NULL)
 			plume_scene_body_pose(scene, t, body_positions);
 		plume_solve_report report;

@@ -82,6 +82,20 @@ check "progress of the steps" grep -aq 'plume simulate: 2/2 (100%), [0-9]* s ela
 succeeded "--render with three feathers and a body"
 check "ray-traced frames" test -s "$scratch/render/frames/0001-rt.png"
 
+# An entry may be a feather dump (plume generate --format json), beside the spec it came from:
+# the same feather, so the same mesh (placed 10 cm apart, as feathers at rest must be).
+"$plume" generate "$blue" -o "$scratch/dump" --format json >/dev/null 2>&1
+printf '{"feathers": [{"feather": "%s/dump/feather.json"}, {"feather": "%s", "position": [0.1, 0, 0]}], "duration": 0.011}\n' \
+	"$scratch" "$blue" >"$scratch/dump.json"
+"$plume" simulate "$scratch/dump.json" -o "$scratch/dump-out" >/dev/null 2>"$scratch/err.txt"
+succeeded "a feather dump as an entry"
+check "the dump meshes as its spec" /usr/bin/python3 -c '
+import json, sys
+s = json.load(open(sys.argv[1]))
+a, b = s["feathers"]
+assert a["vertex_count"] == b["vertex_count"] and a["face_count"] == b["face_count"], s["feathers"]
+' "$scratch/dump-out/summary.json"
+
 # The example runs as it is.
 "$plume" simulate "$source_dir/examples/scenes/two-feathers.json" -o "$scratch/two" >/dev/null 2>"$scratch/err.txt"
 succeeded "examples/scenes/two-feathers.json runs"
