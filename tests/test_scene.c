@@ -568,6 +568,14 @@ static void test_bad_scenes(void **state)
 	expect_error("{\"body\": {\"mesh\": {\"shape\": \"ellipsoid\", \"radii\": [0.05, -1, 0.05]}}, \"feather\": " BLUE
 	             "}",
 	             PLUME_ERROR_SPEC, "$.body.mesh.radii");
+	// Into the body: turned to point its shaft down (-z) from the top pole, through the sphere.
+	expect_error("{" BODY ", \"feathers\": [{\"feather\": " BLUE
+	             ", \"position\": [0, 0, 0.05], \"rotation_axis\": [1, 0, 0], \"rotation_deg\": -90, \"follicle\": "
+	             "{}}]}",
+	             PLUME_ERROR_SPEC, "$.feathers: feather \"f0\" passes through the body at rest: its face ");
+	// Touching counts: a feather on the body that the body does not carry touches it at its calamus.
+	expect_error("{" BODY ", \"feathers\": [{\"feather\": " BLUE ", \"position\": [0, 0, 0.05]}]}", PLUME_ERROR_SPEC,
+	             "$.feathers: feather \"f0\" passes through the body at rest");
 	expect_error("{\"feathers\": [{\"coat\": \"missing-coat.json\"}]}", PLUME_ERROR_IO, "$.feathers[0].coat");
 	expect_error("{" FEATHER ", \"cycle_period\": 0}", PLUME_ERROR_SPEC, "$.cycle_period: is 0, allowed > 0");
 }

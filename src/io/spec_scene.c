@@ -772,56 +772,117 @@ static plume_vec3 face_centroid(const plume_mesh *mesh, int face)
 	return plume_v3_scale(sum, 1.0 / 3.0);
 }
 
-/// Feathers that intersect each other at rest (exactly, plume_find_intersections) are an error
-/// naming the first pair of feathers, their faces and where: a simulation cannot start from
-/// surfaces that already pass through each other. A feather's own faces are the mesher's.
-static plume_status check_rest_intersections(const char *file, const plume_scene *scene, plume_error *err)
+/// Whether face f of the joined mesh has a vertex in the calamus of a feather the body carries:
+/// those faces sit on the body at the follicle and may touch it.
+static bool on_follicle(const plume_scene *scene, const bool *carried_clamp, int face)
 {
-	if (scene->feather_count < 2)
-		return PLUME_OK;
+	const int *v = scene->mesh->faces + 3 * face;
+	return carried_clamp[v[0]] || carried_clamp[v[1]] || carried_clamp[v[2]];
+}
+
+/// Every pair of intersecting triangles of the soup (plume_find_intersections, exact): into
+/// *pairs (plume_free), their count into *count.
+static plume_status all_intersections(const plume_vec3 *positions, int vertex_count, const int *triangles,
+                                      int triangle_count, int **pairs, int *count, plume_error *err)
+{
+	int capacity = 1024;
+	*pairs = NULL;
+	for (;;) {
+		plume_free(*pairs);
+		*pairs = plume_alloc(sizeof(int) * 2 * (size_t)capacity);
+		if (*pairs == NULL)
+			return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory");
+		plume_status status =
+		    plume_find_intersections(positions, vertex_count, triangles, triangle_count, capacity, *pairs, count, err);
+		if (status != PLUME_OK || *count <= capacity)
+			return status;
+		capacity = *count; // again, with room for every pair: none between two feathers is left out
+	}
+}
+
+/// Feathers that intersect each other or the body at rest (exactly, plume_find_intersections)
+/// are an error naming the first pair, the faces and where: a simulation cannot start from
+/// surfaces that already pass through each other. A feather's own faces are the mesher's; a
+/// carried feather's calamus faces sit on the body at its follicle and are not checked against it.
+static plume_status check_rest_intersections(const char *file, const char *where, const plume_scene *scene,
+                                             plume_error *err)
+{
 	const plume_mesh *mesh = scene->mesh;
-	int count = 0, capacity = 1024;
-	int *pairs = NULL;
-	plume_status status = PLUME_OK;
-	for (int attempt = 0; attempt < 2; ++attempt) {
-		plume_free(pairs);
-		pairs = plume_alloc(sizeof(int) * 2 * (size_t)capacity);
-		if (pairs == NULL)
-			return plume_error_set(err, PLUME_ERROR_MEMORY, "%s: out of memory checking the feathers at rest", file);
-		status = plume_find_intersections(mesh->rest, mesh->vertex_count, mesh->faces, mesh->face_count, capacity,
-		                                  pairs, &count, err);
-		if (status != PLUME_OK || count <= capacity)
-			break;
-		capacity = count; // every pair, so that no pair between two feathers is left out
+	int body_vertices = scene->body != NULL ? plume_body_vertex_count(scene->body) : 0;
+	int body_triangles = scene->body != NULL ? plume_body_triangle_count(scene->body) : 0;
+	if (scene->feather_count < 2 && scene->body == NULL)
+		return PLUME_OK;
+	// The soup: the feathers' rest mesh, then the body's rest mesh.
+	int vertex_count = mesh->vertex_count + body_vertices, triangle_count = mesh->face_count + body_triangles;
+	plume_vec3 *positions = plume_alloc(sizeof(plume_vec3) * (size_t)vertex_count);
+	int *triangles = plume_alloc(sizeof(int) * 3 * (size_t)triangle_count);
+	bool *carried_clamp = plume_calloc((size_t)mesh->vertex_count, sizeof(bool));
+	if (positions == NULL || triangles == NULL || carried_clamp == NULL) {
+		plume_free(positions);
+		plume_free(triangles);
+		plume_free(carried_clamp);
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "%s: out of memory checking the feathers at rest", file);
 	}
+	memcpy(positions, mesh->rest, sizeof(plume_vec3) * (size_t)mesh->vertex_count);
+	memcpy(triangles, mesh->faces, sizeof(int) * 3 * (size_t)mesh->face_count);
+	if (scene->body != NULL) {
+		memcpy(positions + mesh->vertex_count, plume_body_rest_positions(scene->body),
+		       sizeof(plume_vec3) * (size_t)body_vertices);
+		const int *body = plume_body_triangles(scene->body);
+		for (int k = 0; k < 3 * body_triangles; ++k)
+			triangles[3 * mesh->face_count + k] = body[k] + mesh->vertex_count;
+	}
+	for (int i = 0; i < scene->feather_count; ++i) {
+		char name[64];
+		snprintf(name, sizeof name, "%s/rachis_clamp", scene->feathers[i].name);
+		const plume_vertex_group *clamp = plume_mesh_find_group(mesh, name);
+		for (int k = 0; scene->feathers[i].follicle && clamp != NULL && k < clamp->count; ++k)
+			carried_clamp[clamp->vertices[k]] = true;
+	}
+	int *pairs = NULL, count = 0;
+	plume_status status = all_intersections(positions, vertex_count, triangles, triangle_count, &pairs, &count, err);
 	if (status != PLUME_OK) {
-		plume_free(pairs);
 		char prefix[4200];
-		snprintf(prefix, sizeof prefix, "%s: $.feathers: checking the feathers at rest", file);
+		snprintf(prefix, sizeof prefix, "%s: %s: checking the feathers at rest", file, where);
 		plume_error_prefix(err, prefix);
-		return status;
 	}
-	int first = -1, between = 0;
-	for (int k = 0; k < count && k < capacity; ++k)
-		if (feather_of_face(scene, pairs[2 * k]) != feather_of_face(scene, pairs[2 * k + 1])) {
-			between++;
-			if (first < 0)
-				first = k;
-		}
+	int first = -1, reported = 0;
+	for (int k = 0; status == PLUME_OK && k < count; ++k) {
+		int a = pairs[2 * k], b = pairs[2 * k + 1]; // a < b: a body triangle comes second
+		bool counts = b >= mesh->face_count ? a < mesh->face_count && !on_follicle(scene, carried_clamp, a)
+		                                    : feather_of_face(scene, a) != feather_of_face(scene, b);
+		if (counts && first < 0)
+			first = k;
+		reported += counts;
+	}
 	if (first >= 0) {
 		int a = pairs[2 * first], b = pairs[2 * first + 1];
 		const plume_scene_feather *fa = scene->feathers + feather_of_face(scene, a);
-		const plume_scene_feather *fb = scene->feathers + feather_of_face(scene, b);
-		plume_vec3 at = plume_v3_scale(plume_v3_add(face_centroid(mesh, a), face_centroid(mesh, b)), 0.5);
-		status =
-		    plume_error_set(err, PLUME_ERROR_SPEC,
-		                    "%s: $.feathers: feathers \"%s\" and \"%s\" intersect at rest: face %d of \"%s\" meets "
-		                    "face %d of \"%s\" near (%.6g, %.6g, %.6g) m (%d pairs of faces between feathers in "
-		                    "all); place them apart",
-		                    file, fa->name, fb->name, a - fa->face_offset, fa->name, b - fb->face_offset, fb->name,
-		                    at.x, at.y, at.z, between);
+		const int *t = triangles + 3 * b;
+		plume_vec3 other =
+		    plume_v3_scale(plume_v3_add(plume_v3_add(positions[t[0]], positions[t[1]]), positions[t[2]]), 1.0 / 3.0);
+		plume_vec3 at = plume_v3_scale(plume_v3_add(face_centroid(mesh, a), other), 0.5);
+		if (b >= mesh->face_count) {
+			status = plume_error_set(err, PLUME_ERROR_SPEC,
+			                         "%s: %s: feather \"%s\" passes through the body at rest: its face %d meets "
+			                         "body triangle %d near (%.6g, %.6g, %.6g) m (%d pairs of faces in all); place it "
+			                         "outside the body",
+			                         file, where, fa->name, a - fa->face_offset, b - mesh->face_count, at.x, at.y, at.z,
+			                         reported);
+		} else {
+			const plume_scene_feather *fb = scene->feathers + feather_of_face(scene, b);
+			status = plume_error_set(err, PLUME_ERROR_SPEC,
+			                         "%s: %s: feathers \"%s\" and \"%s\" intersect at rest: face %d of \"%s\" "
+			                         "meets face %d of \"%s\" near (%.6g, %.6g, %.6g) m (%d pairs of faces in all); "
+			                         "place them apart",
+			                         file, where, fa->name, fb->name, a - fa->face_offset, fa->name,
+			                         b - fb->face_offset, fb->name, at.x, at.y, at.z, reported);
+		}
 	}
 	plume_free(pairs);
+	plume_free(positions);
+	plume_free(triangles);
+	plume_free(carried_clamp);
 	return status;
 }
 
@@ -910,11 +971,11 @@ static plume_status build_many(const char *file, const json_t *array, const plum
 		}
 		plume_free(parts);
 	}
-	if (status == PLUME_OK)
-		status = check_rest_intersections(file, scene, err);
 	for (int i = 0; i < list.count && status == PLUME_OK; ++i)
 		if (list.items[i].follicle)
 			status = attach_follicle(file, scene, list.items + i, scene->feathers + i, err);
+	if (status == PLUME_OK)
+		status = check_rest_intersections(file, "$.feathers", scene, err);
 	pending_free(&list);
 	return status;
 }
@@ -974,6 +1035,8 @@ static plume_status build_mesh(const char *file, const json_t *root, const plume
 		plume_error_prefix(err, file);
 	if (status == PLUME_OK)
 		status = one_feather(file, scene, err);
+	if (status == PLUME_OK)
+		status = check_rest_intersections(file, feather != NULL ? "$.feather" : "$.guides", scene, err);
 	return status;
 }
 

@@ -123,6 +123,8 @@ bad "follicle off the body" "\$.feathers[0].follicle: feather \"f0\"'s follicle 
 	"{$sphere, \"feathers\": [{\"feather\": \"$blue\", \"position\": [0, 0, 0.07], \"follicle\": {}}]}"
 bad "unknown bone" '$.feathers[0].follicle.bone: unknown bone "nek"; did you mean "neck"?' \
 	"{$sphere, \"feathers\": [{\"feather\": \"$blue\", \"position\": [0, 0, 0.05], \"follicle\": {\"bone\": \"nek\"}}]}"
+bad "feather through the body" '$.feathers: feather "f0" passes through the body at rest: its face ' \
+	"{$sphere, \"feathers\": [{\"feather\": \"$blue\", \"position\": [0, 0, 0.05], \"rotation_axis\": [1, 0, 0], \"rotation_deg\": -90, \"follicle\": {}}]}"
 bad "follicle without a body" '$.feathers[0].follicle: the scene has no "body"' \
 	"{\"feathers\": [{\"feather\": \"$blue\", \"follicle\": {}}]}"
 bad "unknown feather group" '$.handles[0].group: unknown vertex group "f3/rachis_clamp"' \
