@@ -625,6 +625,8 @@ static plume_status read_feather_entries(const char *file, const json_t *array, 
 	size_t count = json_array_size(array);
 	if (count == 0)
 		return plume_error_set(err, PLUME_ERROR_SPEC, "%s: $.feathers: is empty; list at least one feather", file);
+	double bytes = 0; // of the feathers read so far, list->items[0, counted)
+	int counted = 0;
 	for (size_t i = 0; i < count; ++i) {
 		char path[48];
 		plume_spec_index_path(path, sizeof path, "$.feathers", i);
@@ -675,6 +677,15 @@ static plume_status read_feather_entries(const char *file, const json_t *array, 
 		}
 		if (status != PLUME_OK)
 			return status;
+		// Each feather is held to the limit when it is made; together they are too (a list may
+		// repeat one spec many times).
+		for (; counted < list->count; ++counted)
+			bytes += plume_feather_bytes(list->items[counted].feather);
+		if (bytes > plume_spec_memory_limit(options))
+			return plume_error_set(err, PLUME_ERROR_LIMIT,
+			                       "%s: %s: the feathers up to here take about %.3g GB; the limit is %.3g GB (raise it "
+			                       "with --max-memory, or list fewer feathers)",
+			                       file, path, bytes / 1e9, plume_spec_memory_limit(options) / 1e9);
 	}
 	return PLUME_OK;
 }

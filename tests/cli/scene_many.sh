@@ -111,6 +111,15 @@ expect_no_output "zero frames-every" 2 "--frames-every takes a whole number in [
 expect_no_output "duration past the step limit" 2 "allowed at most 1e+07" "$scratch/none" \
 	"$plume" simulate "$scratch/three.json" -o "$scratch/none" --duration 1e9
 
+# Many copies of a feather are held to --max-memory together (each alone is well under it).
+/usr/bin/python3 -c '
+import json, sys
+feathers = [{"feather": sys.argv[1], "position": [0.1 * i, 0, 0]} for i in range(50)]
+json.dump({"feathers": feathers}, open(sys.argv[2], "w"))
+' "$source_dir/examples/franco-walter/hawk.json" "$scratch/fifty.json"
+expect_no_output "feathers past --max-memory together" 5 'the feathers up to here take about' "$scratch/none" \
+	"$plume" simulate "$scratch/fifty.json" -o "$scratch/none" --max-memory 100M
+
 # Bad scenes: the JSON path and what is wrong, exit 3, nothing written.
 bad() { # bad NAME FRAGMENT JSON
 	printf '%s\n' "$3" >"$scratch/bad.json"
