@@ -199,8 +199,9 @@ typedef struct plume_mesh_part {
 /// barb edges are offset accordingly, its rest positions placed by its rigid motion. Vertex
 /// groups: first one group per name found in any part holding that name's vertices of every
 /// part (in part order: "rachis_clamp" is every part's clamp), then each part's own groups
-/// as "prefix/name". PLUME_ERROR_SPEC when a prefixed name passes 31 bytes or two prefixes
-/// are equal, PLUME_ERROR_LIMIT when the counts overflow an int, PLUME_ERROR_MEMORY.
+/// as "prefix/name". PLUME_ERROR_SPEC when a prefixed name passes 31 bytes, two prefixes are
+/// equal or two groups would share a name; PLUME_ERROR_LIMIT when the counts overflow an int;
+/// PLUME_ERROR_MEMORY. Time O(n log n) in the number of groups.
 plume_status plume_mesh_concatenate(const plume_mesh_part *parts, int count, plume_mesh **out, plume_error *err);
 
 /// Rebuilds barb_edges from the faces' barb_edge marks (unique edges, sorted).

@@ -4,61 +4,12 @@
 // and each group name without a prefix gathers that group of every part.
 #include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "../core/alloc.h"
 #include "../core/asserts.h"
 #include "plume/mesh.h"
-
-/// The name's first group among parts [0, part) with that name, for the union groups.
-static bool seen_before(const plume_mesh_part *parts, int part, const char *name)
-{
-	for (int p = 0; p < part; ++p)
-		if (plume_mesh_find_group(parts[p].mesh, name) != NULL)
-			return true;
-	return false;
-}
-
-/// The union over every part of group `name`, offset into the concatenated numbering.
-static plume_status add_union_group(plume_mesh *out, const plume_mesh_part *parts, int count, const int *offsets,
-                                    const char *name, plume_error *err)
-{
-	int64_t total = 0;
-	for (int p = 0; p < count; ++p) {
-		const plume_vertex_group *group = plume_mesh_find_group(parts[p].mesh, name);
-		total += group != NULL ? group->count : 0;
-	}
-	int *vertices = plume_alloc(sizeof(int) * (size_t)(total > 0 ? total : 1));
-	if (vertices == NULL)
-		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory joining vertex group \"%s\"", name);
-	int n = 0;
-	for (int p = 0; p < count; ++p) {
-		const plume_vertex_group *group = plume_mesh_find_group(parts[p].mesh, name);
-		for (int i = 0; group != NULL && i < group->count; ++i)
-			vertices[n++] = group->vertices[i] + offsets[p];
-	}
-	plume_status status = plume_mesh_add_group(out, name, vertices, n, err);
-	plume_free(vertices);
-	return status;
-}
-
-static plume_status add_prefixed_group(plume_mesh *out, const char *prefix, const plume_vertex_group *group, int offset,
-                                       plume_error *err)
-{
-	char name[sizeof group->name];
-	int length = snprintf(name, sizeof name, "%s/%s", prefix, group->name);
-	if (length < 0 || (size_t)length >= sizeof name)
-		return plume_error_set(err, PLUME_ERROR_SPEC, "vertex group \"%s/%s\" is longer than %zu bytes", prefix,
-		                       group->name, sizeof name - 1);
-	int *vertices = plume_alloc(sizeof(int) * (size_t)(group->count > 0 ? group->count : 1));
-	if (vertices == NULL)
-		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory adding vertex group \"%s\"", name);
-	for (int i = 0; i < group->count; ++i)
-		vertices[i] = group->vertices[i] + offset;
-	plume_status status = plume_mesh_add_group(out, name, vertices, group->count, err);
-	plume_free(vertices);
-	return status;
-}
 
 /// Copies part p's arrays into out at the given offsets, rest positions placed.
 static void copy_part(plume_mesh *out, const plume_mesh_part *part, int vertex_offset, int face_offset, int barb_offset)
@@ -80,6 +31,116 @@ static void copy_part(plume_mesh *out, const plume_mesh_part *part, int vertex_o
 		out->barb_edges[2 * barb_offset + e] = mesh->barb_edges[e] + vertex_offset;
 }
 
+/// A group of the result, before its vertices are copied: its name and where they come from
+/// (one part's group, or every part's group of that name when part is -1).
+typedef struct group_plan {
+	char name[sizeof(((plume_vertex_group *)0)->name)];
+	int part;
+	int group;
+	int count;
+} group_plan;
+
+static int compare_names(const void *a, const void *b)
+{
+	return strcmp(((const group_plan *)a)->name, ((const group_plan *)b)->name);
+}
+
+static int compare_prefixes(const void *a, const void *b)
+{
+	return strcmp(*(const char *const *)a, *(const char *const *)b);
+}
+
+/// The groups of the result in order: one per distinct name (first appearance), then each
+/// part's own, prefixed. PLUME_ERROR_SPEC for a prefixed name too long or two names alike.
+static plume_status plan_groups(const plume_mesh_part *parts, int count, group_plan **out, int *out_count,
+                                plume_error *err)
+{
+	int64_t total = 0;
+	for (int p = 0; p < count; ++p)
+		total += parts[p].mesh->group_count;
+	group_plan *plan = plume_calloc((size_t)(2 * total + 1), sizeof *plan);
+	if (plan == NULL)
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory joining %d meshes", count);
+	int n = 0, distinct = 0;
+	// Distinct names are few (a feather's mesh has seven groups): a linear search is enough.
+	for (int p = 0; p < count; ++p)
+		for (int g = 0; g < parts[p].mesh->group_count; ++g) {
+			const plume_vertex_group *group = parts[p].mesh->groups + g;
+			int u = 0;
+			while (u < distinct && strcmp(plan[u].name, group->name) != 0)
+				++u;
+			if (u == distinct) {
+				memcpy(plan[u].name, group->name, sizeof plan[u].name);
+				plan[u].part = -1;
+				distinct++;
+			}
+			plan[u].count += group->count;
+		}
+	n = distinct;
+	plume_status status = PLUME_OK;
+	for (int p = 0; p < count && status == PLUME_OK; ++p)
+		for (int g = 0; g < parts[p].mesh->group_count; ++g) {
+			const plume_vertex_group *group = parts[p].mesh->groups + g;
+			int length = snprintf(plan[n].name, sizeof plan[n].name, "%s/%s", parts[p].prefix, group->name);
+			if (length < 0 || (size_t)length >= sizeof plan[n].name) {
+				status = plume_error_set(err, PLUME_ERROR_SPEC, "vertex group \"%s/%s\" is longer than %zu bytes",
+				                         parts[p].prefix, group->name, sizeof plan[n].name - 1);
+				break;
+			}
+			plan[n].part = p;
+			plan[n].group = g;
+			plan[n].count = group->count;
+			n++;
+		}
+	// Names must stay unique (a part's own group "a/b" under prefix "x" is "x/a/b", as is group
+	// "b" under prefix "x/a"): sorted copies side by side.
+	if (status == PLUME_OK) {
+		group_plan *sorted = plume_alloc(sizeof *sorted * (size_t)(n > 0 ? n : 1));
+		if (sorted == NULL) {
+			status = plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory joining %d meshes", count);
+		} else {
+			memcpy(sorted, plan, sizeof *sorted * (size_t)n);
+			qsort(sorted, (size_t)n, sizeof *sorted, compare_names);
+			for (int k = 1; k < n && status == PLUME_OK; ++k)
+				if (strcmp(sorted[k - 1].name, sorted[k].name) == 0)
+					status = plume_error_set(err, PLUME_ERROR_SPEC, "two vertex groups would be named \"%s\"",
+					                         sorted[k].name);
+			plume_free(sorted);
+		}
+	}
+	if (status != PLUME_OK) {
+		plume_free(plan);
+		return status;
+	}
+	*out = plan;
+	*out_count = n;
+	return PLUME_OK;
+}
+
+/// Fills out's groups from the plan: vertex indices offset into the joined numbering.
+static plume_status make_groups(plume_mesh *out, const plume_mesh_part *parts, int count, const int *offsets,
+                                const group_plan *plan, int n, plume_error *err)
+{
+	out->groups = plume_calloc((size_t)(n > 0 ? n : 1), sizeof *out->groups);
+	if (out->groups == NULL)
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory joining %d meshes", count);
+	for (int k = 0; k < n; ++k) {
+		plume_vertex_group *group = out->groups + k;
+		memcpy(group->name, plan[k].name, sizeof group->name);
+		group->vertices = plume_alloc(sizeof(int) * (size_t)(plan[k].count > 0 ? plan[k].count : 1));
+		if (group->vertices == NULL)
+			return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory joining %d meshes", count);
+		out->group_count = k + 1;
+		for (int p = plan[k].part < 0 ? 0 : plan[k].part; p < (plan[k].part < 0 ? count : plan[k].part + 1); ++p) {
+			const plume_vertex_group *source = plan[k].part < 0 ? plume_mesh_find_group(parts[p].mesh, plan[k].name)
+			                                                    : parts[p].mesh->groups + plan[k].group;
+			for (int i = 0; source != NULL && i < source->count; ++i)
+				group->vertices[group->count++] = source->vertices[i] + offsets[p];
+		}
+	}
+	return PLUME_OK;
+}
+
 plume_status plume_mesh_concatenate(const plume_mesh_part *parts, int count, plume_mesh **out, plume_error *err)
 {
 	PLUME_ASSERT(out != NULL && count >= 1 && parts != NULL);
@@ -87,10 +148,6 @@ plume_status plume_mesh_concatenate(const plume_mesh_part *parts, int count, plu
 	int64_t vertices = 0, faces = 0, barb_edges = 0;
 	for (int p = 0; p < count; ++p) {
 		PLUME_ASSERT(parts[p].mesh != NULL && parts[p].prefix != NULL);
-		for (int q = 0; q < p; ++q)
-			if (strcmp(parts[p].prefix, parts[q].prefix) == 0)
-				return plume_error_set(err, PLUME_ERROR_SPEC, "parts %d and %d share the group prefix \"%s\"", q, p,
-				                       parts[p].prefix);
 		vertices += parts[p].mesh->vertex_count;
 		faces += parts[p].mesh->face_count;
 		barb_edges += parts[p].mesh->barb_edge_count;
@@ -100,6 +157,26 @@ plume_status plume_mesh_concatenate(const plume_mesh_part *parts, int count, plu
 		return plume_error_set(err, PLUME_ERROR_LIMIT,
 		                       "%lld vertices and %lld faces in one mesh: allowed at most %d indices",
 		                       (long long)vertices, (long long)faces, INT32_MAX);
+	// Prefixes alike would merge two parts' groups: sorted, neighbours differ.
+	const char **prefixes = plume_alloc(sizeof *prefixes * (size_t)count);
+	if (prefixes == NULL)
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory joining %d meshes", count);
+	for (int p = 0; p < count; ++p)
+		prefixes[p] = parts[p].prefix;
+	qsort(prefixes, (size_t)count, sizeof *prefixes, compare_prefixes);
+	for (int p = 1; p < count; ++p)
+		if (strcmp(prefixes[p - 1], prefixes[p]) == 0) {
+			plume_status status =
+			    plume_error_set(err, PLUME_ERROR_SPEC, "two parts share the group prefix \"%s\"", prefixes[p]);
+			plume_free(prefixes);
+			return status;
+		}
+	plume_free(prefixes);
+	group_plan *plan = NULL;
+	int group_count = 0;
+	plume_status status = plan_groups(parts, count, &plan, &group_count, err);
+	if (status != PLUME_OK)
+		return status;
 	int *offsets = plume_alloc(sizeof(int) * (size_t)count);
 	plume_mesh *mesh = plume_mesh_create((int)vertices, (int)faces);
 	if (mesh != NULL) {
@@ -107,6 +184,7 @@ plume_status plume_mesh_concatenate(const plume_mesh_part *parts, int count, plu
 		mesh->barb_edges = plume_alloc(sizeof(int) * (size_t)(2 * barb_edges > 0 ? 2 * barb_edges : 1));
 	}
 	if (offsets == NULL || mesh == NULL || mesh->barb_edges == NULL) {
+		plume_free(plan);
 		plume_free(offsets);
 		plume_mesh_destroy(mesh);
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory joining %d meshes", count);
@@ -120,16 +198,8 @@ plume_status plume_mesh_concatenate(const plume_mesh_part *parts, int count, plu
 		face_offset += parts[p].mesh->face_count;
 		barb_offset += parts[p].mesh->barb_edge_count;
 	}
-	plume_status status = PLUME_OK;
-	for (int p = 0; p < count && status == PLUME_OK; ++p)
-		for (int g = 0; g < parts[p].mesh->group_count && status == PLUME_OK; ++g) {
-			const char *name = parts[p].mesh->groups[g].name;
-			if (!seen_before(parts, p, name))
-				status = add_union_group(mesh, parts, count, offsets, name, err);
-		}
-	for (int p = 0; p < count && status == PLUME_OK; ++p)
-		for (int g = 0; g < parts[p].mesh->group_count && status == PLUME_OK; ++g)
-			status = add_prefixed_group(mesh, parts[p].prefix, parts[p].mesh->groups + g, offsets[p], err);
+	status = make_groups(mesh, parts, count, offsets, plan, group_count, err);
+	plume_free(plan);
 	plume_free(offsets);
 	if (status != PLUME_OK) {
 		plume_mesh_destroy(mesh);
