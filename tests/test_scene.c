@@ -308,6 +308,15 @@ static void test_mesh_concatenate(void **state)
 	assert_int_equal(plume_mesh_concatenate(parts, 2, &mesh, &err), PLUME_ERROR_SPEC);
 	assert_non_null(strstr(err.message, "longer than 31 bytes"));
 	assert_null(mesh);
+	// Group "tip/a" of part "x" and group "a" of part "x/tip" would both be "x/tip/a".
+	int one[1] = {0};
+	assert_int_equal(plume_mesh_add_group(a, "tip/a", one, 1, &err), PLUME_OK);
+	assert_int_equal(plume_mesh_add_group(b, "a", one, 1, &err), PLUME_OK);
+	parts[0].prefix = "x";
+	parts[1].prefix = "x/tip";
+	assert_int_equal(plume_mesh_concatenate(parts, 2, &mesh, &err), PLUME_ERROR_SPEC);
+	assert_non_null(strstr(err.message, "two vertex groups would be named \"x/tip/a\""));
+	assert_null(mesh);
 	plume_mesh_destroy(a);
 	plume_mesh_destroy(b);
 	assert_int_equal(plume_bytes_in_use(), 0);
