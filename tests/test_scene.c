@@ -498,6 +498,25 @@ static void test_rest_intersections(void **state)
 	assert_int_equal(plume_bytes_in_use(), 0);
 }
 
+/// "shaft" and "front" place a feather as the rotation that takes +y and +z to them: shaft +z,
+/// front -y is a quarter turn about +x (y -> z, z -> -y), written the other way.
+static void test_shaft_and_front(void **state)
+{
+	(void)state;
+	plume_scene *turned = load_text("{\"feathers\": [{\"feather\": " BLUE ", \"position\": [0.1, 0.2, 0.3], "
+	                                "\"rotation_axis\": [1, 0, 0], \"rotation_deg\": 90}]}");
+	plume_scene *framed = load_text("{\"feathers\": [{\"feather\": " BLUE ", \"position\": [0.1, 0.2, 0.3], "
+	                                "\"shaft\": [0, 0, 2], \"front\": [0, -1, 0.5]}]}");
+	assert_int_equal(turned->mesh->vertex_count, framed->mesh->vertex_count);
+	double worst = 0;
+	for (int v = 0; v < turned->mesh->vertex_count; ++v)
+		worst = fmax(worst, plume_v3_distance(turned->mesh->rest[v], framed->mesh->rest[v]));
+	assert_true(worst < 1e-15);
+	plume_scene_destroy(turned);
+	plume_scene_destroy(framed);
+	assert_int_equal(plume_bytes_in_use(), 0);
+}
+
 static void expect_error(const char *text, plume_status status, const char *message)
 {
 	char dir[512], path[1024];
@@ -585,6 +604,13 @@ static void test_bad_scenes(void **state)
 	// Touching counts: a feather on the body that the body does not carry touches it at its calamus.
 	expect_error("{" BODY ", \"feathers\": [{\"feather\": " BLUE ", \"position\": [0, 0, 0.05]}]}", PLUME_ERROR_SPEC,
 	             "$.feathers: feather \"f0\" passes through the body at rest");
+	expect_error("{\"feathers\": [{\"feather\": " BLUE ", \"shaft\": [0, 0, 1], \"front\": [0, 0, -2]}]}",
+	             PLUME_ERROR_SPEC, "$.feathers[0].front: is along the shaft (or zero)");
+	expect_error("{\"feathers\": [{\"feather\": " BLUE ", \"shaft\": [0, 0, 1]}]}", PLUME_ERROR_SPEC,
+	             "$.feathers[0]: a feather is turned by \"shaft\" and \"front\" together");
+	expect_error("{\"feathers\": [{\"feather\": " BLUE
+	             ", \"shaft\": [0, 0, 1], \"front\": [0, 1, 0], \"rotation_deg\": 5}]}",
+	             PLUME_ERROR_SPEC, "or by \"rotation_axis\" and \"rotation_deg\", not both");
 	expect_error("{\"feathers\": [{\"coat\": \"missing-coat.json\"}]}", PLUME_ERROR_IO, "$.feathers[0].coat");
 	expect_error("{" FEATHER ", \"cycle_period\": 0}", PLUME_ERROR_SPEC, "$.cycle_period: is 0, allowed > 0");
 }
@@ -627,6 +653,7 @@ int main(void)
 	    cmocka_unit_test(test_coat_entry),
 	    cmocka_unit_test(test_follicles_follow_the_body),
 	    cmocka_unit_test(test_rest_intersections),
+	    cmocka_unit_test(test_shaft_and_front),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -22,8 +22,8 @@ static const char *const top_keys[] = {
     "forces",      "gravity",    "drag",     "bending",      "time_step", "duration", "frame_every", "quasi_static",
     "solver",      "integrator", "air",      "cycle_period", "body",      NULL,
 };
-static const char *const feather_entry_keys[] = {"name",          "feather",      "coat",     "mesh", "position",
-                                                 "rotation_axis", "rotation_deg", "follicle", NULL};
+static const char *const feather_entry_keys[] = {
+    "shaft", "front", "name", "feather", "coat", "mesh", "position", "rotation_axis", "rotation_deg", "follicle", NULL};
 static const char *const follicle_keys[] = {"bone", "nearest_bone", NULL};
 static const char *const material_keys[] = {
     "model",
@@ -515,6 +515,43 @@ static bool valid_name(const char *name)
 	return true;
 }
 
+/// "shaft" and "front": the directions the feather's own +y (its shaft) and +z (its front) take,
+/// instead of an axis and an angle. front is made perpendicular to shaft (Gram-Schmidt).
+static void read_frame(plume_spec_reader *reader, const json_t *object, const char *path, pending_feather *item)
+{
+	bool has_shaft = json_object_get(object, "shaft") != NULL, has_front = json_object_get(object, "front") != NULL;
+	if (!has_shaft && !has_front)
+		return;
+	if (has_shaft != has_front || json_object_get(object, "rotation_deg") != NULL ||
+	    json_object_get(object, "rotation_axis") != NULL) {
+		plume_spec_fail(reader, path,
+		                "a feather is turned by \"shaft\" and \"front\" together, or by \"rotation_axis\" and "
+		                "\"rotation_deg\", not both");
+		return;
+	}
+	plume_vec3 shaft, front;
+	if (!read_vec3(reader, object, path, "shaft", &shaft) || !read_vec3(reader, object, path, "front", &front))
+		return;
+	char child[96];
+	if (!(plume_v3_length(shaft) > 0)) {
+		plume_spec_path(child, sizeof child, path, "shaft");
+		plume_spec_fail(reader, child, "is the zero vector; it gives the direction of the feather's shaft");
+		return;
+	}
+	shaft = plume_v3_normalize(shaft);
+	double length = plume_v3_length(front);
+	front = plume_v3_mad(front, -plume_v3_dot(front, shaft), shaft);
+	// Within a thousandth of a radian of the shaft, the front has no direction of its own.
+	if (!(plume_v3_length(front) > 1e-3 * length)) {
+		plume_spec_path(child, sizeof child, path, "front");
+		plume_spec_fail(reader, child, "is along the shaft (or zero); give a direction across it");
+		return;
+	}
+	front = plume_v3_normalize(front);
+	plume_vec3 x = plume_v3_cross(shaft, front); // the own frame is right-handed: x = y cross z
+	item->rotation = (plume_mat3){{{x.x, shaft.x, front.x}, {x.y, shaft.y, front.y}, {x.z, shaft.z, front.z}}};
+}
+
 /// The attachment of an entry: name, mesh settings, placement and follicle, into item.
 static void read_attachment(plume_spec_reader *reader, const json_t *object, const char *path,
                             const plume_mesh_def *scene_mesh, pending_feather *item)
@@ -541,6 +578,7 @@ static void read_attachment(plume_spec_reader *reader, const json_t *object, con
 		}
 		item->rotation = plume_m3_rotation(plume_v3_normalize(axis), degrees * acos(-1.0) / 180);
 	}
+	read_frame(reader, object, path, item);
 	const char *name = NULL;
 	if (plume_spec_string(reader, object, path, "name", &name)) {
 		char name_path[96];
