@@ -77,6 +77,12 @@ script -qec "'$plume' simulate '$scratch/three.json' -o '$scratch/tty' --duratio
 check "progress of the meshing" grep -aq 'plume simulate: meshing feathers: 3/3 (100%)' "$scratch/tty.txt"
 check "progress of the steps" grep -aq 'plume simulate: 2/2 (100%), [0-9]* s elapsed, t = 0.022 s, 3 feathers' "$scratch/tty.txt"
 
+# Determinism: the same frames, byte for byte, with one thread and with two.
+OMP_NUM_THREADS=1 "$plume" simulate "$scratch/three.json" -o "$scratch/one" --duration 0.033 --frames-every 1 >/dev/null 2>&1
+OMP_NUM_THREADS=2 "$plume" simulate "$scratch/three.json" -o "$scratch/two-threads" --duration 0.033 --frames-every 1 >/dev/null 2>&1
+check "1 and 2 threads: the same frames" cmp -s "$scratch/one/frames/0003.obj" "$scratch/two-threads/frames/0003.obj"
+check "1 and 2 threads: the same feathers" cmp -s "$scratch/one/feathers/top.bin" "$scratch/two-threads/feathers/top.bin"
+
 # --render draws every feather at barb level and the body.
 "$plume" simulate "$scratch/three.json" -o "$scratch/render" --duration 0.011 --render --size 64x64 --spp 1 >/dev/null 2>"$scratch/err.txt"
 succeeded "--render with three feathers and a body"
