@@ -648,7 +648,7 @@ static plume_status expand_coat(const char *file, const char *name, const char *
 				                         file, where, entry->name, composed);
 				break;
 			}
-			snprintf(item->name, sizeof item->name, "%s", composed);
+			memcpy(item->name, composed, strlen(composed) + 1); // valid: at most 15 bytes
 		}
 	}
 	plume_coat_destroy(coat);
