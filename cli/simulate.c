@@ -1,4 +1,4 @@
-// plume simulate SCENE.json -o DIR [--seed N] [--png] [--size WxH]
+// plume simulate SCENE.json -o DIR [--seed N] [--duration T] [--frames-every N] [--png] [--size WxH]
 #define _POSIX_C_SOURCE 200809L
 #include <getopt.h>
 #include <math.h>
@@ -21,7 +21,12 @@ void cli_help_simulate(void)
 	     "  DIR/mesh.obj          the rest shell (UVs, rachis and vane groups)\n"
 	     "  DIR/feather.json      the generated feather (barb-level geometry; its numbers\n"
 	     "                        in DIR/feather.bin, docs/feather-json.md)\n"
-	     "  DIR/frames/NNNN.obj   the shell at every written step (0000: the start)\n"
+	     "  DIR/feathers/NAME.json  instead, for a scene that lists \"feathers\": each\n"
+	     "                        feather placed at rest (world coordinates, like mesh.obj)\n"
+	     "  DIR/frames/NNNN.obj   the shell at every written step (0000: the start); every\n"
+	     "                        feather of the scene in one mesh\n"
+	     "  DIR/body.obj, DIR/frames/body-NNNN.obj  the scene's body at rest and at every\n"
+	     "                        written step, when it has one\n"
 	     "  DIR/sim.glb           all frames as one animated glTF 2.0 file (morph\n"
 	     "                        targets, animation \"simulation\"; Blender, three.js)\n"
 	     "  DIR/sim.usda          the same as USD text: time-sampled points\n"
@@ -32,7 +37,7 @@ void cli_help_simulate(void)
 	     "                        per handle N (in the scene's order) the reaction force\n"
 	     "                        handleN_f{x,y,z} (N) and displacement handleN_d{x,y,z} (m)\n"
 	     "  DIR/summary.json      steps, iterations, timings, largest barb strain,\n"
-	     "                        rachis tip deflection\n"
+	     "                        rachis tip deflection, feather and vertex counts\n"
 	     "Bad input writes nothing. If a step fails even with substeps, the frames\n"
 	     "before it are kept, summary.json says where it stopped, and the exit\n"
 	     "status is 1.\n"
@@ -40,13 +45,17 @@ void cli_help_simulate(void)
 	     "Options:\n"
 	     "  -o, --output DIR    output folder (created if missing)\n"
 	     "  -s, --seed N        seed of the scene's feather (overrides the specs)\n"
+	     "      --duration T    simulate T seconds instead of the scene's $.duration (> 0)\n"
+	     "      --frames-every N  write every N-th step instead of the scene's\n"
+	     "                      $.frame_every (N >= 1; the last step is always written)\n"
 	     "      --png           also write a shaded PNG of every frame\n"
 	     "      --size WxH      PNG size (default 800x800)\n"
 	     "      --view AZ,EL    PNG camera azimuth about +y and elevation, degrees\n"
 	     "                      (default 34,20; 0,0 looks at the vane face on)\n"
 	     "      --render        ray-trace every frame at barb level (the feather's barbs\n"
-	     "                      carried by the shell) to frames/NNNN-rt.png, and make\n"
-	     "                      DIR/movie.mp4 when ffmpeg is installed\n"
+	     "                      carried by the shell; every feather, and the body) to\n"
+	     "                      frames/NNNN-rt.png, and make DIR/movie.mp4 when ffmpeg\n"
+	     "                      is installed\n"
 	     "      --spp N         samples per pixel of --render (default 4)\n"
 	     "      --glb-feather   sim.glb also carries the feather's barbs (line segments\n"
 	     "                      moved by the shell, one morph target per frame; large:\n"
@@ -119,8 +128,104 @@ typedef struct run_state {
 	double max_out_of_plane;
 	double max_kinetic;
 	double max_elastic;
-	double *max_reaction; ///< per handle: the largest |reaction|, N
+	double *max_reaction;       ///< per handle: the largest |reaction|, N
+	plume_vec3 *body_positions; ///< the scene's body posed at a frame's time
+	/// --render of a scene that lists "feathers" or has a body: each feather's barbs embedded
+	/// in the joined shell (NULL for guides), the body drawn as a shell.
+	plume_barb_embedding **embeddings;
+	int embedding_count;
+	plume_mesh *body_shell;
 } run_state;
+
+/// Sets up --render for many feathers and a body: the camera as cli_barb_renderer_begin
+/// frames it, one embedding per feather in the joined rest shell (each feather's barbs lie
+/// on its own piece of it), and the body as a plain shell.
+static plume_status many_renderer_begin(run_state *run, plume_vec3 lo, plume_vec3 hi, int spp, plume_error *err)
+{
+	const plume_scene *scene = run->scene;
+	run->renderer.embedding = NULL;
+	run->renderer.def = plume_raytrace_default_def();
+	run->renderer.def.camera.width = run->view.width;
+	run->renderer.def.camera.height = run->view.height;
+	run->renderer.def.spp = spp;
+	run->renderer.def.camera = plume_camera_frame_bounds(&run->renderer.def.camera, lo, hi);
+	run->embeddings = calloc((size_t)scene->feather_count, sizeof *run->embeddings);
+	if (run->embeddings == NULL)
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "simulate: out of memory");
+	run->embedding_count = scene->feather_count;
+	for (int i = 0; i < scene->feather_count; ++i) {
+		if (scene->feathers[i].feather == NULL)
+			continue;
+		plume_status status = plume_embedding_create(scene->feathers[i].feather, scene->mesh, &run->embeddings[i], err);
+		if (status != PLUME_OK)
+			return status;
+	}
+	if (scene->body != NULL) {
+		const plume_body *body = scene->body;
+		run->body_shell = plume_mesh_create(plume_body_vertex_count(body), plume_body_triangle_count(body));
+		if (run->body_shell == NULL)
+			return plume_error_set(err, PLUME_ERROR_MEMORY, "simulate: out of memory");
+		memcpy(run->body_shell->rest, plume_body_rest_positions(body),
+		       sizeof(plume_vec3) * (size_t)plume_body_vertex_count(body));
+		memcpy(run->body_shell->faces, plume_body_triangles(body),
+		       sizeof(int) * 3 * (size_t)plume_body_triangle_count(body));
+	}
+	return PLUME_OK;
+}
+
+static void many_renderer_end(run_state *run)
+{
+	for (int i = 0; i < run->embedding_count; ++i)
+		plume_embedding_destroy(run->embeddings[i]);
+	free(run->embeddings);
+	run->embeddings = NULL;
+	plume_mesh_destroy(run->body_shell);
+	run->body_shell = NULL;
+}
+
+/// Every feather carried by the shell at positions, and the body posed at time, to path (PNG).
+static plume_status many_renderer_frame(run_state *run, const plume_vec3 *positions, double time, const char *path,
+                                        plume_error *err)
+{
+	const plume_scene *scene = run->scene;
+	plume_feather **moved = calloc((size_t)scene->feather_count, sizeof *moved);
+	if (moved == NULL)
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "simulate: out of memory");
+	plume_status status = PLUME_OK;
+	int count = 0;
+	for (int i = 0; i < scene->feather_count && status == PLUME_OK; ++i)
+		if (run->embeddings[i] != NULL)
+			status = plume_embedding_apply(run->embeddings[i], positions, &moved[count++], err);
+	if (status == PLUME_OK) {
+		if (scene->body != NULL)
+			plume_scene_body_pose(scene, time, run->body_positions);
+		plume_raytrace_scene picture = {count, (const plume_feather *const *)moved, run->body_shell,
+		                                scene->body != NULL ? run->body_positions : NULL};
+		status = plume_raytrace_render_png(&picture, &run->renderer.def, path, NULL, err);
+	}
+	for (int i = 0; i < count; ++i)
+		plume_feather_destroy(moved[i]);
+	free(moved);
+	return status;
+}
+
+/// The body at the given positions as Wavefront OBJ (object "body", metres), for renders.
+static plume_status write_body_obj(const plume_body *body, const plume_vec3 *positions, const char *path,
+                                   plume_error *err)
+{
+	FILE *file = fopen(path, "wb");
+	if (file == NULL)
+		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write", path);
+	fputs("o body\n", file);
+	for (int v = 0; v < plume_body_vertex_count(body); ++v)
+		fprintf(file, "v %.17g %.17g %.17g\n", positions[v].x, positions[v].y, positions[v].z);
+	const int *triangles = plume_body_triangles(body);
+	for (int f = 0; f < plume_body_triangle_count(body); ++f)
+		fprintf(file, "f %d %d %d\n", triangles[3 * f] + 1, triangles[3 * f + 1] + 1, triangles[3 * f + 2] + 1);
+	if (fclose(file) != 0)
+		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write", path);
+	return PLUME_OK;
+}
 
 // time: the scene's time of the step (plume_sim_time stays 0 in quasi-static scenes,
 // whose keyframed handles still move with it).
@@ -130,6 +235,12 @@ static plume_status write_frame(run_state *run, int frame, double time, const pl
 	snprintf(name, sizeof name, "frames/%04d.obj", frame);
 	cli_output_path(run->output, name, path, sizeof path);
 	plume_status status = plume_mesh_obj_writer_write(run->obj, plume_sim_positions(sim), path, err);
+	if (status == PLUME_OK && run->scene->body != NULL) {
+		snprintf(name, sizeof name, "frames/body-%04d.obj", frame);
+		plume_scene_body_pose(run->scene, time, run->body_positions);
+		status = write_body_obj(run->scene->body, run->body_positions,
+		                        cli_output_path(run->output, name, path, sizeof path), err);
+	}
 	if (status == PLUME_OK)
 		status = plume_mesh_animation_add_frame(run->animation, time, plume_sim_positions(sim), err);
 	if (status == PLUME_OK && run->fields) {
@@ -152,7 +263,8 @@ static plume_status write_frame(run_state *run, int frame, double time, const pl
 	if (status == PLUME_OK && run->render) {
 		snprintf(name, sizeof name, "frames/%04d-rt.png", frame);
 		cli_output_path(run->output, name, path, sizeof path);
-		status = cli_barb_renderer_frame(&run->renderer, plume_sim_positions(sim), path, err);
+		status = run->embeddings != NULL ? many_renderer_frame(run, plume_sim_positions(sim), time, path, err)
+		                                 : cli_barb_renderer_frame(&run->renderer, plume_sim_positions(sim), path, err);
 	}
 	run->frames = frame + 1;
 	return status;
@@ -179,7 +291,10 @@ static void write_handle_columns(run_state *run, double time, const plume_sim *s
 static void show_progress(run_state *run, int step, double time)
 {
 	char note[64];
-	snprintf(note, sizeof note, "t = %.3f s", time);
+	if (run->scene->feather_count > 1)
+		snprintf(note, sizeof note, "t = %.3f s, %d feathers", time, run->scene->feather_count);
+	else
+		snprintf(note, sizeof note, "t = %.3f s", time);
 	cli_progress_update_note(&run->bar, step, note);
 }
 
@@ -234,9 +349,12 @@ void cli_scene_bounds(const plume_scene *scene, plume_vec3 *lo, plume_vec3 *hi)
 
 /// The group whose rigid motion carries the rest vane's plane for vane_max_out_of_plane: the
 /// rachis clamp (the first two rows of rachis vertices at the calamus) when the mesh has it,
-/// else the first handle's group (docs/simulation.md).
+/// else the first handle's group (docs/simulation.md). Many feathers have no one vane plane:
+/// a group the mesh lacks leaves the measure undefined (NaN, null in summary.json).
 static const char *vane_base_group(const plume_scene *scene)
 {
+	if (scene->feather_count > 1)
+		return "";
 	if (plume_mesh_find_group(scene->mesh, "rachis_clamp") != NULL || scene->handle_count == 0)
 		return "rachis_clamp";
 	return scene->handles[0].group;
@@ -270,6 +388,36 @@ static plume_status write_summary(cli_output *output, const plume_scene *scene, 
 	json_object_set_new(root, "max_barb_strain", json_real(summary->max_barb_strain));
 	json_object_set_new(root, "rachis_tip_deflection", json_real(summary->rachis_tip_deflection));
 	json_object_set_new(root, "vertices", json_integer(summary->vertex_count));
+	json_object_set_new(root, "vertex_count", json_integer(summary->vertex_count));
+	json_object_set_new(root, "feather_count", json_integer(scene->feather_count));
+	json_object_set_new(root, "duration", json_real(scene->duration));
+	// The cost of one cycle of a cyclic scene: the wall time over the cycles simulated.
+	double simulated = fmin(summary->steps * scene->sim.time_step, scene->duration);
+	if (scene->cycle_period > 0) {
+		json_object_set_new(root, "cycle_period", json_real(scene->cycle_period));
+		if (simulated > 0)
+			json_object_set_new(root, "seconds_per_cycle",
+			                    json_real(summary->wall_seconds / (simulated / scene->cycle_period)));
+	}
+	// Written only by runs that measure them (contact, the independent intersection check).
+	if (summary->contact_measured) {
+		json_object_set_new(root, "contact_pairs_max", json_integer(summary->contact_pairs_max));
+		json_object_set_new(root, "min_distance", json_measure(summary->min_distance));
+	}
+	if (summary->intersections_checked)
+		json_object_set_new(root, "intersecting_pairs", json_integer(summary->intersecting_pairs));
+	json_t *feathers = json_array();
+	for (int i = 0; i < scene->feather_count; ++i) {
+		const plume_scene_feather *f = scene->feathers + i;
+		json_t *entry = json_object();
+		json_object_set_new(entry, "name", json_string(f->name));
+		json_object_set_new(entry, "vertex_offset", json_integer(f->vertex_offset));
+		json_object_set_new(entry, "vertex_count", json_integer(f->vertex_count));
+		json_object_set_new(entry, "face_offset", json_integer(f->face_offset));
+		json_object_set_new(entry, "face_count", json_integer(f->face_count));
+		json_array_append_new(feathers, entry);
+	}
+	json_object_set_new(root, "feathers", feathers);
 	json_object_set_new(root, "faces", json_integer(summary->face_count));
 	json_object_set_new(root, "barb_constraints", json_integer(summary->constraint_count));
 	json_object_set_new(root, "vane_min_principal_stretch", json_measure(run->min_stretch));
@@ -314,6 +462,24 @@ static void make_movie(cli_output *output)
 	}
 }
 
+/// A scene that lists "feathers": DIR/feathers/NAME.json (and .bin), each feather placed at rest.
+static plume_status write_feathers(const plume_scene *scene, cli_output *output, plume_error *err)
+{
+	char path[4352], name[64];
+	snprintf(path, sizeof path, "%s/feathers", output->stage);
+	if (mkdir(path, 0777) != 0)
+		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot create: %s", path, "mkdir failed");
+	plume_status status = PLUME_OK;
+	for (int i = 0; i < scene->feather_count && status == PLUME_OK; ++i) {
+		if (scene->feathers[i].feather == NULL)
+			continue;
+		snprintf(name, sizeof name, "feathers/%s.json", scene->feathers[i].name);
+		status =
+		    plume_write_json_binary(scene->feathers[i].feather, cli_output_path(output, name, path, sizeof path), err);
+	}
+	return status;
+}
+
 /// Writes the rest shell and the feather, then runs the scene into frames/ and stats.csv.
 static plume_status simulate(const plume_scene *scene, cli_output *output, run_state *run, plume_scene_summary *summary,
                              plume_error *failure, plume_error *err)
@@ -325,6 +491,15 @@ static plume_status simulate(const plume_scene *scene, cli_output *output, run_s
 	if (status == PLUME_OK && scene->feather != NULL)
 		status =
 		    plume_write_json_binary(scene->feather, cli_output_path(output, "feather.json", path, sizeof path), err);
+	else if (status == PLUME_OK)
+		status = write_feathers(scene, output, err);
+	if (status == PLUME_OK && scene->body != NULL) {
+		run->body_positions = malloc(sizeof(plume_vec3) * (size_t)plume_body_vertex_count(scene->body));
+		if (run->body_positions == NULL)
+			return plume_error_set(err, PLUME_ERROR_MEMORY, "simulate: out of memory");
+		status = write_body_obj(scene->body, plume_body_rest_positions(scene->body),
+		                        cli_output_path(output, "body.obj", path, sizeof path), err);
+	}
 	if (status != PLUME_OK)
 		return status;
 	snprintf(path, sizeof path, "%s/frames", output->stage);
@@ -395,6 +570,8 @@ int cli_simulate(int argc, char **argv)
 	    {"glb-feather", no_argument, NULL, 'G'},
 	    {"help", no_argument, NULL, 'h'},
 	    {"max-memory", required_argument, NULL, 'M'},
+	    {"duration", required_argument, NULL, 'D'},
+	    {"frames-every", required_argument, NULL, 'E'},
 	    {NULL, 0, NULL, 0},
 	};
 	const char *output_dir = NULL;
@@ -403,6 +580,8 @@ int cli_simulate(int argc, char **argv)
 	run_state run = {0};
 	run.view = plume_shell_view_default_def();
 	int spp = 4;
+	double duration = 0; // 0: the scene's
+	int frames_every = 0;
 	int option;
 	optind = 1;
 	opterr = 0;
@@ -444,6 +623,22 @@ int cli_simulate(int argc, char **argv)
 			if (!cli_parse_memory("simulate", optarg, &max_bytes))
 				return CLI_EXIT_USAGE;
 			break;
+		case 'D': {
+			char *end = NULL;
+			duration = strtod(optarg, &end);
+			if (end == optarg || *end != '\0' || !(duration > 0) || !isfinite(duration))
+				return cli_usage_error("simulate", "--duration takes a time in seconds > 0, got '%s'", optarg);
+			break;
+		}
+		case 'E': {
+			char *end = NULL;
+			long value = strtol(optarg, &end, 10);
+			if (end == optarg || *end != '\0' || value < 1 || value > PLUME_SCENE_MAX_STEPS)
+				return cli_usage_error("simulate", "--frames-every takes a whole number in [1, %d], got '%s'",
+				                       PLUME_SCENE_MAX_STEPS, optarg);
+			frames_every = (int)value;
+			break;
+		}
 		case 'h': cli_help_simulate(); return CLI_EXIT_OK;
 		case ':': return cli_usage_error("simulate", "option '%s' needs a value", argv[optind - 1]);
 		default: return cli_usage_error("simulate", "unknown option '%s'", argv[optind - 1]);
@@ -455,15 +650,36 @@ int cli_simulate(int argc, char **argv)
 	plume_error err = {0}, failure = {0};
 	plume_scene *scene = NULL;
 	spec_options.max_memory = max_bytes; // the feather and its mesh too
+	// Many feathers take a while to generate and mesh: a progress line of its own.
+	cli_progress meshing;
+	cli_progress_begin(&meshing, "simulate: meshing feathers", 1);
+	spec_options.progress = cli_progress_callback;
+	spec_options.progress_user = &meshing;
 	plume_status status = plume_scene_load(argv[optind], &spec_options, &scene, &err);
+	cli_progress_end(&meshing);
 	if (status != PLUME_OK)
 		return cli_fail(&err);
+	if (duration > 0) {
+		// The scene's own duration passed the same limit when it was read (spec_scene.c).
+		double dt = scene->sim.time_step;
+		if (!(duration / dt <= PLUME_SCENE_MAX_STEPS)) {
+			plume_scene_destroy(scene);
+			return cli_usage_error("simulate",
+			                       "--duration %g s in steps of %g s ($.time_step) is %.3g steps; allowed at most %.0e",
+			                       duration, dt, duration / dt, (double)PLUME_SCENE_MAX_STEPS);
+		}
+		scene->duration = duration;
+	}
+	if (frames_every > 0)
+		scene->frame_every = frames_every;
 	run.scene = scene;
 	run.total_steps = (int)ceil(scene->duration / scene->sim.time_step - 1e-9);
 	// The frames' bytes before the run: an OBJ line is at most about 80 bytes
 	// (three %.17g coordinates), a PNG at most its raw pixels.
 	double frame_count = (double)run.total_steps / scene->frame_every + 2.0;
-	double frame_bytes = 80.0 * (scene->mesh->vertex_count + scene->mesh->face_count) +
+	double body_elements =
+	    scene->body != NULL ? plume_body_vertex_count(scene->body) + plume_body_triangle_count(scene->body) : 0;
+	double frame_bytes = 80.0 * (scene->mesh->vertex_count + scene->mesh->face_count + body_elements) +
 	                     ((run.png ? 1 : 0) + (run.render ? 1 : 0)) * 4.0 * run.view.width * run.view.height;
 	if (frame_count * frame_bytes > (double)max_bytes) {
 		fprintf(stderr,
@@ -485,16 +701,31 @@ int cli_simulate(int argc, char **argv)
 	}
 	if (run.glb_feather && scene->feather == NULL) {
 		plume_scene_destroy(scene);
-		return cli_usage_error("simulate", "--glb-feather needs a scene whose feather is generated (not guides)");
+		return cli_usage_error(
+		    "simulate",
+		    "--glb-feather needs a scene with one generated feather (\"feather\", not guides or \"feathers\")");
 	}
 	if (run.render) {
-		if (scene->feather == NULL) {
+		bool many = scene->feather_count > 1 || scene->feather == NULL || scene->body != NULL;
+		bool generated = false;
+		for (int i = 0; i < scene->feather_count; ++i)
+			generated = generated || scene->feathers[i].feather != NULL;
+		if (!generated) {
 			plume_scene_destroy(scene);
-			return cli_usage_error("simulate", "--render needs a scene whose feather is generated (not guides)");
+			return cli_usage_error("simulate", "--render needs a scene whose feathers are generated (not guides)");
 		}
-		status = cli_barb_renderer_begin(&run.renderer, scene->feather, scene->mesh, lo, hi, run.view.width,
-		                                 run.view.height, spp, &err);
+		if (scene->body != NULL) // the camera sees the body too
+			for (int v = 0; v < plume_body_vertex_count(scene->body); ++v) {
+				plume_vec3 p = plume_body_rest_positions(scene->body)[v];
+				lo = plume_v3(fmin(lo.x, p.x), fmin(lo.y, p.y), fmin(lo.z, p.z));
+				hi = plume_v3(fmax(hi.x, p.x), fmax(hi.y, p.y), fmax(hi.z, p.z));
+			}
+		run.scene = scene;
+		status = many ? many_renderer_begin(&run, lo, hi, spp, &err)
+		              : cli_barb_renderer_begin(&run.renderer, scene->feather, scene->mesh, lo, hi, run.view.width,
+		                                        run.view.height, spp, &err);
 		if (status != PLUME_OK) {
+			many_renderer_end(&run);
 			plume_scene_destroy(scene);
 			cli_barb_renderer_end(&run.renderer);
 			return cli_fail(&err);
@@ -523,7 +754,9 @@ int cli_simulate(int argc, char **argv)
 	plume_embedding_destroy(run.carried);
 	free(run.field_times);
 	free(run.max_reaction);
+	free(run.body_positions);
 	cli_barb_renderer_end(&run.renderer);
+	many_renderer_end(&run);
 	if (status != PLUME_OK)
 		return cli_fail(status == PLUME_ERROR_NUMERIC && failure.message[0] ? &failure : &err);
 	return CLI_EXIT_OK;

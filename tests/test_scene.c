@@ -112,6 +112,411 @@ static void test_handle_pose_interpolation(void **state)
 	assert_close(r.m[1][0], sin(1), 1e-15);
 }
 
+/// Loads a scene from text (written to a temporary file, so relative paths are the source tree's).
+static plume_scene *load_text(const char *text)
+{
+	char dir[512], path[1024];
+	test_make_temp_dir(dir, sizeof dir);
+	snprintf(path, sizeof path, "%s/scene.json", dir);
+	test_write_file(path, text);
+	plume_scene *scene = NULL;
+	plume_error err = {0};
+	if (plume_scene_load(path, NULL, &scene, &err) != PLUME_OK)
+		fail_msg("%s", err.message);
+	test_remove_tree(dir);
+	return scene;
+}
+
+/// Every step's positions of a run, back to back (steps + 1 states of vertex_count each).
+typedef struct trajectory {
+	int vertex_count;
+	int states;
+	plume_vec3 *positions;
+} trajectory;
+
+static plume_status record_state(void *user, int step, double time, const plume_sim *sim,
+                                 const plume_solve_report *report, double wall_seconds, plume_error *err)
+{
+	(void)step, (void)time, (void)report, (void)wall_seconds, (void)err;
+	trajectory *path = user;
+	path->vertex_count = plume_sim_vertex_count(sim);
+	path->positions =
+	    realloc(path->positions, sizeof(plume_vec3) * (size_t)path->vertex_count * (size_t)(path->states + 1));
+	memcpy(path->positions + (size_t)path->states * (size_t)path->vertex_count, plume_sim_positions(sim),
+	       sizeof(plume_vec3) * (size_t)path->vertex_count);
+	path->states++;
+	return PLUME_OK;
+}
+
+static trajectory run_text(const char *text, plume_scene **keep)
+{
+	plume_scene *scene = load_text(text);
+	trajectory path = {0, 0, NULL};
+	plume_scene_summary summary;
+	plume_error err = {0};
+	if (plume_scene_run(scene, record_state, &path, &summary, &err) != PLUME_OK)
+		fail_msg("%s", err.message);
+	if (keep != NULL)
+		*keep = scene;
+	else
+		plume_scene_destroy(scene);
+	return path;
+}
+
+#define BLUE "\"" PLUME_SOURCE_DIR "/examples/franco-walter/blue.json\""
+#define HAWK "\"" PLUME_SOURCE_DIR "/examples/franco-walter/hawk.json\""
+/// Held at the calamus, under gravity across the vane, 6 steps; Newton solved to 1e-12 so that
+/// two runs agree to well under the test's 1e-10 m wherever they agree physically.
+#define SETTINGS                                                                                                       \
+	"\"mesh\": {\"edge_length\": 0.01, \"rachis_width_base\": 0.006, \"rachis_width_tip\": 0.003}, "                   \
+	"\"handles\": [{\"group\": \"rachis_clamp\"}], \"gravity\": [0.5, -2, -9.81], \"duration\": 0.066, "               \
+	"\"solver\": {\"tolerance\": 1e-12, \"max_iterations\": 100}"
+#define ENTRY_A "{\"feather\": " BLUE ", \"position\": [-0.4, 0.1, 0]}"
+#define ENTRY_B                                                                                                        \
+	"{\"feather\": " HAWK ", \"position\": [0.4, 0, 0.2], \"rotation_axis\": [1, 1, 0], \"rotation_deg\": 40, "        \
+	"\"mesh\": {\"edge_length\": 0.012}}"
+
+/// Issue 14: feathers that never touch move as when simulated one by one. Two feathers
+/// 0.8 m apart (no contact, no shared vertex) in one simulation against each alone (with
+/// the same placement and mesh), every step, to 1e-10 m.
+static void test_far_apart_feathers_do_not_interact(void **state)
+{
+	(void)state;
+	plume_scene *both_scene = NULL;
+	trajectory both = run_text("{\"feathers\": [" ENTRY_A ", " ENTRY_B "], " SETTINGS "}", &both_scene);
+	trajectory alone[2] = {run_text("{\"feathers\": [" ENTRY_A "], " SETTINGS "}", NULL),
+	                       run_text("{\"feathers\": [" ENTRY_B "], " SETTINGS "}", NULL)};
+	assert_int_equal(both_scene->feather_count, 2);
+	assert_int_equal(both.vertex_count, alone[0].vertex_count + alone[1].vertex_count);
+	double worst = 0, moved = 0;
+	for (int f = 0; f < 2; ++f) {
+		assert_int_equal(both.states, alone[f].states);
+		assert_int_equal(both_scene->feathers[f].vertex_count, alone[f].vertex_count);
+		int offset = both_scene->feathers[f].vertex_offset;
+		for (int s = 0; s < both.states; ++s)
+			for (int v = 0; v < alone[f].vertex_count; ++v) {
+				plume_vec3 p = both.positions[(size_t)s * (size_t)both.vertex_count + (size_t)(offset + v)];
+				plume_vec3 q = alone[f].positions[(size_t)s * (size_t)alone[f].vertex_count + (size_t)v];
+				worst = fmax(worst, plume_v3_distance(p, q));
+				moved = fmax(moved, plume_v3_distance(q, alone[f].positions[v]));
+			}
+		free(alone[f].positions);
+	}
+	printf("two feathers together against each alone: %d steps, largest difference %.3g m (largest motion %.3g m)\n",
+	       both.states - 1, worst, moved);
+	assert_int_equal(both.states, 7);
+	assert_true(moved > 1e-4); // they do move: the comparison means something
+	assert_true(worst <= 1e-10);
+	free(both.positions);
+	plume_scene_destroy(both_scene);
+	assert_int_equal(plume_bytes_in_use(), 0);
+}
+
+/// A one-entry "feathers" list at the origin is the "feather" scene: same mesh, same steps.
+static void test_one_entry_list_is_the_single_feather_scene(void **state)
+{
+	(void)state;
+	trajectory listed = run_text("{\"feathers\": [{\"feather\": " BLUE "}], " SETTINGS "}", NULL);
+	trajectory single = run_text("{\"feather\": " BLUE ", " SETTINGS "}", NULL);
+	assert_int_equal(listed.vertex_count, single.vertex_count);
+	assert_int_equal(listed.states, single.states);
+	size_t n = (size_t)listed.states * (size_t)listed.vertex_count;
+	assert_memory_equal(listed.positions, single.positions, n * sizeof(plume_vec3));
+	free(listed.positions);
+	free(single.positions);
+	assert_int_equal(plume_bytes_in_use(), 0);
+}
+
+static plume_mesh *square_mesh(double size)
+{
+	plume_mesh *mesh = plume_mesh_create(4, 2);
+	plume_vec2 corners[4] = {{0, 0}, {size, 0}, {size, size}, {0, size}};
+	int faces[6] = {0, 1, 2, 0, 2, 3};
+	for (int v = 0; v < 4; ++v) {
+		mesh->reference[v] = corners[v];
+		mesh->rest[v] = plume_v3(corners[v].x, corners[v].y, 0.25 * v);
+		mesh->uv[v] = (plume_vec2){0.1 * v, 0.2 * v};
+	}
+	memcpy(mesh->faces, faces, sizeof faces);
+	mesh->material[1] = PLUME_MATERIAL_RACHIS;
+	mesh->barb_angle[0] = 0.5;
+	mesh->barb_edge[0] = 0;
+	plume_error err = {0};
+	assert_int_equal(plume_mesh_collect_barb_edges(mesh, &err), PLUME_OK);
+	int base[2] = {0, 1}, tip[1] = {3};
+	assert_int_equal(plume_mesh_add_group(mesh, "rachis_clamp", base, 2, &err), PLUME_OK);
+	assert_int_equal(plume_mesh_add_group(mesh, "rachis_tip", tip, 1, &err), PLUME_OK);
+	return mesh;
+}
+
+/// plume_mesh_concatenate against the parts, entry by entry: counts add up, faces and barb
+/// edges are offset, rest positions placed by R p + T (computed here by hand), groups kept
+/// under their prefix and joined under their own name.
+static void test_mesh_concatenate(void **state)
+{
+	(void)state;
+	plume_mesh *a = square_mesh(1), *b = square_mesh(2);
+	int extra[1] = {2};
+	plume_error err = {0};
+	assert_int_equal(plume_mesh_add_group(b, "left_edge", extra, 1, &err), PLUME_OK);
+	// A quarter turn about z: (x, y, z) -> (-y, x, z).
+	plume_mat3 quarter = {{{0, -1, 0}, {1, 0, 0}, {0, 0, 1}}};
+	plume_mesh_part parts[2] = {{a, plume_m3_identity(), {0, 0, 0}, "f0"}, {b, quarter, {10, 20, 30}, "f1"}};
+	plume_mesh *mesh = NULL;
+	assert_int_equal(plume_mesh_concatenate(parts, 2, &mesh, &err), PLUME_OK);
+	assert_int_equal(mesh->vertex_count, 8);
+	assert_int_equal(mesh->face_count, 4);
+	assert_int_equal(mesh->barb_edge_count, 2);
+	assert_int_equal(mesh->barb_edges[2], b->barb_edges[0] + 4);
+	assert_int_equal(mesh->faces[9], 4); // b's face {0, 2, 3} after a's 4 vertices
+	assert_int_equal(mesh->faces[10], 6);
+	assert_int_equal(mesh->faces[11], 7);
+	assert_int_equal(mesh->material[3], PLUME_MATERIAL_RACHIS);
+	assert_close(mesh->barb_angle[2], 0.5, 0);
+	assert_int_equal(mesh->barb_edge[2], 0);
+	for (int v = 0; v < 4; ++v) {
+		assert_memory_equal(&mesh->rest[v], &a->rest[v], sizeof(plume_vec3));
+		plume_vec3 p = b->rest[v];
+		assert_close(mesh->rest[4 + v].x, -p.y + 10, 1e-15);
+		assert_close(mesh->rest[4 + v].y, p.x + 20, 1e-15);
+		assert_close(mesh->rest[4 + v].z, p.z + 30, 1e-15);
+		assert_memory_equal(&mesh->reference[4 + v], &b->reference[v], sizeof(plume_vec2)); // material plane kept
+		assert_memory_equal(&mesh->uv[4 + v], &b->uv[v], sizeof(plume_vec2));
+	}
+	// rachis_clamp, rachis_tip, left_edge joined, then f0/ and f1/ groups.
+	assert_int_equal(mesh->group_count, 3 + 2 + 3);
+	const plume_vertex_group *all = plume_mesh_find_group(mesh, "rachis_clamp");
+	assert_non_null(all);
+	assert_int_equal(all->count, 4);
+	int expected[4] = {0, 1, 4, 5};
+	assert_memory_equal(all->vertices, expected, sizeof expected);
+	const plume_vertex_group *left = plume_mesh_find_group(mesh, "left_edge");
+	assert_int_equal(left->count, 1);
+	assert_int_equal(left->vertices[0], 6);
+	const plume_vertex_group *own = plume_mesh_find_group(mesh, "f1/rachis_tip");
+	assert_non_null(own);
+	assert_int_equal(own->count, 1);
+	assert_int_equal(own->vertices[0], 7);
+	assert_non_null(plume_mesh_find_group(mesh, "f0/rachis_clamp"));
+	assert_null(plume_mesh_find_group(mesh, "f0/left_edge"));
+	plume_mesh_destroy(mesh);
+	// Prefixes that collide, or names past 31 bytes, are refused.
+	parts[1].prefix = "f0";
+	assert_int_equal(plume_mesh_concatenate(parts, 2, &mesh, &err), PLUME_ERROR_SPEC);
+	assert_non_null(strstr(err.message, "share the group prefix \"f0\""));
+	parts[1].prefix = "a_prefix_much_too_long_for";
+	assert_int_equal(plume_mesh_concatenate(parts, 2, &mesh, &err), PLUME_ERROR_SPEC);
+	assert_non_null(strstr(err.message, "longer than 31 bytes"));
+	assert_null(mesh);
+	// Group "tip/a" of part "x" and group "a" of part "x/tip" would both be "x/tip/a".
+	int one[1] = {0};
+	assert_int_equal(plume_mesh_add_group(a, "tip/a", one, 1, &err), PLUME_OK);
+	assert_int_equal(plume_mesh_add_group(b, "a", one, 1, &err), PLUME_OK);
+	parts[0].prefix = "x";
+	parts[1].prefix = "x/tip";
+	assert_int_equal(plume_mesh_concatenate(parts, 2, &mesh, &err), PLUME_ERROR_SPEC);
+	assert_non_null(strstr(err.message, "two vertex groups would be named \"x/tip/a\""));
+	assert_null(mesh);
+	plume_mesh_destroy(a);
+	plume_mesh_destroy(b);
+	assert_int_equal(plume_bytes_in_use(), 0);
+}
+
+/// A handle on "f1/rachis_clamp" holds only the second feather: the first one falls freely.
+static void test_prefixed_group_handle(void **state)
+{
+	(void)state;
+	plume_scene *scene = NULL;
+	trajectory path = run_text("{\"feathers\": [" ENTRY_A ", " ENTRY_B "], "
+	                           "\"mesh\": {\"edge_length\": 0.01, \"rachis_width_base\": 0.006, \"rachis_width_tip\": "
+	                           "0.003}, \"handles\": [{\"group\": \"f1/rachis_clamp\"}], \"gravity\": [0, 0, -9.81], "
+	                           "\"duration\": 0.022}",
+	                           &scene);
+	const plume_vertex_group *held = plume_mesh_find_group(scene->mesh, "f1/rachis_clamp");
+	const plume_vertex_group *free_clamp = plume_mesh_find_group(scene->mesh, "f0/rachis_clamp");
+	const plume_vertex_group *both = plume_mesh_find_group(scene->mesh, "rachis_clamp");
+	assert_non_null(held);
+	assert_non_null(free_clamp);
+	assert_int_equal(both->count, held->count + free_clamp->count);
+	const plume_vec3 *last = path.positions + (size_t)(path.states - 1) * (size_t)path.vertex_count;
+	for (int i = 0; i < held->count; ++i)
+		assert_memory_equal(&last[held->vertices[i]], &scene->mesh->rest[held->vertices[i]], sizeof(plume_vec3));
+	// The free feather falls with the gravity's acceleration as a whole (no drag): its clamp's
+	// drop after 2 steps is of the order of g t^2 / 2 = 2.4 mm.
+	for (int i = 0; i < free_clamp->count; ++i) {
+		int v = free_clamp->vertices[i];
+		double drop = scene->mesh->rest[v].z - last[v].z;
+		assert_true(drop > 1e-3 && drop < 5e-3);
+	}
+	free(path.positions);
+	plume_scene_destroy(scene);
+	assert_int_equal(plume_bytes_in_use(), 0);
+}
+
+/// A coat's feathers become entries: each meshed feather starts at its coat follicle.
+static void test_coat_entry(void **state)
+{
+	(void)state;
+	plume_scene *scene = load_text("{\"feathers\": [{\"coat\": \"" PLUME_SOURCE_DIR
+	                               "/examples/coats/figure15-hexagonal.json\"}], \"mesh\": {\"edge_length\": 0.004, "
+	                               "\"rachis_width_base\": 0.001, \"rachis_width_tip\": 0.0005}}");
+	plume_spec_options options = {0};
+	plume_coat *coat = NULL;
+	plume_error err = {0};
+	assert_int_equal(
+	    plume_coat_spec_generate(PLUME_SOURCE_DIR "/examples/coats/figure15-hexagonal.json", &options, &coat, &err),
+	    PLUME_OK);
+	assert_int_equal(scene->feather_count, plume_coat_feather_count(coat));
+	double worst = 0, worst_tip = 0;
+	int vertices = 0;
+	for (int k = 0; k < scene->feather_count; ++k) {
+		char name[48];
+		snprintf(name, sizeof name, "f%d/rachis_base", k);
+		const plume_vertex_group *base = plume_mesh_find_group(scene->mesh, name);
+		assert_non_null(base);
+		plume_vec3 centre = {0, 0, 0}, root, normal;
+		for (int i = 0; i < base->count; ++i)
+			centre = plume_v3_add(centre, plume_v3_scale(scene->mesh->rest[base->vertices[i]], 1.0 / base->count));
+		plume_coat_follicle(coat, k, &root, &normal);
+		worst = fmax(worst, plume_v3_distance(centre, root));
+		// The rotation too: the rachis tip row lies at the coat feather's shaft tip.
+		snprintf(name, sizeof name, "f%d/rachis_tip", k);
+		const plume_vertex_group *tip = plume_mesh_find_group(scene->mesh, name);
+		centre = plume_v3(0, 0, 0);
+		for (int i = 0; i < tip->count; ++i)
+			centre = plume_v3_add(centre, plume_v3_scale(scene->mesh->rest[tip->vertices[i]], 1.0 / tip->count));
+		const plume_feather *feather = plume_coat_feather(coat, k);
+		plume_vec3 shaft_tip =
+		    plume_feather_shaft(feather)[plume_feather_get_info(feather).shaft_sample_count - 1].position;
+		worst_tip = fmax(worst_tip, plume_v3_distance(centre, shaft_tip));
+		assert_int_equal(scene->feathers[k].vertex_offset, vertices);
+		vertices += scene->feathers[k].vertex_count;
+	}
+	assert_int_equal(vertices, scene->mesh->vertex_count);
+	printf("coat of %d feathers, %d vertices: the rachis base is at most %.3g m from its follicle, the rachis tip "
+	       "%.3g m from the shaft's tip\n",
+	       scene->feather_count, vertices, worst, worst_tip);
+	assert_true(worst < 1e-3);
+	assert_true(worst_tip < 2e-3);
+	plume_coat_destroy(coat);
+	plume_scene_destroy(scene);
+	assert_int_equal(plume_bytes_in_use(), 0);
+}
+
+/// A sphere of radius 5 cm turning about z (30 degrees in 0.1 s) with a bone "crest" at its top
+/// that nods about x (-20 degrees in 0.1 s); one feather rides on the crest, one on the body
+/// as a whole (on its bottom pole). Their calamus vertices must follow, at every step,
+/// Rz(theta) Rx(phi) (x - h) + h for the crest and Rz(theta) x for the body, computed here.
+#define BODY                                                                                                           \
+	"\"body\": {\"mesh\": {\"shape\": \"ellipsoid\", \"center\": [0, 0, 0], \"radii\": [0.05, 0.05, 0.05], "           \
+	"\"segments\": 16}, \"keyframes\": [{\"time\": 0}, {\"time\": 0.1, \"rotation_axis\": [0, 0, 1], "                 \
+	"\"rotation_deg\": 30}], \"bones\": [{\"name\": \"crest\", \"head\": [0, 0, 0.05], \"keyframes\": [{\"time\": "    \
+	"0}, "                                                                                                             \
+	"{\"time\": 0.1, \"rotation_axis\": [1, 0, 0], \"rotation_deg\": -20}]}]}"
+
+static plume_vec3 turn_z(plume_vec3 p, double angle)
+{
+	return plume_v3(cos(angle) * p.x - sin(angle) * p.y, sin(angle) * p.x + cos(angle) * p.y, p.z);
+}
+
+static plume_vec3 turn_x(plume_vec3 p, double angle)
+{
+	return plume_v3(p.x, cos(angle) * p.y - sin(angle) * p.z, sin(angle) * p.y + cos(angle) * p.z);
+}
+
+static void test_follicles_follow_the_body(void **state)
+{
+	(void)state;
+	plume_scene *scene = NULL;
+	trajectory path = run_text("{" BODY ", \"feathers\": [{\"feather\": " BLUE ", \"position\": [0, 0, 0.05], "
+	                           "\"follicle\": {\"bone\": \"crest\"}}, {\"feather\": " BLUE
+	                           ", \"position\": [0, 0, -0.05], \"rotation_axis\": [1, 0, 0], \"rotation_deg\": 180, "
+	                           "\"follicle\": {}}], \"mesh\": {\"edge_length\": 0.01}, \"gravity\": [0, 0, -9.81], "
+	                           "\"duration\": 0.121}",
+	                           &scene);
+	assert_non_null(scene->body);
+	assert_int_equal(scene->feathers[0].bone, 0);
+	assert_int_equal(scene->feathers[1].bone, -1); // the body as a whole
+	const plume_vertex_group *clamps[2] = {plume_mesh_find_group(scene->mesh, "f0/rachis_clamp"),
+	                                       plume_mesh_find_group(scene->mesh, "f1/rachis_clamp")};
+	const double degree = acos(-1.0) / 180, dt = scene->sim.time_step;
+	double worst = 0;
+	assert_int_equal(path.states, 12);
+	for (int s = 0; s < path.states; ++s) {
+		double t = s * dt, key = fmin(t / 0.1, 1.0); // linear keys, held after the last
+		const plume_vec3 *x = path.positions + (size_t)s * (size_t)path.vertex_count;
+		for (int f = 0; f < 2; ++f)
+			for (int i = 0; i < clamps[f]->count; ++i) {
+				int v = clamps[f]->vertices[i];
+				plume_vec3 rest = scene->mesh->rest[v], expected;
+				if (f == 0) {
+					plume_vec3 head = plume_v3(0, 0, 0.05);
+					expected = turn_z(plume_v3_add(turn_x(plume_v3_sub(rest, head), -20 * degree * key), head),
+					                  30 * degree * key);
+				} else {
+					expected = turn_z(rest, 30 * degree * key);
+				}
+				worst = fmax(worst, plume_v3_distance(x[v], expected));
+			}
+	}
+	printf("calamus vertices against the body's motion computed by hand: largest difference %.3g m\n", worst);
+	assert_true(worst < 1e-12);
+	free(path.positions);
+	plume_scene_destroy(scene);
+	assert_int_equal(plume_bytes_in_use(), 0);
+}
+
+/// Feathers that pass through each other at rest are refused with the pair and where
+/// (plume_find_intersections, exact); one 1 mm above the other is fine.
+static void test_rest_intersections(void **state)
+{
+	(void)state;
+	plume_scene *scene = load_text("{\"feathers\": [{\"feather\": " HAWK "}, {\"feather\": " HAWK
+	                               ", \"position\": [0, 0, 0.001]}], \"mesh\": {\"edge_length\": 0.01}}");
+	assert_int_equal(scene->feather_count, 2);
+	plume_scene_destroy(scene);
+	// The second one turned a quarter about its shaft (+y) and lifted 5 cm along it: the two
+	// vanes cross along the shaft line x = z = 0, from y = 5 cm up.
+	char dir[512], path[1024];
+	test_make_temp_dir(dir, sizeof dir);
+	snprintf(path, sizeof path, "%s/scene.json", dir);
+	test_write_file(path, "{\"feathers\": [{\"feather\": " HAWK "}, {\"feather\": " HAWK
+	                      ", \"name\": \"crossed\", \"position\": [0, 0.05, 0], \"rotation_axis\": [0, 1, 0], "
+	                      "\"rotation_deg\": 90}], \"mesh\": {\"edge_length\": 0.01}}");
+	plume_error err = {0};
+	assert_int_equal(plume_scene_load(path, NULL, &scene, &err), PLUME_ERROR_SPEC);
+	assert_null(scene);
+	printf("%s\n", err.message);
+	assert_non_null(strstr(err.message, "$.feathers: feathers \"f0\" and \"crossed\" intersect at rest: face "));
+	double x, y, z;
+	const char *near = strstr(err.message, "near (");
+	assert_non_null(near);
+	assert_int_equal(sscanf(near, "near (%lf, %lf, %lf)", &x, &y, &z), 3);
+	// The midpoint of two crossing faces' centroids: within an edge length of the crossing line.
+	assert_true(fabs(x) < 0.01 && fabs(z) < 0.01 && y > 0.04);
+	test_remove_tree(dir);
+	assert_int_equal(plume_bytes_in_use(), 0);
+}
+
+/// "shaft" and "front" place a feather as the rotation that takes +y and +z to them: shaft +z,
+/// front -y is a quarter turn about +x (y -> z, z -> -y), written the other way.
+static void test_shaft_and_front(void **state)
+{
+	(void)state;
+	plume_scene *turned = load_text("{\"feathers\": [{\"feather\": " BLUE ", \"position\": [0.1, 0.2, 0.3], "
+	                                "\"rotation_axis\": [1, 0, 0], \"rotation_deg\": 90}]}");
+	plume_scene *framed = load_text("{\"feathers\": [{\"feather\": " BLUE ", \"position\": [0.1, 0.2, 0.3], "
+	                                "\"shaft\": [0, 0, 2], \"front\": [0, -1, 0.5]}]}");
+	assert_int_equal(turned->mesh->vertex_count, framed->mesh->vertex_count);
+	double worst = 0;
+	for (int v = 0; v < turned->mesh->vertex_count; ++v)
+		worst = fmax(worst, plume_v3_distance(turned->mesh->rest[v], framed->mesh->rest[v]));
+	assert_true(worst < 1e-15);
+	plume_scene_destroy(turned);
+	plume_scene_destroy(framed);
+	assert_int_equal(plume_bytes_in_use(), 0);
+}
+
 static void expect_error(const char *text, plume_status status, const char *message)
 {
 	char dir[512], path[1024];
@@ -141,7 +546,8 @@ static void test_bad_scenes(void **state)
 	expect_error("{" FEATHER ", \"materials\": {\"rachis\": {\"thickness\": 0}}}", PLUME_ERROR_SPEC,
 	             "$.materials.rachis.thickness is 0, allowed [1e-09, 1] m");
 	expect_error("{" FEATHER ", \"time_step\": 0}", PLUME_ERROR_SPEC, "$.time_step is 0, allowed [1e-09, 100] s");
-	expect_error("{" FEATHER ", \"time_step\": -0.01}", PLUME_ERROR_SPEC, "$.time_step is -0.01, allowed [1e-09, 100] s");
+	expect_error("{" FEATHER ", \"time_step\": -0.01}", PLUME_ERROR_SPEC,
+	             "$.time_step is -0.01, allowed [1e-09, 100] s");
 	expect_error("{" FEATHER ", \"materials\": {\"vane\": {\"model\": \"orthotropc\"}}}", PLUME_ERROR_SPEC,
 	             "did you mean \"orthotropic\"?");
 	expect_error("{" FEATHER ", \"duraton\": 1}", PLUME_ERROR_SPEC, "duration");
@@ -153,6 +559,60 @@ static void test_bad_scenes(void **state)
 	             "$.bending: unknown value \"paper_hinge\"; did you mean \"paper-hinge\"? (allowed: fundamental-form, "
 	             "paper-hinge)");
 	expect_error("{" FEATHER ", \"bending\": 1}", PLUME_ERROR_SPEC, "$.bending");
+	// Many feathers.
+	expect_error("{\"feathers\": [{\"feather\": " BLUE ", \"name\": \"wing\"}, {\"feather\": " BLUE
+	             ", \"name\": \"wing\"}]}",
+	             PLUME_ERROR_SPEC,
+	             "$.feathers[1]: the feather name \"wing\" is also the name of $.feathers[0]; names must differ");
+	expect_error("{\"feathers\": [{\"feather\": " BLUE "}, {\"feather\": " BLUE ", \"name\": \"f0\"}]}",
+	             PLUME_ERROR_SPEC, "$.feathers[1]: the feather name \"f0\" is also the name of $.feathers[0]");
+	expect_error("{\"feathers\": [{\"feather\": " BLUE ", \"name\": \"a/b\"}]}", PLUME_ERROR_SPEC,
+	             "$.feathers[0].name: \"a/b\" is not a feather name");
+	expect_error("{\"feathers\": [], \"feather\": " BLUE "}", PLUME_ERROR_SPEC,
+	             "exactly one of \"feather\" (a feather spec), \"feathers\"");
+	expect_error("{\"feathers\": []}", PLUME_ERROR_SPEC, "$.feathers: is empty");
+	expect_error("{\"feathers\": [{\"position\": [0, 0, 0]}]}", PLUME_ERROR_SPEC,
+	             "$.feathers[0]: an entry needs exactly one of \"feather\"");
+	expect_error("{\"feathers\": [{\"feather\": " BLUE ", \"positon\": [0, 0, 0]}]}", PLUME_ERROR_SPEC,
+	             "did you mean \"position\"");
+	expect_error("{\"feathers\": [{\"feather\": " BLUE ", \"rotation_deg\": 10, \"rotation_axis\": [0, 0, 0]}]}",
+	             PLUME_ERROR_SPEC, "$.feathers[0].rotation_axis: is the zero vector");
+	expect_error("{\"feathers\": [{\"feather\": " BLUE "}, {\"feather\": " BLUE
+	             ", \"position\": [0.1, 0, 0]}], \"handles\": [{\"group\": \"f2/rachis_clamp\"}]}",
+	             PLUME_ERROR_SPEC, "$.handles[0].group: unknown vertex group \"f2/rachis_clamp\"");
+	expect_error("{\"feathers\": [{\"feather\": " BLUE ", \"follicle\": {\"bone\": \"wrist\"}}]}", PLUME_ERROR_SPEC,
+	             "$.feathers[0].follicle: the scene has no \"body\" to carry feather \"f0\"");
+	expect_error("{" BODY ", \"feathers\": [{\"feather\": " BLUE ", \"position\": [0, 0, 0.06], \"follicle\": {}}]}",
+	             PLUME_ERROR_SPEC,
+	             "$.feathers[0].follicle: feather \"f0\"'s follicle (0, 0, 0.06) is 0.01 m from the body's rest "
+	             "surface; allowed at most 0.001 m");
+	expect_error("{" BODY ", \"feathers\": [{\"feather\": " BLUE
+	             ", \"position\": [0, 0, 0.05], \"follicle\": {\"bone\": \"cret\"}}]}",
+	             PLUME_ERROR_SPEC,
+	             "$.feathers[0].follicle.bone: unknown bone \"cret\"; did you mean \"crest\"? (the body has: crest)");
+	expect_error("{" BODY ", \"feathers\": [{\"feather\": " BLUE
+	             ", \"position\": [0, 0, 0.05], \"follicle\": {}}], \"handles\": [{\"group\": \"rachis_clamp\"}]}",
+	             PLUME_ERROR_SPEC, "$.handles[0].group: \"rachis_clamp\" holds feather \"f0\"'s calamus");
+	expect_error("{\"body\": {\"mesh\": {\"shape\": \"ellipsoid\", \"radii\": [0.05, -1, 0.05]}}, \"feather\": " BLUE
+	             "}",
+	             PLUME_ERROR_SPEC, "$.body.mesh.radii");
+	// Into the body: turned to point its shaft down (-z) from the top pole, through the sphere.
+	expect_error("{" BODY ", \"feathers\": [{\"feather\": " BLUE
+	             ", \"position\": [0, 0, 0.05], \"rotation_axis\": [1, 0, 0], \"rotation_deg\": -90, \"follicle\": "
+	             "{}}]}",
+	             PLUME_ERROR_SPEC, "$.feathers: feather \"f0\" passes through the body at rest: its face ");
+	// Touching counts: a feather on the body that the body does not carry touches it at its calamus.
+	expect_error("{" BODY ", \"feathers\": [{\"feather\": " BLUE ", \"position\": [0, 0, 0.05]}]}", PLUME_ERROR_SPEC,
+	             "$.feathers: feather \"f0\" passes through the body at rest");
+	expect_error("{\"feathers\": [{\"feather\": " BLUE ", \"shaft\": [0, 0, 1], \"front\": [0, 0, -2]}]}",
+	             PLUME_ERROR_SPEC, "$.feathers[0].front: is along the shaft (or zero)");
+	expect_error("{\"feathers\": [{\"feather\": " BLUE ", \"shaft\": [0, 0, 1]}]}", PLUME_ERROR_SPEC,
+	             "$.feathers[0]: a feather is turned by \"shaft\" and \"front\" together");
+	expect_error("{\"feathers\": [{\"feather\": " BLUE
+	             ", \"shaft\": [0, 0, 1], \"front\": [0, 1, 0], \"rotation_deg\": 5}]}",
+	             PLUME_ERROR_SPEC, "or by \"rotation_axis\" and \"rotation_deg\", not both");
+	expect_error("{\"feathers\": [{\"coat\": \"missing-coat.json\"}]}", PLUME_ERROR_IO, "$.feathers[0].coat");
+	expect_error("{" FEATHER ", \"cycle_period\": 0}", PLUME_ERROR_SPEC, "$.cycle_period: is 0, allowed > 0");
 }
 
 /// "bending": a model's name selects it (and bending stays on); true/false switch it.
@@ -186,6 +646,14 @@ int main(void)
 	    cmocka_unit_test(test_bad_scenes),
 	    cmocka_unit_test(test_bending_key),
 	    cmocka_unit_test(test_figure1_anisotropic_bends_the_rachis),
+	    cmocka_unit_test(test_mesh_concatenate),
+	    cmocka_unit_test(test_one_entry_list_is_the_single_feather_scene),
+	    cmocka_unit_test(test_far_apart_feathers_do_not_interact),
+	    cmocka_unit_test(test_prefixed_group_handle),
+	    cmocka_unit_test(test_coat_entry),
+	    cmocka_unit_test(test_follicles_follow_the_body),
+	    cmocka_unit_test(test_rest_intersections),
+	    cmocka_unit_test(test_shaft_and_front),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -36,6 +36,10 @@ const plume_feather *plume_coat_feather(const plume_coat *coat, int index);
 /// The follicle of feather index: its root on the surface and the surface's outward unit normal there.
 void plume_coat_follicle(const plume_coat *coat, int index, plume_vec3 *position, plume_vec3 *normal);
 
+/// The rigid motion that placed feather index: its points are rotation * (the point in the
+/// feather's own frame, docs/feather-json.md) + origin; origin is the follicle.
+void plume_coat_feather_frame(const plume_coat *coat, int index, plume_mat3 *rotation, plume_vec3 *origin);
+
 /// True when feather index is one of the key feathers (placed as designed, not interpolated).
 bool plume_coat_is_key(const plume_coat *coat, int index);
 

@@ -195,6 +195,26 @@ plume_status plume_mesh_add_group(plume_mesh *mesh, const char *name, const int 
 plume_status plume_mesh_add_group_near(plume_mesh *mesh, const char *name, const char *source, plume_vec2 near,
                                        double radius, plume_error *err);
 
+/// One piece of plume_mesh_concatenate: a mesh and the rigid placement of its rest shape.
+typedef struct plume_mesh_part {
+	const plume_mesh *mesh;
+	/// Rest positions go to rotation * rest + translation (a rotation: orthonormal, det +1).
+	/// reference and uv are material coordinates and stay as they are.
+	plume_mat3 rotation;
+	plume_vec3 translation;
+	/// Prefix of this part's vertex groups: "f3" names group "rachis_clamp" "f3/rachis_clamp".
+	const char *prefix;
+} plume_mesh_part;
+
+/// One mesh of the parts, back to back: part i's vertices follow part i-1's, its faces and
+/// barb edges are offset accordingly, its rest positions placed by its rigid motion. Vertex
+/// groups: first one group per name found in any part holding that name's vertices of every
+/// part (in part order: "rachis_clamp" is every part's clamp), then each part's own groups
+/// as "prefix/name". PLUME_ERROR_SPEC when a prefixed name passes 31 bytes, two prefixes are
+/// equal or two groups would share a name; PLUME_ERROR_LIMIT when the counts overflow an int;
+/// PLUME_ERROR_MEMORY. Time O(n log n) in the number of groups.
+plume_status plume_mesh_concatenate(const plume_mesh_part *parts, int count, plume_mesh **out, plume_error *err);
+
 /// Rebuilds barb_edges from the faces' barb_edge marks (unique edges, sorted).
 plume_status plume_mesh_collect_barb_edges(plume_mesh *mesh, plume_error *err);
 

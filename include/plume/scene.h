@@ -13,6 +13,12 @@ extern "C" {
 #endif
 PLUME_API_BEGIN
 
+typedef struct plume_body plume_body; // plume/body.h
+
+/// A follicle may lie this far from the body's rest surface, m: feathers are attached at their
+/// calamus, on the skin (docs/scene.md "Bodies").
+#define PLUME_SCENE_FOLLICLE_TOLERANCE 1e-3
+
 /// One key of a handle's scripted motion: at `time` the handle's vertices are at
 /// rotation(axis, angle) (rest - pivot) + pivot + translation.
 typedef struct plume_keyframe {
@@ -51,14 +57,51 @@ typedef struct plume_scene_force {
 	plume_vec3 force;
 } plume_scene_force;
 
+/// One feather of a scene (docs/scene.md "Many feathers"): where its piece of the scene's
+/// mesh is, how it was placed and what holds it.
+typedef struct plume_scene_feather {
+	/// Its name and the prefix of its vertex groups ("f3": "f3/rachis_clamp"); "f<index>"
+	/// unless the scene names it. Letters, digits, '-' and '_', at most 15 bytes.
+	char name[16];
+	/// The feather at rest, placed (world coordinates, like its rest mesh); NULL for guides.
+	plume_feather *feather;
+	/// The placement of the feather's own frame (docs/feather-json.md): world = rotation * own
+	/// + translation. Identity for a one-feather scene written with "feather".
+	plume_mat3 rotation;
+	plume_vec3 translation;
+	/// Its vertices and faces in the scene's mesh: [offset, offset + count).
+	int vertex_offset;
+	int vertex_count;
+	int face_offset;
+	int face_count;
+	plume_mesh_report mesh_report;
+	/// Carried by the body at its calamus ("follicle"): its rachis_clamp group follows
+	/// bone `bone` of the body (-1: the body's motion as a whole).
+	bool follicle;
+	/// The bone's name as the scene gives it ("": the body as a whole) and its index.
+	char bone_name[32];
+	int bone;
+	/// The follicle at rest, m: where the feather's own origin (the calamus) is placed.
+	plume_vec3 follicle_point;
+} plume_scene_feather;
+
 /// The most steps one scene may take (duration / time_step): the count is an int.
 #define PLUME_SCENE_MAX_STEPS 10000000
 
 typedef struct plume_scene {
-	/// The generated feather (NULL when the scene gives explicit guides).
+	/// The generated feather of a scene written with "feather" (an alias of feathers[0].feather);
+	/// NULL when the scene gives explicit guides or lists "feathers".
 	plume_feather *feather;
+	/// Every feather's mesh, one after the other (plume_mesh_concatenate); for a scene written
+	/// with "feather" or "guides", that feather's mesh as the mesher made it.
 	plume_mesh *mesh;
+	/// The worst over the feathers: smallest angle and aligned fraction, guides dropped summed.
 	plume_mesh_report mesh_report;
+	/// At least 1.
+	int feather_count;
+	plume_scene_feather *feathers;
+	/// The body the feathers hang on ("body"), or NULL. Its pose at time t: plume_scene_body_pose.
+	plume_body *body;
 	plume_sim_def sim;
 	int handle_count;
 	plume_scene_handle *handles;
@@ -71,21 +114,28 @@ typedef struct plume_scene {
 	/// Solve each step as a static equilibrium at the handles' positions (quasi-static
 	/// loading, no inertia) instead of implicit Euler. Default false.
 	bool quasi_static;
+	/// The period of a cyclic motion (a wing beat), s; 0 when the scene is not cyclic.
+	/// Gives summary.json its seconds_per_cycle.
+	double cycle_period;
 } plume_scene;
 
 /// Reads a scene: generates its feather (seed from options or the feather spec)
-/// and meshes it. Errors name the file and the JSON path.
-plume_status plume_scene_load(const char *path, const plume_spec_options *options, plume_scene **out,
-                              plume_error *err);
+/// and meshes it. Errors name the file and the JSON path. For a scene that lists
+/// "feathers", options->progress (when set) is called after each feather is meshed.
+plume_status plume_scene_load(const char *path, const plume_spec_options *options, plume_scene **out, plume_error *err);
 /// The same from JSON text; name stands for the file in messages, and relative paths
 /// in the text are relative to the current folder.
-plume_status plume_scene_parse(const char *text, const char *name, const plume_spec_options *options,
-                               plume_scene **out, plume_error *err);
+plume_status plume_scene_parse(const char *text, const char *name, const plume_spec_options *options, plume_scene **out,
+                               plume_error *err);
 void plume_scene_destroy(plume_scene *scene);
 
 /// Where a handle is at time t: translation and rotation for plume_sim_set_handle.
-void plume_scene_handle_pose(const plume_scene_handle *handle, double t, plume_vec3 *translation,
-                             plume_mat3 *rotation);
+void plume_scene_handle_pose(const plume_scene_handle *handle, double t, plume_vec3 *translation, plume_mat3 *rotation);
+
+/// The body's vertex positions at time t (plume_body_pose) into out[plume_body_vertex_count];
+/// the scene must have a body. The run poses it at every step's time, where contact with
+/// the body takes its obstacle.
+void plume_scene_body_pose(const plume_scene *scene, double t, plume_vec3 *out);
 
 /// What a run measured.
 typedef struct plume_scene_summary {
@@ -103,6 +153,15 @@ typedef struct plume_scene_summary {
 	int vertex_count;
 	int face_count;
 	int constraint_count;
+	int feather_count;
+	/// Contact and the independent intersection check, when the run has them (contact_measured,
+	/// intersections_checked); left false and 0 otherwise, and summary.json leaves them out.
+	bool contact_measured;
+	int contact_pairs_max;
+	/// Smallest distance between contact primitives over the run, m.
+	double min_distance;
+	bool intersections_checked;
+	int intersecting_pairs;
 } plume_scene_summary;
 
 /// Called after the initial state (step 0, report NULL) and after every step.

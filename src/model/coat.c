@@ -18,6 +18,7 @@ struct plume_coat {
 	plume_feather **feathers; ///< drawing order
 	plume_vec3 *roots;
 	plume_vec3 *normals;
+	plume_mat3 *frames; ///< per feather: its own frame's axes as columns (x, shaft, front)
 	bool *is_key;
 	plume_mesh *surface;
 };
@@ -44,6 +45,15 @@ void plume_coat_follicle(const plume_coat *coat, int index, plume_vec3 *position
 	*normal = coat->normals[index];
 }
 
+void plume_coat_feather_frame(const plume_coat *coat, int index, plume_mat3 *rotation, plume_vec3 *origin)
+{
+	PLUME_ASSERT_HANDLE(coat);
+	PLUME_ASSERT_INDEX(index, coat->count);
+	PLUME_ASSERT(rotation != NULL && origin != NULL);
+	*rotation = coat->frames[index];
+	*origin = coat->roots[index];
+}
+
 bool plume_coat_is_key(const plume_coat *coat, int index)
 {
 	PLUME_ASSERT_HANDLE(coat);
@@ -68,6 +78,7 @@ void plume_coat_destroy(plume_coat *coat)
 	plume_free(coat->feathers);
 	plume_free(coat->roots);
 	plume_free(coat->normals);
+	plume_free(coat->frames);
 	plume_free(coat->is_key);
 	plume_mesh_destroy(coat->surface);
 	plume_free(coat);
@@ -665,9 +676,10 @@ plume_status coat_build(coat_def *def, plume_coat **out, plume_error *err)
 	coat->feathers = plume_calloc((size_t)count, sizeof *coat->feathers);
 	coat->roots = plume_alloc((size_t)count * sizeof *coat->roots);
 	coat->normals = plume_alloc((size_t)count * sizeof *coat->normals);
+	coat->frames = plume_alloc((size_t)count * sizeof *coat->frames);
 	coat->is_key = plume_calloc((size_t)count, sizeof *coat->is_key);
 	if (key_of == NULL || order == NULL || coat->feathers == NULL || coat->roots == NULL || coat->normals == NULL ||
-	    coat->is_key == NULL) {
+	    coat->frames == NULL || coat->is_key == NULL) {
 		status = plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory");
 		goto fail;
 	}
@@ -749,6 +761,10 @@ plume_status coat_build(coat_def *def, plume_coat **out, plume_error *err)
 			plume_vec3 axes[3];
 			feather_frame(def, positions[i], normals[i], axes);
 			place(feather, axes, positions[i]);
+			// The axes are the columns: rotate(axes, v) = axes[0] v.x + axes[1] v.y + axes[2] v.z.
+			coat->frames[slot] = (plume_mat3){{{axes[0].x, axes[1].x, axes[2].x},
+			                                   {axes[0].y, axes[1].y, axes[2].y},
+			                                   {axes[0].z, axes[1].z, axes[2].z}}};
 		}
 		coat->feathers[slot] = feather;
 		coat->roots[slot] = positions[i];

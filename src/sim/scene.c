@@ -1,19 +1,29 @@
 // Running a scene: handles follow their keyframes, each step is an implicit-Euler
 // step (or a static solve for quasi-static scenes), and the caller sees every step.
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 #include <omp.h>
 
+#include "../core/asserts.h"
 #include "core/alloc.h"
+#include "plume/body.h"
 #include "plume/scene.h"
 
 void plume_scene_destroy(plume_scene *scene)
 {
 	if (scene == NULL)
 		return;
-	plume_feather_destroy(scene->feather);
+	if (scene->feathers != NULL) { // scene->feather is feathers[0]'s when there is one
+		for (int i = 0; i < scene->feather_count; ++i)
+			plume_feather_destroy(scene->feathers[i].feather);
+		plume_free(scene->feathers);
+	} else {
+		plume_feather_destroy(scene->feather);
+	}
 	plume_mesh_destroy(scene->mesh);
+	plume_body_destroy(scene->body);
 	for (int h = 0; h < scene->handle_count; ++h)
 		plume_free(scene->handles[h].keyframes);
 	plume_free(scene->handles);
@@ -54,6 +64,13 @@ void plume_scene_handle_pose(const plume_scene_handle *handle, double t, plume_v
 		*rotation = plume_m3_rotation(plume_v3_normalize(pose.axis), pose.angle);
 }
 
+void plume_scene_body_pose(const plume_scene *scene, double t, plume_vec3 *out)
+{
+	PLUME_ASSERT(scene != NULL && scene->body != NULL && out != NULL);
+	plume_body_pose(scene->body, t, out);
+}
+
+/// ids: the scene's handles, then one per feather carried by a follicle (-1 for the others).
 static void pose_handles(const plume_scene *scene, plume_sim *sim, const int *ids, double t)
 {
 	for (int h = 0; h < scene->handle_count; ++h) {
@@ -62,6 +79,33 @@ static void pose_handles(const plume_scene *scene, plume_sim *sim, const int *id
 		plume_scene_handle_pose(scene->handles + h, t, &translation, &rotation);
 		plume_sim_set_handle(sim, ids[h], translation, rotation, scene->handles[h].pivot);
 	}
+	// A follicle's bone maps a rest point x to R x + T (plume_body_bone_transform); the handle
+	// maps its rest vertices to R (x - pivot) + pivot + translation: pivot 0, translation T.
+	for (int i = 0; i < scene->feather_count; ++i) {
+		int id = ids[scene->handle_count + i];
+		if (id < 0)
+			continue;
+		plume_mat3 rotation;
+		plume_vec3 translation;
+		plume_body_bone_transform(scene->body, scene->feathers[i].bone, t, &rotation, &translation);
+		plume_sim_set_handle(sim, id, translation, rotation, plume_v3(0, 0, 0));
+	}
+}
+
+/// The handles of the feathers carried by the body: each one's "NAME/rachis_clamp".
+static plume_status add_follicle_handles(const plume_scene *scene, plume_sim *sim, int *ids, plume_error *err)
+{
+	for (int i = 0; i < scene->feather_count; ++i) {
+		ids[scene->handle_count + i] = -1;
+		if (!scene->feathers[i].follicle)
+			continue;
+		char group[64];
+		snprintf(group, sizeof group, "%s/rachis_clamp", scene->feathers[i].name);
+		ids[scene->handle_count + i] = plume_sim_add_handle(sim, group, err);
+		if (ids[scene->handle_count + i] < 0)
+			return err != NULL ? err->status : PLUME_ERROR_SPEC;
+	}
+	return PLUME_OK;
 }
 
 static double rachis_tip_deflection(const plume_scene *scene, const plume_sim *sim)
@@ -86,8 +130,13 @@ plume_status plume_scene_run(const plume_scene *scene, plume_scene_step_fn *on_s
 	plume_status status = plume_sim_create(scene->mesh, &scene->sim, &sim, err);
 	if (status != PLUME_OK)
 		return status;
-	int *ids = plume_alloc(sizeof(int) * (size_t)(scene->handle_count + 1));
-	if (ids == NULL) {
+	int *ids = plume_alloc(sizeof(int) * (size_t)(scene->handle_count + scene->feather_count + 1));
+	// The body's pose at each step's time (contact takes it as an obstacle there).
+	plume_vec3 *body_positions =
+	    scene->body != NULL ? plume_alloc(sizeof(plume_vec3) * (size_t)plume_body_vertex_count(scene->body)) : NULL;
+	if (ids == NULL || (scene->body != NULL && body_positions == NULL)) {
+		plume_free(ids);
+		plume_free(body_positions);
 		plume_sim_destroy(sim);
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory starting the scene");
 	}
@@ -96,10 +145,13 @@ plume_status plume_scene_run(const plume_scene *scene, plume_scene_step_fn *on_s
 		if (ids[h] < 0)
 			status = err != NULL ? err->status : PLUME_ERROR_SPEC;
 	}
+	if (status == PLUME_OK)
+		status = add_follicle_handles(scene, sim, ids, err);
 	for (int l = 0; l < scene->force_count && status == PLUME_OK; ++l)
 		status = plume_sim_set_group_load(sim, scene->forces[l].group, scene->forces[l].force, err);
 
 	summary->vertex_count = scene->mesh->vertex_count;
+	summary->feather_count = scene->feather_count;
 	summary->face_count = scene->mesh->face_count;
 	summary->constraint_count = plume_sim_constraint_count(sim);
 	if (status == PLUME_OK && on_step != NULL)
@@ -120,6 +172,11 @@ plume_status plume_scene_run(const plume_scene *scene, plume_scene_step_fn *on_s
 	for (int n = 1; n <= steps && status == PLUME_OK; ++n) {
 		double t = n * dt;
 		pose_handles(scene, sim, ids, t);
+		// The body where it is at the end of the step: with contact, the obstacle's positions
+		// for this step (plume_sim_set_obstacle_positions; plume_sim_add_obstacle takes the
+		// pose at t = 0 when the simulation is created).
+		if (body_positions != NULL)
+			plume_scene_body_pose(scene, t, body_positions);
 		plume_solve_report report;
 		double step_start = omp_get_wtime();
 		status = scene->quasi_static ? plume_sim_solve_static(sim, &report, err) : plume_sim_step(sim, &report, err);
@@ -140,6 +197,7 @@ plume_status plume_scene_run(const plume_scene *scene, plume_scene_step_fn *on_s
 	summary->rachis_tip_deflection = rachis_tip_deflection(scene, sim);
 	summary->wall_seconds = omp_get_wtime() - start;
 	plume_free(ids);
+	plume_free(body_positions);
 	plume_sim_destroy(sim);
 	return status;
 }
