@@ -140,6 +140,11 @@ double plume_sim_potential(plume_sim *sim, const sim_problem *problem, const plu
 		evaluate_ff_faces(sim, x, want_gradient, hessian, project);
 	if (problem->dynamic && sim->air.active)
 		plume_air_add(sim, problem, x, want_gradient, hessian);
+	// Contact first: it may rebuild the matrix's pattern (contact.c).
+	bool contact = plume_contact_on(sim);
+	double contact_energy = contact ? plume_contact_evaluate(sim, x, hessian) : 0;
+	if (!isfinite(contact_energy))
+		return NAN; // out of memory, or a pair in contact: outside the barrier's domain
 
 	double *values = hessian ? plume_kkt_values(&sim->kkt) : NULL;
 	if (hessian)
@@ -204,6 +209,11 @@ double plume_sim_potential(plume_sim *sim, const sim_problem *problem, const plu
 			scatter_block(sim, values, &i, 1, sim->kkt.vertex_slots + 9 * i, block);
 	}
 
+	if (contact && sim->contact.active_count > 0) {
+		// The IPC barrier over the pairs in reach (Li et al. 2020, eq. 6), Hessian projected.
+		energy += contact_energy;
+		plume_contact_scatter(sim, gradient, values);
+	}
 	if (hessian)
 		for (int i = 0; i < 3 * n; ++i)
 			if (sim->fixed[i])
