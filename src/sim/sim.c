@@ -34,7 +34,7 @@ plume_sim_def plume_sim_default_def(void)
 	def.solver.max_substep_halvings = 4;
 	def.contact.enabled = false;
 	def.contact.distance = 1.2e-4;
-	def.contact.stiffness = 1e-3;
+	def.contact.stiffness = 1e6;
 	def.contact.self_contact = true;
 	def.contact.ccd_separation = 0.1;
 	def.cookie = PLUME_DEF_COOKIE;
