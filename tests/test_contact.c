@@ -564,12 +564,61 @@ static void test_bad_contact_input(void **state)
 	plume_mesh_destroy(mesh);
 }
 
+static plume_status parse_contact(const char *fragment, plume_scene **scene, plume_error *err)
+{
+	char text[1024];
+	snprintf(text, sizeof text,
+	         "{\"feather\": \"%s/examples/franco-walter/hawk.json\", \"mesh\": {\"edge_length\": 0.02}, "
+	         "\"contact\": %s}",
+	         PLUME_SOURCE_DIR, fragment);
+	*scene = NULL;
+	return plume_scene_parse(text, "scene.json", NULL, scene, err);
+}
+
+/// The scene's "contact" object: defaults, values, and errors naming the key and the range.
+static void test_scene_contact(void **state)
+{
+	(void)state;
+	plume_scene *scene = NULL;
+	plume_error err = {0};
+	if (parse_contact("{}", &scene, &err) != PLUME_OK)
+		fail_msg("%s", err.message);
+	assert_true(scene->sim.contact.enabled && scene->sim.contact.self_contact);
+	assert_true(scene->sim.contact.distance == 1.2e-4 && scene->sim.contact.stiffness == 1e6);
+	plume_scene_destroy(scene);
+	assert_int_equal(parse_contact("{\"distance\": 2e-4, \"stiffness\": 5e5, \"self_contact\": false, "
+	                               "\"ccd_separation\": 0.2}",
+	                               &scene, &err),
+	                 PLUME_OK);
+	assert_true(scene->sim.contact.enabled && !scene->sim.contact.self_contact);
+	assert_true(scene->sim.contact.distance == 2e-4 && scene->sim.contact.stiffness == 5e5 &&
+	            scene->sim.contact.ccd_separation == 0.2);
+	plume_scene_destroy(scene);
+	assert_int_equal(parse_contact("{\"enabled\": false}", &scene, &err), PLUME_OK);
+	assert_false(scene->sim.contact.enabled);
+	plume_scene_destroy(scene);
+	static const char *const bad[][2] = {
+	    {"{\"distance\": 0}", "$.contact.distance is 0, allowed [1e-09, 1] m"},
+	    {"{\"stiffness\": -1}", "$.contact.stiffness is -1, allowed (0, 1e30]"},
+	    {"{\"ccd_separation\": 1.5}", "$.contact.ccd_separation is 1.5, allowed (0, 1)"},
+	    {"{\"reach\": 1}", "$.contact"},
+	    {"{\"enabled\": 1}", "$.contact.enabled"},
+	};
+	for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+		assert_int_not_equal(parse_contact(bad[i][0], &scene, &err), PLUME_OK);
+		assert_null(scene);
+		if (strstr(err.message, bad[i][1]) == NULL)
+			fail_msg("expected \"%s\" in: %s", bad[i][1], err.message);
+	}
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-	    cmocka_unit_test(test_bad_contact_input),      cmocka_unit_test(test_assembled_barrier),
-	    cmocka_unit_test(test_far_apart_is_identical), cmocka_unit_test(test_press_balances_load),
-	    cmocka_unit_test(test_sheets_drop_and_stack),  cmocka_unit_test(test_strip_folds_onto_itself),
+	    cmocka_unit_test(test_scene_contact),           cmocka_unit_test(test_bad_contact_input),
+	    cmocka_unit_test(test_assembled_barrier),       cmocka_unit_test(test_far_apart_is_identical),
+	    cmocka_unit_test(test_press_balances_load),     cmocka_unit_test(test_sheets_drop_and_stack),
+	    cmocka_unit_test(test_strip_folds_onto_itself),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
