@@ -386,6 +386,44 @@ static void test_strip_folds_onto_itself(void **state)
 	plume_mesh_destroy(mesh);
 }
 
+/// The ground rises under a resting sheet and lifts it: the obstacle's prescribed motion is
+/// checked by CCD at each step's start, subdividing the first steps where it would close the
+/// gap faster than the sheet can follow.
+static void test_rising_ground_lifts_sheet(void **state)
+{
+	(void)state;
+	sheet sheets[1] = {{plume_v3(-0.01, 6e-5, -0.01), 0.02, 0.02, 5}};
+	plume_mesh *mesh = make_sheets(sheets, 1);
+	plume_sim_def def = plume_sim_default_def();
+	def.contact.enabled = true;
+	def.time_step = 0.005;
+	plume_sim *sim = NULL;
+	plume_error err = {0};
+	assert_int_equal(plume_sim_create(mesh, &def, &sim, &err), PLUME_OK);
+	int ground = add_ground(sim, 0, 0.05);
+	double speed = 0.05, rise = 0;
+	int steps = 40, substeps = 0, iterations = 0;
+	for (int step = 0; step < steps; ++step) {
+		rise = speed * def.time_step * fmin(step + 1, 30); // rises for 30 steps, then stops
+		plume_vec3 corners[4] = {plume_v3(-0.05, rise, -0.05), plume_v3(0.05, rise, -0.05), plume_v3(0.05, rise, 0.05),
+		                         plume_v3(-0.05, rise, 0.05)};
+		plume_sim_set_obstacle_positions(sim, ground, corners);
+		plume_solve_report report;
+		if (plume_sim_step(sim, &report, &err) != PLUME_OK)
+			fail_msg("step %d: %s", step, err.message);
+		check_state(sim, &report);
+		substeps = report.substeps > substeps ? report.substeps : substeps;
+		iterations += report.newton_iterations;
+	}
+	double gap = min_distance(shell_surface(sim), body_surface(sim), false);
+	printf("rising ground: %d steps, %d Newton iterations, up to %d substeps, lifted %.3g m, gap %.3g m\n", steps,
+	       iterations, substeps, mean_y(sim, 0, sim->vertex_count) - 6e-5, gap);
+	assert_true(gap > 0 && gap <= def.contact.distance);
+	assert_true(mean_y(sim, 0, sim->vertex_count) > rise);
+	plume_sim_destroy(sim);
+	plume_mesh_destroy(mesh);
+}
+
 /// Two sheets far apart: contact on and off give the same bits.
 static void test_far_apart_is_identical(void **state)
 {
@@ -618,7 +656,7 @@ int main(void)
 	    cmocka_unit_test(test_scene_contact),           cmocka_unit_test(test_bad_contact_input),
 	    cmocka_unit_test(test_assembled_barrier),       cmocka_unit_test(test_far_apart_is_identical),
 	    cmocka_unit_test(test_press_balances_load),     cmocka_unit_test(test_sheets_drop_and_stack),
-	    cmocka_unit_test(test_strip_folds_onto_itself),
+	    cmocka_unit_test(test_strip_folds_onto_itself), cmocka_unit_test(test_rising_ground_lifts_sheet),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -261,6 +261,13 @@ static bool rebuild_pattern(plume_sim *sim)
 	return status == PLUME_OK;
 }
 
+static double fail(sim_contact *contact, plume_status status, const char *message)
+{
+	contact->failure = status;
+	snprintf(contact->message, sizeof contact->message, "%s", message);
+	return NAN;
+}
+
 double plume_contact_evaluate(plume_sim *sim, const plume_vec3 *x, bool hessian)
 {
 	sim_contact *contact = &sim->contact;
@@ -268,10 +275,9 @@ double plume_contact_evaluate(plume_sim *sim, const plume_vec3 *x, bool hessian)
 	double dhat = def->distance, dhat2 = dhat * dhat;
 	contact->active_count = 0;
 	contact->min_distance = INFINITY;
-	if (!find_candidates(sim, x, x, contact->body_x, contact->body_x, dhat)) {
-		snprintf(contact->message, sizeof contact->message, "out of memory finding contact pairs");
-		return NAN;
-	}
+	contact->failure = PLUME_OK;
+	if (!find_candidates(sim, x, x, contact->body_x, contact->body_x, dhat))
+		return fail(contact, PLUME_ERROR_MEMORY, "out of memory finding contact pairs");
 	double closest = INFINITY;
 	for (int p = 0; p < contact->pair_count; ++p) {
 		sim_contact_pair *pair = contact->pairs + p;
@@ -280,10 +286,8 @@ double plume_contact_evaluate(plume_sim *sim, const plume_vec3 *x, bool hessian)
 		pair->distance2 = pair_distance2(pair, points);
 		if (pair->distance2 >= dhat2)
 			continue;
-		if (PLUME_GROW(contact->active, contact->active_capacity, contact->active_count + 1) != 0) {
-			snprintf(contact->message, sizeof contact->message, "out of memory evaluating contact pairs");
-			return NAN;
-		}
+		if (PLUME_GROW(contact->active, contact->active_capacity, contact->active_count + 1) != 0)
+			return fail(contact, PLUME_ERROR_MEMORY, "out of memory evaluating contact pairs");
 		contact->active[contact->active_count++] = p;
 		closest = fmin(closest, pair->distance2);
 	}
@@ -291,30 +295,41 @@ double plume_contact_evaluate(plume_sim *sim, const plume_vec3 *x, bool hessian)
 	if (count == 0)
 		return 0;
 	contact->min_distance = sqrt(closest);
-	if (!(closest > 0))
-		return INFINITY; // in contact: outside the barrier's domain
-	size_t capacity = (size_t)contact->active_capacity;
-	// Per-pair buffers sized with the active list's capacity: they grow with it and are reused.
-	double *energy = plume_realloc(contact->energy, sizeof(double) * capacity);
-	if (energy != NULL)
-		contact->energy = energy;
-	double *gradient = energy ? plume_realloc(contact->gradient, sizeof(double) * 12 * capacity) : NULL;
-	if (gradient != NULL)
-		contact->gradient = gradient;
-	double *block = gradient ? plume_realloc(contact->hessian, sizeof(double) * 144 * capacity) : NULL;
-	if (block == NULL) {
-		snprintf(contact->message, sizeof contact->message, "out of memory evaluating contact pairs");
-		return NAN;
+	if (!(closest > 0)) {
+		// In contact: outside the barrier's domain. A line search's trial never gets here
+		// (CCD); a start state can (a mesh or obstacle that touches itself).
+		const sim_contact_pair *pair = contact->pairs + contact->active[0];
+		for (int k = 0; k < count; ++k)
+			if (!(contact->pairs[contact->active[k]].distance2 > 0))
+				pair = contact->pairs + contact->active[k];
+		fail(contact, PLUME_ERROR_NUMERIC, "");
+		snprintf(contact->message, sizeof contact->message,
+		         "contact: surfaces touch (%s pair of vertices %d %d %d %d; numbers from %d are obstacle vertices)",
+		         pair->type == PLUME_CONTACT_POINT_TRIANGLE ? "point-triangle" : "edge-edge", pair->vertices[0],
+		         pair->vertices[1], pair->vertices[2], pair->vertices[3], sim->vertex_count);
+		return INFINITY;
 	}
-	contact->hessian = block;
+	if (count > contact->buffer_capacity) {
+		// Per-pair buffers grow with the active list's capacity and are reused.
+		size_t capacity = (size_t)contact->active_capacity;
+		double *energy = plume_realloc(contact->energy, sizeof(double) * capacity);
+		if (energy != NULL)
+			contact->energy = energy;
+		double *gradient = energy ? plume_realloc(contact->gradient, sizeof(double) * 12 * capacity) : NULL;
+		if (gradient != NULL)
+			contact->gradient = gradient;
+		double *block = gradient ? plume_realloc(contact->hessian, sizeof(double) * 144 * capacity) : NULL;
+		if (block == NULL)
+			return fail(contact, PLUME_ERROR_MEMORY, "out of memory evaluating contact pairs");
+		contact->hessian = block;
+		contact->buffer_capacity = contact->active_capacity;
+	}
 	if (hessian) {
 		bool holds = true;
 		for (int k = 0; k < count && holds; ++k)
 			holds = pattern_holds(sim, contact->pairs + contact->active[k]);
-		if (!holds && !rebuild_pattern(sim)) {
-			snprintf(contact->message, sizeof contact->message, "out of memory rebuilding the solver's pattern");
-			return NAN;
-		}
+		if (!holds && !rebuild_pattern(sim))
+			return fail(contact, PLUME_ERROR_MEMORY, "out of memory rebuilding the solver's pattern");
 	}
 	plume_vec3 *rest = sim->rest;
 #pragma omp parallel for schedule(static) if (count >= 256)

@@ -62,12 +62,15 @@ typedef struct sim_contact {
 	int active_count, active_capacity;
 	int *active;
 	double *energy, *gradient, *hessian;
+	int buffer_capacity;
 	/// The smallest pair distance of the last evaluation, m (+inf when no pair is in reach).
 	double min_distance;
 	/// Times the KKT pattern was rebuilt for new contact couplings.
 	int pattern_rebuilds;
-	/// Why the last evaluation failed (out of memory), for the caller's error.
-	char message[128];
+	/// Why the last evaluation failed (out of memory: PLUME_ERROR_MEMORY; primitives touching:
+	/// PLUME_ERROR_NUMERIC), for the caller's error; PLUME_OK when it did not.
+	plume_status failure;
+	char message[160];
 } sim_contact;
 
 bool plume_contact_init(struct plume_sim *sim);

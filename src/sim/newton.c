@@ -216,8 +216,8 @@ static plume_status newton_system(plume_sim *sim, const sim_problem *problem, bo
 	double *g = sim->gradient;
 	double t0 = omp_get_wtime();
 	*phi = plume_sim_potential(sim, problem, sim->x, g, true, !exact);
-	if (isnan(*phi) && sim->contact.message[0] != '\0')
-		return plume_error_set(err, PLUME_ERROR_MEMORY, "%s", sim->contact.message);
+	if (isnan(*phi) && plume_contact_on(sim) && sim->contact.failure != PLUME_OK)
+		return plume_error_set(err, sim->contact.failure, "%s", sim->contact.message);
 	if (isnan(*phi))
 		return plume_error_set(err, PLUME_ERROR_NUMERIC, "the potential is not finite (NaN or infinite)");
 	if (plume_contact_on(sim)) {
@@ -342,7 +342,6 @@ plume_status plume_sim_newton(plume_sim *sim, const sim_problem *problem, plume_
 		double bound = 1;
 		if (contact) {
 			apply_step(sim, x, step, 1, sim->trial);
-			sim->contact.message[0] = '\0';
 			bound = plume_contact_step_bound(sim, x, sim->trial, sim->contact.body_x, sim->contact.body_x);
 			if (isnan(bound))
 				return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory finding contact pairs");
