@@ -129,12 +129,15 @@ static bool fill_tree(sim_contact *contact, int tree, const int *indices, int si
 	return plume_bvh_create(contact->boxes, count, &contact->trees[tree], NULL) == PLUME_OK;
 }
 
-static bool push_pair(sim_contact *contact, plume_contact_pair_type type, int a, int b, int c, int d)
+/// Room for every overlap of the last query (one growth per query, not per pair).
+static bool reserve_pairs(sim_contact *contact)
 {
-	if (PLUME_GROW(contact->pairs, contact->pair_capacity, contact->pair_count + 1) != 0)
-		return false;
+	return PLUME_GROW(contact->pairs, contact->pair_capacity, contact->pair_count + contact->overlaps.count + 1) == 0;
+}
+
+static void push_pair(sim_contact *contact, plume_contact_pair_type type, int a, int b, int c, int d)
+{
 	contact->pairs[contact->pair_count++] = (sim_contact_pair){type, {a, b, c, d}, INFINITY};
-	return true;
 }
 
 /// Point-triangle candidates: points of tree `points` (indices `point_index`, offset into
@@ -146,7 +149,8 @@ static bool query_point_triangle(sim_contact *contact, int points, int point_off
 	contact->overlaps.count = 0;
 	if (contact->tree_size[points] == 0 || contact->tree_size[faces] == 0)
 		return true;
-	if (plume_bvh_overlaps(contact->trees[points], contact->trees[faces], &contact->overlaps, NULL) != PLUME_OK)
+	if (plume_bvh_overlaps(contact->trees[points], contact->trees[faces], &contact->overlaps, NULL) != PLUME_OK ||
+	    !reserve_pairs(contact))
 		return false;
 	for (int k = 0; k < contact->overlaps.count; ++k) {
 		int p = contact->overlaps.pairs[2 * k] + point_offset;
@@ -154,8 +158,7 @@ static bool query_point_triangle(sim_contact *contact, int points, int point_off
 		int a = t[0] + face_offset, b = t[1] + face_offset, c = t[2] + face_offset;
 		if (p == a || p == b || p == c)
 			continue;
-		if (!push_pair(contact, PLUME_CONTACT_POINT_TRIANGLE, p, a, b, c))
-			return false;
+		push_pair(contact, PLUME_CONTACT_POINT_TRIANGLE, p, a, b, c);
 	}
 	return true;
 }
@@ -166,7 +169,8 @@ static bool query_edge_edge(sim_contact *contact, int first, const int *first_ed
 	contact->overlaps.count = 0;
 	if (contact->tree_size[first] == 0 || contact->tree_size[second] == 0)
 		return true;
-	if (plume_bvh_overlaps(contact->trees[first], contact->trees[second], &contact->overlaps, NULL) != PLUME_OK)
+	if (plume_bvh_overlaps(contact->trees[first], contact->trees[second], &contact->overlaps, NULL) != PLUME_OK ||
+	    !reserve_pairs(contact))
 		return false;
 	for (int k = 0; k < contact->overlaps.count; ++k) {
 		const int *e = first_edges + 2 * contact->overlaps.pairs[2 * k];
@@ -174,8 +178,7 @@ static bool query_edge_edge(sim_contact *contact, int first, const int *first_ed
 		int a0 = e[0] + first_offset, a1 = e[1] + first_offset, b0 = f[0] + second_offset, b1 = f[1] + second_offset;
 		if (a0 == b0 || a0 == b1 || a1 == b0 || a1 == b1)
 			continue;
-		if (!push_pair(contact, PLUME_CONTACT_EDGE_EDGE, a0, a1, b0, b1))
-			return false;
+		push_pair(contact, PLUME_CONTACT_EDGE_EDGE, a0, a1, b0, b1);
 	}
 	return true;
 }
@@ -276,7 +279,8 @@ double plume_contact_evaluate(plume_sim *sim, const plume_vec3 *x, bool hessian)
 	contact->active_count = 0;
 	contact->min_distance = INFINITY;
 	contact->failure = PLUME_OK;
-	if (!find_candidates(sim, x, x, contact->body_x, contact->body_x, dhat))
+	// Boxes inflated by d-hat / 2 overlap whenever the primitives are closer than d-hat.
+	if (!find_candidates(sim, x, x, contact->body_x, contact->body_x, 0.5 * dhat))
 		return fail(contact, PLUME_ERROR_MEMORY, "out of memory finding contact pairs");
 	double closest = INFINITY;
 	for (int p = 0; p < contact->pair_count; ++p) {
@@ -332,7 +336,7 @@ double plume_contact_evaluate(plume_sim *sim, const plume_vec3 *x, bool hessian)
 			return fail(contact, PLUME_ERROR_MEMORY, "out of memory rebuilding the solver's pattern");
 	}
 	plume_vec3 *rest = sim->rest;
-#pragma omp parallel for schedule(static) if (count >= 256)
+#pragma omp parallel for schedule(static) if (count >= 4096)
 	for (int k = 0; k < count; ++k) {
 		const sim_contact_pair *pair = contact->pairs + contact->active[k];
 		plume_vec3 points[4], reference[4];
@@ -408,12 +412,12 @@ double plume_contact_step_bound(plume_sim *sim, const plume_vec3 *x0, const plum
 	sim_contact *contact = &sim->contact;
 	// Pairs whose swept boxes do not overlap never touch; those that come within the
 	// separation of their distance without touching are harmless (the barrier sees them
-	// at the next evaluation). A margin of d-hat keeps rounding in the boxes harmless.
-	if (!find_candidates(sim, x0, x1, body0, body1, sim->def.contact.distance))
+	// at the next evaluation). A margin of d-hat / 2 keeps rounding in the boxes harmless.
+	if (!find_candidates(sim, x0, x1, body0, body1, 0.5 * sim->def.contact.distance))
 		return NAN;
 	double separation = sim->def.contact.ccd_separation, bound = 1;
 	int count = contact->pair_count;
-#pragma omp parallel for schedule(static) reduction(min : bound) if (count >= 256)
+#pragma omp parallel for schedule(static) reduction(min : bound) if (count >= 4096)
 	for (int p = 0; p < count; ++p) {
 		const sim_contact_pair *pair = contact->pairs + p;
 		plume_vec3 start[4], end[4];
