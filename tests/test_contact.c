@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "sim/sim_internal.h"
 #include "support.h"
@@ -239,6 +240,22 @@ static double check_state(const plume_sim *sim, const plume_solve_report *report
 	return fmin(self, body);
 }
 
+/// Seconds since some fixed moment (for the figures printed, never asserted).
+static double now(void)
+{
+	struct timespec t;
+	clock_gettime(CLOCK_MONOTONIC, &t);
+	return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static plume_status timed_step(plume_sim *sim, plume_solve_report *report, plume_error *err, double *seconds)
+{
+	double start = now();
+	plume_status status = plume_sim_step(sim, report, err);
+	*seconds += now() - start;
+	return status;
+}
+
 static double mean_y(const plume_sim *sim, int first, int count)
 {
 	double sum = 0;
@@ -274,9 +291,10 @@ static void test_sheets_drop_and_stack(void **state)
 	add_ground(sim, 0, 0.05);
 	double closest = INFINITY;
 	int max_pairs = 0, iterations = 0, steps = 60;
+	double seconds = 0;
 	for (int step = 0; step < steps; ++step) {
 		plume_solve_report report;
-		plume_status status = plume_sim_step(sim, &report, &err);
+		plume_status status = timed_step(sim, &report, &err, &seconds);
 		if (status != PLUME_OK)
 			fail_msg("step %d: %s", step, err.message);
 		closest = fmin(closest, check_state(sim, &report));
@@ -293,9 +311,11 @@ static void test_sheets_drop_and_stack(void **state)
 	surface upper = {per_sheet, sim->x + per_sheet, half, upper_faces};
 	double stack_gap = min_distance(lower, upper, false);
 	free(upper_faces);
-	printf("drop: %d steps, %d Newton iterations, up to %d pairs, pattern rebuilt %d times, closest %.3g m, "
+	printf("drop: %d steps (%.2f ms each), %d Newton iterations, up to %d pairs, pattern rebuilt %d times, closest "
+	       "%.3g m, "
 	       "ground gap %.3g m, stack gap %.3g m\n",
-	       steps, iterations, max_pairs, sim->contact.pattern_rebuilds, closest, ground_gap, stack_gap);
+	       steps, 1e3 * seconds / steps, iterations, max_pairs, sim->contact.pattern_rebuilds, closest, ground_gap,
+	       stack_gap);
 	assert_true(ground_gap > 0 && ground_gap <= dhat);
 	assert_true(stack_gap > 0 && stack_gap <= dhat);
 	// At rest: the upper sheet lies on the lower one, both flat.
@@ -325,8 +345,9 @@ static void test_press_balances_load(void **state)
 	plume_vec3 expected = plume_v3_add(plume_v3_scale(def.gravity, total_mass), load);
 	plume_solve_report report;
 	int iterations = 0, steps = 60;
+	double seconds = 0;
 	for (int step = 0; step < steps; ++step) {
-		if (plume_sim_step(sim, &report, &err) != PLUME_OK)
+		if (timed_step(sim, &report, &err, &seconds) != PLUME_OK)
 			fail_msg("step %d: %s", step, err.message);
 		check_state(sim, &report);
 		iterations += report.newton_iterations;
@@ -338,9 +359,11 @@ static void test_press_balances_load(void **state)
 	assert_true(speed < 1e-4);
 	plume_vec3 force = plume_contact_obstacle_force(sim, ground, sim->x);
 	double gap = min_distance(shell_surface(sim), body_surface(sim), false);
-	printf("press: %d steps, %d Newton iterations, largest speed %.3g m/s, %d pairs, gap %.3g m, force on the ground "
+	printf("press: %d steps (%.2f ms each), %d Newton iterations, largest speed %.3g m/s, %d pairs, gap %.3g m, force "
+	       "on the ground "
 	       "(%.6g %.6g %.6g) N, weight + load %.6g N\n",
-	       steps, iterations, speed, report.contact_pairs, gap, force.x, force.y, force.z, expected.y);
+	       steps, 1e3 * seconds / steps, iterations, speed, report.contact_pairs, gap, force.x, force.y, force.z,
+	       expected.y);
 	assert_true(gap > 0 && gap <= def.contact.distance);
 	assert_true(fabs(force.y - expected.y) <= 0.01 * fabs(expected.y));
 	assert_true(fabs(force.x) <= 0.01 * fabs(expected.y) && fabs(force.z) <= 0.01 * fabs(expected.y));
@@ -367,19 +390,20 @@ static void test_strip_folds_onto_itself(void **state)
 	assert_true(tip >= 0);
 	plume_vec3 pivot = plume_v3(length / 2, lift / 2, 0);
 	int turn = 60, steps = 100, max_pairs = 0, iterations = 0;
+	double seconds = 0;
 	double closest = INFINITY;
 	for (int step = 0; step < steps; ++step) {
 		double angle = 3.14159265358979323846 * fmin(1.0, (step + 1.0) / turn);
 		plume_sim_set_handle(sim, tip, plume_v3(0, 0, 0), plume_m3_rotation(plume_v3(0, 0, 1), angle), pivot);
 		plume_solve_report report;
-		if (plume_sim_step(sim, &report, &err) != PLUME_OK)
+		if (timed_step(sim, &report, &err, &seconds) != PLUME_OK)
 			fail_msg("step %d: %s", step, err.message);
 		closest = fmin(closest, check_state(sim, &report));
 		max_pairs = report.contact_pairs > max_pairs ? report.contact_pairs : max_pairs;
 		iterations += report.newton_iterations;
 	}
-	printf("fold: %d steps, %d Newton iterations, up to %d pairs, closest %.3g m\n", steps, iterations, max_pairs,
-	       closest);
+	printf("fold: %d steps (%.2f ms each), %d Newton iterations, up to %d pairs, closest %.3g m\n", steps,
+	       1e3 * seconds / steps, iterations, max_pairs, closest);
 	assert_true(max_pairs > 0);
 	assert_true(closest <= def.contact.distance);
 	plume_sim_destroy(sim);
@@ -403,21 +427,23 @@ static void test_rising_ground_lifts_sheet(void **state)
 	int ground = add_ground(sim, 0, 0.05);
 	double speed = 0.05, rise = 0;
 	int steps = 40, substeps = 0, iterations = 0;
+	double seconds = 0;
 	for (int step = 0; step < steps; ++step) {
 		rise = speed * def.time_step * fmin(step + 1, 30); // rises for 30 steps, then stops
 		plume_vec3 corners[4] = {plume_v3(-0.05, rise, -0.05), plume_v3(0.05, rise, -0.05), plume_v3(0.05, rise, 0.05),
 		                         plume_v3(-0.05, rise, 0.05)};
 		plume_sim_set_obstacle_positions(sim, ground, corners);
 		plume_solve_report report;
-		if (plume_sim_step(sim, &report, &err) != PLUME_OK)
+		if (timed_step(sim, &report, &err, &seconds) != PLUME_OK)
 			fail_msg("step %d: %s", step, err.message);
 		check_state(sim, &report);
 		substeps = report.substeps > substeps ? report.substeps : substeps;
 		iterations += report.newton_iterations;
 	}
 	double gap = min_distance(shell_surface(sim), body_surface(sim), false);
-	printf("rising ground: %d steps, %d Newton iterations, up to %d substeps, lifted %.3g m, gap %.3g m\n", steps,
-	       iterations, substeps, mean_y(sim, 0, sim->vertex_count) - 6e-5, gap);
+	printf(
+	    "rising ground: %d steps (%.2f ms each), %d Newton iterations, up to %d substeps, lifted %.3g m, gap %.3g m\n",
+	    steps, 1e3 * seconds / steps, iterations, substeps, mean_y(sim, 0, sim->vertex_count) - 6e-5, gap);
 	assert_true(gap > 0 && gap <= def.contact.distance);
 	assert_true(mean_y(sim, 0, sim->vertex_count) > rise);
 	plume_sim_destroy(sim);
