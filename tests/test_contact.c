@@ -450,6 +450,33 @@ static void test_rising_ground_lifts_sheet(void **state)
 	plume_mesh_destroy(mesh);
 }
 
+/// Statics: a strip clamped 1 mm above the ground droops onto it; the solve converges with its
+/// free end lying on the ground within the contact distance.
+static void test_static_droop_onto_ground(void **state)
+{
+	(void)state;
+	sheet sheets[1] = {{plume_v3(0, 1e-3, 0), 0.04, 0.01, 4}};
+	plume_mesh *mesh = make_sheets(sheets, 1);
+	plume_sim_def def = plume_sim_default_def();
+	def.contact.enabled = true;
+	plume_sim *sim = NULL;
+	plume_error err = {0};
+	assert_int_equal(plume_sim_create(mesh, &def, &sim, &err), PLUME_OK);
+	assert_true(plume_sim_add_handle(sim, "clamp0", &err) >= 0);
+	add_ground(sim, 0, 0.1);
+	plume_solve_report report;
+	if (plume_sim_solve_static(sim, &report, &err) != PLUME_OK)
+		fail_msg("statics: %s", err.message);
+	check_state(sim, &report);
+	double gap = min_distance(shell_surface(sim), body_surface(sim), false);
+	printf("droop (statics): %d substeps, %d Newton iterations, %d pairs, gap %.3g m, min_distance %.3g m\n",
+	       report.substeps, report.newton_iterations, report.contact_pairs, gap, report.min_distance);
+	assert_true(report.converged && report.contact_pairs > 0);
+	assert_true(gap > 0 && gap <= def.contact.distance);
+	plume_sim_destroy(sim);
+	plume_mesh_destroy(mesh);
+}
+
 /// Two sheets far apart: contact on and off give the same bits.
 static void test_far_apart_is_identical(void **state)
 {
@@ -679,10 +706,15 @@ static void test_scene_contact(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-	    cmocka_unit_test(test_scene_contact),           cmocka_unit_test(test_bad_contact_input),
-	    cmocka_unit_test(test_assembled_barrier),       cmocka_unit_test(test_far_apart_is_identical),
-	    cmocka_unit_test(test_press_balances_load),     cmocka_unit_test(test_sheets_drop_and_stack),
-	    cmocka_unit_test(test_strip_folds_onto_itself), cmocka_unit_test(test_rising_ground_lifts_sheet),
+	    cmocka_unit_test(test_scene_contact),
+	    cmocka_unit_test(test_bad_contact_input),
+	    cmocka_unit_test(test_assembled_barrier),
+	    cmocka_unit_test(test_far_apart_is_identical),
+	    cmocka_unit_test(test_press_balances_load),
+	    cmocka_unit_test(test_sheets_drop_and_stack),
+	    cmocka_unit_test(test_strip_folds_onto_itself),
+	    cmocka_unit_test(test_rising_ground_lifts_sheet),
+	    cmocka_unit_test(test_static_droop_onto_ground),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
