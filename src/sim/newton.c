@@ -366,6 +366,8 @@ plume_status plume_sim_newton(plume_sim *sim, const sim_problem *problem, plume_
 		// Backtracking (Armijo) on the merit; a second-order correction first when the full step fails.
 		double alpha = bound;
 		bool accepted = false;
+		if (!(alpha > 0))
+			break; // CCD allows no motion at all (a pair that starts in contact): no step to take
 		for (int backtrack = 0; backtrack < MAX_BACKTRACKS && !accepted; ++backtrack) {
 			apply_step(sim, x, step, alpha, sim->trial);
 			double trial = merit(sim, problem, sim->trial, mu);
