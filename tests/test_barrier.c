@@ -13,6 +13,7 @@
 
 #include "sim/contact_barrier.h"
 #include "sim/contact_distance.h"
+#include "sim/dense.h"
 
 static const double PI = 3.14159265358979323846;
 
@@ -291,6 +292,23 @@ static plume_distance_kind check_distance(plume_contact_pair_type type, const pl
 	// Rounding: relative to the distance, plus the coordinates' rounding times the
 	// distance (a difference of two points of size sqrt(scale2)).
 	double tolerance = 1e-9 * reference + 1e-13 * sqrt(scale2 * reference) + 1e-15 * scale2;
+	double region_tolerance = 1e-7 * reference + 1e-12 * sqrt(scale2 * reference) + 1e-15 * scale2;
+	if (type == PLUME_CONTACT_EDGE_EDGE) {
+		plume_vec3 da = plume_v3_sub(x[1], x[0]), db = plume_v3_sub(x[3], x[2]);
+		plume_vec3 normal = plume_v3_cross(da, db);
+		double aa = plume_v3_dot(da, da), bb = plume_v3_dot(db, db);
+		double sin2 = aa * bb > 0 ? plume_v3_dot(normal, normal) / (aa * bb) : 0;
+		// Below sin² = 1e-14 the contract measures edges as parallel (endpoint against
+		// edge), which overstates d² by up to sin² times the squared edge length.
+		if (sin2 < 2e-14) {
+			tolerance += 2e-14 * fmax(aa, bb);
+			region_tolerance += 2e-14 * fmax(aa, bb);
+		}
+		// The lines' closed form loses eps L / (d sin) relatively: its normal's
+		// direction is that uncertain (the mollifier silences this range).
+		else
+			region_tolerance += 1e-14 * sqrt(scale2 * reference) / sqrt(sin2);
+	}
 	if (!(fabs(d2 - reference) <= tolerance))
 		fail_msg("type %d kind %d: d2 = %.17g, reference %.17g", (int)type, (int)kind, d2, reference);
 	*worst = fmax(*worst, fabs(d2 - reference) / tolerance);
@@ -300,7 +318,6 @@ static plume_distance_kind check_distance(plume_contact_pair_type type, const pl
 	// (a wrong region's form would measure to a line or a plane closer than the
 	// primitive, or to the wrong vertex).
 	double in_region = plume_pair_distance2(type, kind, x, NULL, NULL);
-	double region_tolerance = 1e-7 * reference + 1e-12 * sqrt(scale2 * reference) + 1e-15 * scale2;
 	if (!(fabs(in_region - reference) <= region_tolerance))
 		fail_msg("type %d kind %d: region form %.17g, reference %.17g", (int)type, (int)kind, in_region, reference);
 	return kind;
@@ -326,11 +343,28 @@ static void test_distances_against_minimisation(void **state)
 		if (trial % 7 == 2 || trial % 7 == 3 || trial % 7 == 5)
 			assert_int_not_equal(kind, PLUME_EE_LINES);
 	}
+	// Nearly parallel edges close together, the closest points inside both (where the
+	// lines' normal equations are ill-conditioned: sin² from 1e-13 to 1e-8).
+	for (int trial = 0; trial < 400; ++trial) {
+		plume_vec3 x[4];
+		x[0] = random_vec3(&rng, 1);
+		x[1] = random_vec3(&rng, 1);
+		plume_vec3 da = plume_v3_sub(x[1], x[0]);
+		plume_vec3 side = plume_v3_normalize(plume_v3_cross(da, random_unit(&rng)));
+		plume_vec3 mid = plume_v3_mad(x[0], plume_rng_range(&rng, 0.3, 0.7), da);
+		plume_vec3 gap = plume_v3_scale(plume_v3_normalize(plume_v3_cross(da, side)), log_uniform(&rng, -7, -5));
+		plume_vec3 db = plume_v3_scale(plume_v3_mad(da, log_uniform(&rng, -6.5, -4) * plume_v3_length(da), side),
+		                               plume_rng_range(&rng, 0.5, 1.5));
+		double t = plume_rng_range(&rng, 0.3, 0.7);
+		x[2] = plume_v3_add(plume_v3_mad(mid, -t, db), gap);
+		x[3] = plume_v3_add(x[2], db);
+		seen[check_distance(PLUME_CONTACT_EDGE_EDGE, x, &worst)]++;
+	}
 	// Every region was met.
 	for (int kind = 0; kind <= PLUME_EE_LINES; ++kind)
 		if (seen[kind] == 0)
 			fail_msg("region %d never met", kind);
-	printf("distances: 1400 configurations, worst difference from the reference %.2g of its tolerance\n", worst);
+	printf("distances: 1800 configurations, worst difference from the reference %.2g of its tolerance\n", worst);
 }
 
 // ---------------------------------------------------------------------------
@@ -566,6 +600,9 @@ static void test_energy_finite_differences(void **state)
 			memcpy(rest, x, sizeof rest);
 			context.rest = rest;
 			double error = finite_difference_error(energy_fn, &context, x, 1e-4 * distance);
+			// Point-triangle pairs do not read the rest shape.
+			if (context.type == PLUME_CONTACT_POINT_TRIANGLE)
+				assert_true(plume_contact_pair_energy(context.type, x, NULL, dhat, 1e4, false, NULL, NULL) == energy);
 			if (!(error < 1e-6))
 				fail_msg("region %d, d/dhat %g: relative error %.3g", kind, distance / dhat, error);
 			worst = fmax(worst, error);
@@ -582,81 +619,7 @@ static void test_energy_finite_differences(void **state)
 }
 
 // ---------------------------------------------------------------------------
-// (d) The mollifier of nearly parallel edges
-
-/// Two edges of length 1 at an angle close to parallel, distance apart. Crossing: a
-/// along x, b turned by angle in a plane parallel to it, the closest points inside both.
-/// Otherwise a starts over the inside of b and rises away from it (a0 closest), each
-/// edge turned by half the angle.
-static void nearly_parallel(double angle, double distance, bool crossing, plume_vec3 x[4])
-{
-	double turn = crossing ? angle : 0.5 * angle;
-	double c = cos(turn), s = sin(turn);
-	x[0] = plume_v3(crossing ? -0.5 : 0.2, 0, 0);
-	x[1] = crossing ? plume_v3(0.5, 0, 0) : plume_v3_add(x[0], plume_v3(c, 0, s));
-	x[2] = plume_v3(-0.5 * c, -0.5 * s, -distance);
-	x[3] = plume_v3(0.5 * c, 0.5 * s, -distance);
-}
-
-static void test_mollifier(void **state)
-{
-	(void)state;
-	plume_rng rng = plume_rng_seed(17);
-	const double dhat = 1e-2, stiffness = 1e3;
-	plume_vec3 rest[4];
-	nearly_parallel(0.5, dhat, true, rest); // rest lengths 1: ε = 1e-3
-	const double epsilon = 1e-3;
-	double worst = 0;
-	for (int trial = 0; trial < 24; ++trial) {
-		bool crossing = trial % 2 == 0;
-		// sin² of the angle between 1e-7 and 0.9 ε: the mollifier is active.
-		double angle = asin(sqrt(epsilon * log_uniform(&rng, -4, -0.05)));
-		double distance = dhat * plume_rng_range(&rng, 0.1, 0.8);
-		plume_vec3 x[4];
-		nearly_parallel(angle, distance, crossing, x);
-		move_rigidly(&rng, x);
-		plume_distance_kind kind;
-		double d2 = plume_edge_edge_distance2(x[0], x[1], x[2], x[3], &kind);
-		assert_int_equal(kind, crossing ? PLUME_EE_LINES : PLUME_EE_A0_B);
-		// E = k m(x) b(d²), m(x) = 2 x/ε - x²/ε² (IPC eq. 14), x = |e0 x e1|².
-		plume_vec3 cross = plume_v3_cross(plume_v3_sub(x[1], x[0]), plume_v3_sub(x[3], x[2]));
-		double s = plume_v3_dot(cross, cross) / epsilon;
-		assert_true(s < 1);
-		double expected = stiffness * (2 * s - s * s) * plume_barrier(d2, dhat * dhat, NULL, NULL);
-		energy_context context = {PLUME_CONTACT_EDGE_EDGE, rest, dhat, stiffness, false};
-		double energy = energy_fn(&context, x, NULL, NULL);
-		assert_close(energy, expected, 1e-8 * expected);
-		// The step is small against the angle, whose derivatives are of order 1/angle.
-		double error = finite_difference_error(energy_fn, &context, x, 1e-4 * fmin(distance, angle));
-		if (!(error < 1e-6))
-			fail_msg("angle %.3g, d/dhat %.3g: relative error %.3g", angle, distance / dhat, error);
-		worst = fmax(worst, error);
-	}
-	// Exactly parallel edges have no edge-edge energy (their points meet the other edge).
-	plume_vec3 x[4];
-	nearly_parallel(0, 0.5 * dhat, true, x);
-	double gradient[12];
-	assert_true(plume_contact_pair_energy(PLUME_CONTACT_EDGE_EDGE, x, rest, dhat, stiffness, false, gradient, NULL) ==
-	            0);
-	// C¹ where the mollifier turns off (x = ε): the energy and its slope in the angle
-	// agree on both sides.
-	double threshold = asin(sqrt(epsilon));
-	double energy_at[4];
-	const double offsets[4] = {-2e-7, -1e-7, 1e-7, 2e-7};
-	for (int k = 0; k < 4; ++k) {
-		nearly_parallel(threshold + offsets[k], 0.5 * dhat, true, x);
-		energy_at[k] = plume_contact_pair_energy(PLUME_CONTACT_EDGE_EDGE, x, rest, dhat, stiffness, false, NULL, NULL);
-	}
-	double slope_below = (energy_at[1] - energy_at[0]) / 1e-7, slope_above = (energy_at[3] - energy_at[2]) / 1e-7;
-	assert_close(energy_at[2], energy_at[1], 1e-6 * energy_at[1]);
-	// (A mollifier only continuous, such as x/ε, would change slope by about 60 E here;
-	// this one's slopes differ by the second derivative times the offsets, ~1e-3 E.)
-	assert_close(slope_below, slope_above, 1e-2 * energy_at[1]);
-	printf("mollifier: 24 near-parallel pairs, worst relative FD error %.2e\n", worst);
-}
-
-// ---------------------------------------------------------------------------
-// (e) The PSD projection
+// Eigenvalues, for the checks of the projection
 
 /// Eigenvalues of a symmetric 12 x 12 matrix by cyclic Jacobi rotations (written here,
 /// independent of the library's Householder-QL).
@@ -713,6 +676,92 @@ static double largest_magnitude(const double values[12])
 	return m;
 }
 
+// ---------------------------------------------------------------------------
+// (d) The mollifier of nearly parallel edges
+
+/// Two edges of length 1 at an angle close to parallel, distance apart. Crossing: a
+/// along x, b turned by angle in a plane parallel to it, the closest points inside both.
+/// Otherwise a starts over the inside of b and rises away from it (a0 closest), each
+/// edge turned by half the angle.
+static void nearly_parallel(double angle, double distance, bool crossing, plume_vec3 x[4])
+{
+	double turn = crossing ? angle : 0.5 * angle;
+	double c = cos(turn), s = sin(turn);
+	x[0] = plume_v3(crossing ? -0.5 : 0.2, 0, 0);
+	x[1] = crossing ? plume_v3(0.5, 0, 0) : plume_v3_add(x[0], plume_v3(c, 0, s));
+	x[2] = plume_v3(-0.5 * c, -0.5 * s, -distance);
+	x[3] = plume_v3(0.5 * c, 0.5 * s, -distance);
+}
+
+static void test_mollifier(void **state)
+{
+	(void)state;
+	plume_rng rng = plume_rng_seed(17);
+	const double dhat = 1e-2, stiffness = 1e3;
+	plume_vec3 rest[4];
+	nearly_parallel(0.5, dhat, true, rest); // rest lengths 1: ε = 1e-3
+	const double epsilon = 1e-3;
+	double worst = 0;
+	for (int trial = 0; trial < 24; ++trial) {
+		bool crossing = trial % 2 == 0;
+		// sin² of the angle between 1e-7 and 0.9 ε: the mollifier is active.
+		double angle = asin(sqrt(epsilon * log_uniform(&rng, -4, -0.05)));
+		double distance = dhat * plume_rng_range(&rng, 0.1, 0.8);
+		plume_vec3 x[4];
+		nearly_parallel(angle, distance, crossing, x);
+		move_rigidly(&rng, x);
+		plume_distance_kind kind;
+		double d2 = plume_edge_edge_distance2(x[0], x[1], x[2], x[3], &kind);
+		assert_int_equal(kind, crossing ? PLUME_EE_LINES : PLUME_EE_A0_B);
+		// E = k m(x) b(d²), m(x) = 2 x/ε - x²/ε² (IPC eq. 14), x = |e0 x e1|².
+		plume_vec3 cross = plume_v3_cross(plume_v3_sub(x[1], x[0]), plume_v3_sub(x[3], x[2]));
+		double s = plume_v3_dot(cross, cross) / epsilon;
+		assert_true(s < 1);
+		double expected = stiffness * (2 * s - s * s) * plume_barrier(d2, dhat * dhat, NULL, NULL);
+		energy_context context = {PLUME_CONTACT_EDGE_EDGE, rest, dhat, stiffness, false};
+		double energy = energy_fn(&context, x, NULL, NULL);
+		assert_close(energy, expected, 1e-8 * expected);
+		// The step is small against the angle, whose derivatives are of order 1/angle.
+		double error = finite_difference_error(energy_fn, &context, x, 1e-4 * fmin(distance, angle));
+		if (!(error < 1e-6))
+			fail_msg("angle %.3g, d/dhat %.3g: relative error %.3g", angle, distance / dhat, error);
+		worst = fmax(worst, error);
+		// The projection of a mollified pair's Hessian (all four points involved).
+		double exact[144], projected[144], values[12];
+		plume_contact_pair_energy(PLUME_CONTACT_EDGE_EDGE, x, rest, dhat, stiffness, false, NULL, exact);
+		plume_contact_pair_energy(PLUME_CONTACT_EDGE_EDGE, x, rest, dhat, stiffness, true, NULL, projected);
+		jacobi_eigenvalues(exact, values);
+		double scale = largest_magnitude(values);
+		plume_project_psd(exact, 12);
+		for (int i = 0; i < 144; ++i)
+			assert_close(projected[i], exact[i], 1e-12 * scale);
+	}
+	// Exactly parallel edges have no edge-edge energy (their points meet the other edge).
+	plume_vec3 x[4];
+	nearly_parallel(0, 0.5 * dhat, true, x);
+	double gradient[12];
+	assert_true(plume_contact_pair_energy(PLUME_CONTACT_EDGE_EDGE, x, rest, dhat, stiffness, false, gradient, NULL) ==
+	            0);
+	// C¹ where the mollifier turns off (x = ε): the energy and its slope in the angle
+	// agree on both sides.
+	double threshold = asin(sqrt(epsilon));
+	double energy_at[4];
+	const double offsets[4] = {-2e-7, -1e-7, 1e-7, 2e-7};
+	for (int k = 0; k < 4; ++k) {
+		nearly_parallel(threshold + offsets[k], 0.5 * dhat, true, x);
+		energy_at[k] = plume_contact_pair_energy(PLUME_CONTACT_EDGE_EDGE, x, rest, dhat, stiffness, false, NULL, NULL);
+	}
+	double slope_below = (energy_at[1] - energy_at[0]) / 1e-7, slope_above = (energy_at[3] - energy_at[2]) / 1e-7;
+	assert_close(energy_at[2], energy_at[1], 1e-6 * energy_at[1]);
+	// (A mollifier only continuous, such as x/ε, would change slope by about 60 E here;
+	// this one's slopes differ by the second derivative times the offsets, ~1e-3 E.)
+	assert_close(slope_below, slope_above, 1e-2 * energy_at[1]);
+	printf("mollifier: 24 near-parallel pairs, worst relative FD error %.2e\n", worst);
+}
+
+// ---------------------------------------------------------------------------
+// (e) The PSD projection
+
 static void test_projected_hessian(void **state)
 {
 	(void)state;
@@ -751,6 +800,13 @@ static void test_projected_hessian(void **state)
 					product_norm += sum * sum;
 				}
 			assert_true(sqrt(product_norm) <= 1e-12 * scale * scale);
+			// The same as projecting the whole 12 x 12 matrix (the energy projects only
+			// the rows of the points involved, without their translations).
+			double whole[144];
+			memcpy(whole, exact, sizeof whole);
+			plume_project_psd(whole, 12);
+			for (int i = 0; i < 144; ++i)
+				assert_close(projected[i], whole[i], 1e-12 * scale);
 		}
 	// The barrier's Hessian is indefinite (b' < 0 bends it down sideways), so the
 	// projection is exercised, not skipped.

@@ -298,6 +298,29 @@ static double mollifier(double x, double epsilon, double *dm, double *d2m)
 	return s * (2 - s);
 }
 
+/// Projects the Hessian to the nearest PSD matrix by projecting only the rows and
+/// columns of the points it involves, on the complement of their common translations
+/// (plume_project_psd_translation_free): the other rows are zero and every term is a
+/// function of differences of points, so both are exact invariant subspaces of
+/// eigenvalue zero and the result is plume_project_psd's up to rounding, from a 3x3
+/// (point-point) to a 9x9 (four points) eigen-decomposition instead of a 12x12.
+static void project_involved_psd(double *hessian, const bool involved[4])
+{
+	int index[4], count = 0;
+	for (int i = 0; i < 4; ++i)
+		if (involved[i])
+			index[count++] = i;
+	int n = 3 * count;
+	double compact[144];
+	for (int a = 0; a < n; ++a)
+		for (int b = 0; b < n; ++b)
+			compact[a * n + b] = hessian[(3 * index[a / 3] + a % 3) * 12 + 3 * index[b / 3] + b % 3];
+	plume_project_psd_translation_free(compact, count);
+	for (int a = 0; a < n; ++a)
+		for (int b = 0; b < n; ++b)
+			hessian[(3 * index[a / 3] + a % 3) * 12 + 3 * index[b / 3] + b % 3] = compact[a * n + b];
+}
+
 double plume_contact_pair_energy(plume_contact_pair_type type, const plume_vec3 x[4], const plume_vec3 rest[4],
                                  double dhat, double stiffness, bool project_psd, double *gradient, double *hessian)
 {
@@ -321,6 +344,7 @@ double plume_contact_pair_energy(plume_contact_pair_type type, const plume_vec3 
 		return 0;
 	// The mollifier of edge-edge pairs, m(x) with x = |e0 x e1|² (IPC eq. 14-15).
 	double m = 1, dm = 0, d2m = 0;
+	bool mollified = false;
 	double mg[12] = {0}, mh[144] = {0};
 	if (type == PLUME_CONTACT_EDGE_EDGE) {
 		PLUME_ASSERT(rest != NULL);
@@ -331,7 +355,8 @@ double plume_contact_pair_energy(plume_contact_pair_type type, const plume_vec3 
 		double lg[6] = {0}, lh[36] = {0};
 		double cross2 = lagrange(e0, e1, 0, 3, 6, lg, lh);
 		m = mollifier(cross2, epsilon, &dm, &d2m);
-		if (dm != 0 || d2m != 0)
+		mollified = m < 1;
+		if (mollified)
 			scatter(form2(1, 0, 3, 2), lg, lh, mg, mh);
 	}
 	// E = k m b: grad E = k (b grad m + m grad b), with grad m = m' grad x and
@@ -348,8 +373,14 @@ double plume_contact_pair_energy(plume_contact_pair_type type, const plume_vec3 
 				hessian[i * 12 + j] = stiffness * (b * hess_m + cross_terms + m * hess_b);
 			}
 		symmetrize(hessian);
-		if (project_psd)
-			plume_project_psd(hessian, 12);
+		if (project_psd) {
+			// The region's points, and all four where the mollifier varies.
+			local_form form = region_form(type, kind);
+			bool involved[4] = {mollified, mollified, mollified, mollified};
+			for (int k = 0; k < form.count; ++k)
+				involved[form.plus[k]] = involved[form.minus[k]] = true;
+			project_involved_psd(hessian, involved);
+		}
 	}
 	return stiffness * m * b;
 }

@@ -80,10 +80,18 @@ double plume_edge_edge_distance2(plume_vec3 a0, plume_vec3 a1, plume_vec3 b0, pl
 	double best = -1;
 	plume_distance_kind found = PLUME_EE_LINES;
 	if (denominator > 1e-14 * aa * bb) {
+		// s from the 2x2 normal equations; t by projecting a(s) on the line b rather
+		// than from the same equations. Near parallel lines s and t are both wrong
+		// by about eps / sin² (the system is that ill-conditioned), and independent
+		// errors move the pair across the valley of the distance: measured, d² 6%
+		// too large at sin² = 2e-11. Projecting keeps the pair across from each
+		// other, so the error in s only slides it along the valley (a change of
+		// d² of order sin² δs²).
 		double s = (ab * br - bb * ar) / denominator;
-		double t = (aa * br - ab * ar) / denominator;
+		plume_vec3 on_a = plume_v3_mad(a0, s, da);
+		double t = plume_v3_dot(plume_v3_sub(on_a, b0), db) / bb;
 		if (s > 0 && s < 1 && t > 0 && t < 1) {
-			plume_vec3 d = plume_v3_sub(plume_v3_mad(a0, s, da), plume_v3_mad(b0, t, db));
+			plume_vec3 d = plume_v3_sub(on_a, plume_v3_mad(b0, t, db));
 			best = plume_v3_dot(d, d);
 		}
 	}
