@@ -1,6 +1,7 @@
 // Benchmark: contact detection (issue 14). Prints
 //  - additive CCD queries per second (point-triangle and edge-edge, separation 0.1) over a
-//    seeded random sweep like test_ccd's: generic motions and motions forced to collide;
+//    seeded random sweep like test_ccd's: generic motions and motions forced to collide,
+//    and the time of a query that runs to the iteration limit;
 //  - the AABB tree's build, refit and self-overlap query times for 10^4 and 10^5 random
 //    boxes sized for about ten overlaps each, beside a brute-force all-pairs count for 10^4.
 // One thread; medians of repeated runs, wall and CPU time (read CPU on a shared machine).
@@ -84,6 +85,23 @@ static void bench_ccd_queries(const char *name, int split)
 	free(end);
 }
 
+/// The worst case: a point sliding 10 across a triangle 1e-7 above it stops at the
+/// iteration limit (about 10^8 steps of the bound would be needed).
+static void bench_ccd_worst(void)
+{
+	plume_vec3 start[4] = {{-5, 0.3, 1e-7}, {-10, 0, 0}, {10, 0, 0}, {0, 10, 0}};
+	plume_vec3 end[4] = {{5, 0.3, 1e-7}, {-10, 0, 0}, {10, 0, 0}, {0, 10, 0}};
+	enum { RUNS = 5 };
+	double cpu[RUNS], t = 0;
+	for (int r = 0; r < RUNS; ++r) {
+		double c0 = bench_cpu_now();
+		t = plume_ccd_point_triangle(start, end, 0.1);
+		cpu[r] = bench_cpu_now() - c0;
+	}
+	printf("ccd worst case (sliding 1e-7 above a face, stopped by the iteration limit at t = %.3g): %.2f ms CPU\n", t,
+	       1e3 * bench_median(cpu, RUNS));
+}
+
 /// n boxes in the unit cube, sides up to 2.2 times the spacing n^(-1/3): each box
 /// meets about ten others.
 static plume_aabb *random_boxes(plume_rng *rng, int n)
@@ -152,6 +170,7 @@ int main(void)
 {
 	bench_ccd_queries("point-triangle", 1);
 	bench_ccd_queries("edge-edge", 2);
+	bench_ccd_worst();
 	bench_bvh(10000, 1);
 	bench_bvh(100000, 0);
 	return 0;

@@ -153,6 +153,29 @@ static void test_two_tree_overlaps_match_brute_force(void **state)
 	assert_int_equal(plume_bytes_in_use(), bytes);
 }
 
+/// Boxes in a mesh's grid order, in organ-pipe order (the worst case of a median-of-three
+/// selection) and all equal: many equal centres along an axis, unit cells whose faces
+/// touch their neighbours'.
+static void test_structured_orders(void **state)
+{
+	(void)state;
+	enum { N = 1200 };
+	plume_aabb *boxes = malloc(N * sizeof *boxes);
+	for (int order = 0; order < 3; ++order) {
+		for (int i = 0; i < N; ++i) {
+			int k = order == 1 ? (i < N / 2 ? i : N - 1 - i) : i;
+			double x = order == 2 ? 0 : k % 40, y = order == 2 ? 0 : k / 40;
+			boxes[i] = (plume_aabb){{x, y, 0}, {x + 1, y + 1, 1}};
+		}
+		plume_bvh *bvh = NULL;
+		plume_error err = {0};
+		assert_int_equal(plume_bvh_create(boxes, N, &bvh, &err), PLUME_OK);
+		check_self(bvh, boxes, N);
+		plume_bvh_destroy(bvh);
+	}
+	free(boxes);
+}
+
 static void test_empty_trees(void **state)
 {
 	(void)state;
@@ -285,6 +308,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test(test_self_overlaps_match_brute_force),
 	    cmocka_unit_test(test_two_tree_overlaps_match_brute_force),
+	    cmocka_unit_test(test_structured_orders),
 	    cmocka_unit_test(test_empty_trees),
 	    cmocka_unit_test(test_order_and_determinism),
 	    cmocka_unit_test(test_out_of_memory),

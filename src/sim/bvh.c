@@ -65,20 +65,26 @@ static int valid_box(plume_aabb b)
 	return b.lower.x <= b.upper.x && b.lower.y <= b.upper.y && b.lower.z <= b.upper.z;
 }
 
-/// The build's scratch: box centres and the permutation being split.
+/// A box during the build: its centre beside its index, so that the selection below
+/// reads contiguous memory.
+typedef struct bvh_item {
+	plume_vec3 centre;
+	int index;
+} bvh_item;
+
+/// The build's scratch: the boxes, their items being split, the nodes being written.
 typedef struct bvh_build {
 	const plume_aabb *boxes;
-	const plume_vec3 *centre;
-	int *order;
+	bvh_item *items;
 	bvh_node *nodes;
 	int node_count;
 } bvh_build;
 
-/// (centre along axis, index) of box a before that of box b: a total order.
-static int before(const plume_vec3 *centre, int axis, int a, int b)
+/// (centre along axis, index) of a before that of b: a total order.
+static int before(const bvh_item *a, const bvh_item *b, int axis)
 {
-	double ka = component(centre[a], axis), kb = component(centre[b], axis);
-	return ka < kb || (ka == kb && a < b);
+	double ka = component(a->centre, axis), kb = component(b->centre, axis);
+	return ka < kb || (ka == kb && a->index < b->index);
 }
 
 static void swap_int(int *a, int *b)
@@ -88,24 +94,48 @@ static void swap_int(int *a, int *b)
 	*b = t;
 }
 
-/// Rearranges order[lo, hi) so that order[k] is the box that sorts k-th by (centre, index)
-/// with the ones before it in [lo, k) (quickselect, median-of-three pivot, deterministic).
-static void select_kth(const plume_vec3 *centre, int axis, int *order, int lo, int hi, int k)
+static void swap_items(bvh_item *a, bvh_item *b)
 {
-	while (hi - lo > 2) {
-		int mid = lo + (hi - lo) / 2;
-		// Median of three at hi - 1, the pivot's place during the partition.
-		if (before(centre, axis, order[mid], order[lo]))
-			swap_int(&order[mid], &order[lo]);
-		if (before(centre, axis, order[hi - 1], order[lo]))
-			swap_int(&order[hi - 1], &order[lo]);
-		if (before(centre, axis, order[mid], order[hi - 1]))
-			swap_int(&order[mid], &order[hi - 1]);
-		int pivot = order[hi - 1], store = lo;
+	bvh_item t = *a;
+	*a = *b;
+	*b = t;
+}
+
+/// A position in [lo, hi) drawn from (lo, hi, draw) by a fixed hash (SplitMix64's
+/// finaliser): pivots that look random, so no input order (sorted, organ pipe, a mesh's
+/// grid order) makes the selection quadratic, yet the same on every run.
+static int hashed_position(int lo, int hi, uint64_t draw)
+{
+	uint64_t z = ((uint64_t)(uint32_t)lo << 32 | (uint32_t)hi) + draw * 0x9e3779b97f4a7c15u;
+	z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9u;
+	z = (z ^ (z >> 27)) * 0x94d049bb133111ebu;
+	z ^= z >> 31;
+	return lo + (int)(z % (uint64_t)(hi - lo));
+}
+
+/// Rearranges items[lo, hi) so that items[k] is the one that sorts k-th by (centre along
+/// axis, index), with the ones before it in [lo, k) (quickselect; the pivot is the median
+/// of three hashed positions; expected linear time).
+static void select_kth(bvh_item *items, int axis, int lo, int hi, int k)
+{
+	for (uint64_t round = 0; hi - lo > 2; ++round) {
+		// The median of three, moved to hi - 1, the pivot's place during the partition.
+		int a = hashed_position(lo, hi, 3 * round), b = hashed_position(lo, hi, 3 * round + 1),
+		    c = hashed_position(lo, hi, 3 * round + 2);
+		if (before(&items[b], &items[a], axis))
+			swap_int(&a, &b);
+		if (before(&items[c], &items[b], axis)) {
+			swap_int(&b, &c);
+			if (before(&items[b], &items[a], axis))
+				swap_int(&a, &b);
+		}
+		swap_items(&items[b], &items[hi - 1]);
+		const bvh_item pivot = items[hi - 1];
+		int store = lo;
 		for (int i = lo; i < hi - 1; ++i)
-			if (before(centre, axis, order[i], pivot))
-				swap_int(&order[i], &order[store++]);
-		swap_int(&order[store], &order[hi - 1]);
+			if (before(&items[i], &pivot, axis))
+				swap_items(&items[i], &items[store++]);
+		swap_items(&items[store], &items[hi - 1]);
 		if (k == store)
 			return;
 		if (k < store)
@@ -113,34 +143,30 @@ static void select_kth(const plume_vec3 *centre, int axis, int *order, int lo, i
 		else
 			lo = store + 1;
 	}
-	if (hi - lo == 2 && before(centre, axis, order[lo + 1], order[lo]))
-		swap_int(&order[lo], &order[lo + 1]);
+	if (hi - lo == 2 && before(&items[lo + 1], &items[lo], axis))
+		swap_items(&items[lo], &items[lo + 1]);
 }
 
-/// Builds the subtree over order[begin, end) and returns its node.
+/// Builds the subtree over items[begin, end) and returns its node.
 static int build_node(bvh_build *build, int begin, int end)
 {
 	int index = build->node_count++;
 	bvh_node *node = &build->nodes[index];
 	if (end - begin == 1) {
-		int item = build->order[begin];
+		int item = build->items[begin].index;
 		*node = (bvh_node){build->boxes[item], -1, -1, item};
 		return index;
 	}
-	plume_vec3 lo = build->centre[build->order[begin]], hi = lo;
-	for (int i = begin + 1; i < end; ++i) {
-		plume_aabb c =
-		    merge((plume_aabb){lo, hi}, (plume_aabb){build->centre[build->order[i]], build->centre[build->order[i]]});
-		lo = c.lower;
-		hi = c.upper;
-	}
-	plume_vec3 extent = plume_v3_sub(hi, lo);
+	plume_aabb bounds = {build->items[begin].centre, build->items[begin].centre};
+	for (int i = begin + 1; i < end; ++i)
+		bounds = merge(bounds, (plume_aabb){build->items[i].centre, build->items[i].centre});
+	plume_vec3 extent = plume_v3_sub(bounds.upper, bounds.lower);
 	int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : extent.y >= extent.z ? 1 : 2;
 	int middle = begin + (end - begin) / 2;
-	select_kth(build->centre, axis, build->order, begin, end, middle);
+	select_kth(build->items, axis, begin, end, middle);
 	int left = build_node(build, begin, middle);
 	int right = build_node(build, middle, end);
-	// build->nodes[index] again: node points into the same array, which does not move.
+	// node still points at build->nodes[index]: the array does not move.
 	node->left = left;
 	node->right = right;
 	node->item = -1;
@@ -154,28 +180,24 @@ plume_status plume_bvh_create(const plume_aabb *boxes, int count, plume_bvh **ou
 	PLUME_ASSERT(count <= INT32_MAX / 2);
 	*out = NULL;
 	plume_bvh *bvh = plume_calloc(1, sizeof *bvh);
-	plume_vec3 *centre = plume_calloc((size_t)count + 1, sizeof *centre);
-	int *order = plume_calloc((size_t)count + 1, sizeof *order);
+	bvh_item *items = plume_calloc((size_t)count + 1, sizeof *items);
 	bvh_node *nodes = count > 0 ? plume_calloc(2 * (size_t)count - 1, sizeof *nodes) : NULL;
-	if (bvh == NULL || centre == NULL || order == NULL || (count > 0 && nodes == NULL)) {
+	if (bvh == NULL || items == NULL || (count > 0 && nodes == NULL)) {
 		plume_free(bvh);
-		plume_free(centre);
-		plume_free(order);
+		plume_free(items);
 		plume_free(nodes);
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "bounding-volume hierarchy of %d boxes: out of memory", count);
 	}
 	for (int i = 0; i < count; ++i) {
 		PLUME_ASSERT(valid_box(boxes[i]));
-		centre[i] = plume_v3_scale(plume_v3_add(boxes[i].lower, boxes[i].upper), 0.5);
-		order[i] = i;
+		items[i] = (bvh_item){plume_v3_scale(plume_v3_add(boxes[i].lower, boxes[i].upper), 0.5), i};
 	}
 	if (count > 0) {
-		bvh_build build = {boxes, centre, order, nodes, 0};
+		bvh_build build = {boxes, items, nodes, 0};
 		build_node(&build, 0, count);
 		PLUME_ASSERT(build.node_count == 2 * count - 1);
 	}
-	plume_free(centre);
-	plume_free(order);
+	plume_free(items);
 	bvh->magic = PLUME_HANDLE_MAGIC;
 	bvh->count = count;
 	bvh->node_count = count > 0 ? 2 * count - 1 : 0;

@@ -7,7 +7,7 @@
 //   l_p = |p_0| + max(|p_1|, |p_2|, |p_3|)           (point-triangle)
 //   l_p = max(|p_0|, |p_1|) + max(|p_2|, |p_3|)      (edge-edge)
 // per unit of t, because a point of a triangle or an edge moves by a convex combination
-// of its vertices' displacements (line 3). The distance d is therefore 1/l_p-Lipschitz in
+// of its vertices' displacements (line 3). The distance d is therefore l_p-Lipschitz in
 // t: from a time t where d(t) > g, no time in [t, t + (d(t) - g) / l_p] brings it below
 // g. Advancing by such steps is conservative advancement; it never passes the time at
 // which the distance reaches g, so never the time of impact either.
@@ -18,8 +18,8 @@
 // every time in [0, t], as sim/ccd.h promises. The two cost alike: both shrink the
 // remaining distance geometrically, at the rate at which the primitives actually
 // approach against l_p. The loop stops when the gap d(t) - g is a small fraction
-// (GAP_TOLERANCE) of d(0) - g: the time lost then is that fraction of the time to close
-// the gap, or when the step reaches t = 1.
+// (GAP_TOLERANCE) of d(0) - g (for a steady approach, the time lost is then that
+// fraction of the time to close the gap), or when a step reaches t = 1.
 #include <math.h>
 
 #include "sim/ccd.h"
