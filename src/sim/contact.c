@@ -436,16 +436,60 @@ static void place_bodies(sim_contact *contact, double s, plume_vec3 *out)
 		out[i] = s == 1 ? contact->body_end[i] : plume_v3_lerp(contact->body_start[i], contact->body_end[i], s);
 }
 
-plume_status plume_contact_begin(plume_sim *sim, double s0, double s1, plume_error *err)
+/// The handle vertices of x at step fraction s (sim.c's plume_sim_place_handles, into any array).
+static void place_handles(const plume_sim *sim, double s, plume_vec3 *x)
+{
+	for (int h = 0; h < sim->handle_count; ++h) {
+		const sim_handle *handle = sim->handles + h;
+		for (int i = 0; i < handle->count; ++i)
+			x[handle->vertices[i]] = s == 1 ? handle->end[i] : plume_v3_lerp(handle->start[i], handle->end[i], s);
+	}
+}
+
+/// Advances the prescribed motion (handles, obstacles) of the substep [s0, s1] from the fraction
+/// *reached of it as far as CCD allows with the free vertices where they are in sim->x.
+static plume_status advance_prescribed(plume_sim *sim, double s0, double s1, double *reached, plume_error *err)
 {
 	sim_contact *contact = &sim->contact;
+	double from = s0 + *reached * (s1 - s0);
+	memcpy(sim->scratch, sim->x, sizeof(plume_vec3) * (size_t)sim->vertex_count);
+	place_handles(sim, s1, sim->scratch);
+	place_bodies(contact, from, contact->body_from);
+	place_bodies(contact, s1, contact->body_x);
+	double t = plume_contact_step_bound(sim, sim->x, sim->scratch, contact->body_from, contact->body_x);
+	if (isnan(t))
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory finding contact pairs");
+	double next = t >= 1 ? 1 : *reached + t * (1 - *reached);
+	if (!(next - *reached > 1e-6))
+		return plume_error_set(
+		    err, PLUME_ERROR_NUMERIC,
+		    "the prescribed motion (handles, obstacles) cannot advance without closing a contact gap "
+		    "by more than %g of it",
+		    1 - sim->def.contact.ccd_separation);
+	*reached = next;
+	double s = next >= 1 ? s1 : s0 + next * (s1 - s0);
+	place_handles(sim, s, sim->x);
+	place_bodies(contact, s, contact->body_x);
+	return PLUME_OK;
+}
+
+plume_status plume_contact_begin(plume_sim *sim, double s0, double s1, double *reached, plume_error *err)
+{
+	sim_contact *contact = &sim->contact;
+	if (!plume_contact_on(sim)) {
+		place_bodies(contact, s1, contact->body_x);
+		*reached = 1;
+		return PLUME_OK;
+	}
+	if (*reached > 0)
+		return advance_prescribed(sim, s0, s1, reached, err);
 	place_bodies(contact, s0, contact->body_from);
 	place_bodies(contact, s1, contact->body_x);
-	if (!plume_contact_on(sim))
-		return PLUME_OK;
 	double bound = plume_contact_step_bound(sim, sim->previous, sim->x, contact->body_from, contact->body_x);
-	if (bound >= 1)
+	if (bound >= 1) {
+		*reached = 1;
 		return PLUME_OK;
+	}
 	// The inertial prediction closes a gap: free unknowns start where they were, and only the
 	// prescribed motion (handles, obstacles) remains to check.
 	for (int i = 0; i < 3 * sim->vertex_count; ++i)
@@ -454,12 +498,14 @@ plume_status plume_contact_begin(plume_sim *sim, double s0, double s1, plume_err
 	bound = plume_contact_step_bound(sim, sim->previous, sim->x, contact->body_from, contact->body_x);
 	if (isnan(bound))
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory finding contact pairs");
-	if (bound >= 1)
+	if (bound >= 1) {
+		*reached = 1;
 		return PLUME_OK;
-	return plume_error_set(err, PLUME_ERROR_NUMERIC,
-	                       "the prescribed motion (handles, obstacles) closes a contact gap by more than %g of it "
-	                       "within the step: subdividing",
-	                       1 - sim->def.contact.ccd_separation);
+	}
+	// That closes a gap too: everything starts where it was, and the prescribed motion goes as
+	// far as it can; the caller solves there and calls again for the rest.
+	memcpy(sim->x, sim->previous, sizeof(plume_vec3) * (size_t)sim->vertex_count);
+	return advance_prescribed(sim, s0, s1, reached, err);
 }
 
 void plume_contact_finish(plume_sim *sim)

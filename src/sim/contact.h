@@ -65,8 +65,10 @@ typedef struct sim_contact {
 	int buffer_capacity;
 	/// The smallest pair distance of the last evaluation, m (+inf when no pair is in reach).
 	double min_distance;
-	/// Times the KKT pattern was rebuilt for new contact couplings.
+	/// Times the KKT pattern was rebuilt for new contact couplings, and continuation rounds
+	/// taken beyond the first solve of a substep (plume_contact_begin), since creation.
 	int pattern_rebuilds;
+	int rounds;
 	/// Why the last evaluation failed (out of memory: PLUME_ERROR_MEMORY; primitives touching:
 	/// PLUME_ERROR_NUMERIC), for the caller's error; PLUME_OK when it did not.
 	plume_status failure;
@@ -95,12 +97,17 @@ void plume_contact_scatter(struct plume_sim *sim, double *gradient, double *valu
 double plume_contact_step_bound(struct plume_sim *sim, const plume_vec3 *x0, const plume_vec3 *x1,
                                 const plume_vec3 *body0, const plume_vec3 *body1);
 
-/// Before a (sub)step from fraction s0 to s1 of the step: places the obstacles at s1 and
-/// checks, by continuous collision detection, the motion from sim->previous (shell) and the
-/// obstacles at s0 to the start iterate in sim->x (free vertices at their inertial prediction,
-/// handles at their targets). When that path closes a gap, the free vertices start where they
-/// were; when the prescribed motion alone closes one, PLUME_ERROR_NUMERIC (the caller subdivides).
-plume_status plume_contact_begin(struct plume_sim *sim, double s0, double s1, plume_error *err);
+/// Before a (sub)step from fraction s0 to s1 of the step, with *reached = 0: places the
+/// obstacles at s1 and checks, by continuous collision detection, the motion from
+/// sim->previous (shell) and the obstacles at s0 to the start iterate in sim->x (free vertices
+/// at their inertial prediction, handles at their targets). When that path closes a gap, the
+/// free vertices start where they were; when the prescribed motion alone closes one, it is
+/// taken only as far as CCD allows and *reached says which fraction of it that is (1: all).
+/// The caller then solves and calls again (with the free vertices where the solve left
+/// them) until *reached is 1: a continuation in which the barrier pushes the shell ahead
+/// of the handles and obstacles. PLUME_ERROR_NUMERIC when the motion cannot advance (the
+/// caller subdivides the step).
+plume_status plume_contact_begin(struct plume_sim *sim, double s0, double s1, double *reached, plume_error *err);
 /// After a successful step or solve: the obstacles' end positions become their start.
 void plume_contact_finish(struct plume_sim *sim);
 

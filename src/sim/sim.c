@@ -719,6 +719,32 @@ static void add_report(plume_solve_report *total, const plume_solve_report *part
 	total->min_distance = fmin(total->min_distance, part->min_distance);
 }
 
+/// Contact's continuation rounds a substep may take (contact.h: plume_contact_begin).
+enum { MAX_CONTACT_ROUNDS = 64 };
+
+/// One substep's solve from fraction s0 to s1 of the step, sim->x at its start iterate.
+/// With contact, the start iterate must be reached without passing through anything; when
+/// the prescribed motion cannot be taken at once, it is taken in rounds, each solved.
+static plume_status solve_substep(plume_sim *sim, const sim_problem *problem, double s0, double s1,
+                                  plume_solve_report *total, plume_error *err)
+{
+	double reached = 0;
+	for (int round = 0; round < MAX_CONTACT_ROUNDS; ++round) {
+		plume_status status = plume_contact_begin(sim, s0, s1, &reached, err);
+		if (status != PLUME_OK)
+			return status;
+		plume_solve_report part = {0};
+		status = plume_sim_newton(sim, problem, &part, err);
+		add_report(total, &part);
+		sim->contact.rounds += round > 0;
+		if (status != PLUME_OK || reached >= 1)
+			return status;
+	}
+	return plume_error_set(err, PLUME_ERROR_NUMERIC,
+	                       "the prescribed motion (handles, obstacles) needed more than %d contact rounds: subdividing",
+	                       MAX_CONTACT_ROUNDS);
+}
+
 plume_status plume_sim_solve_static(plume_sim *sim, plume_solve_report *report, plume_error *err)
 {
 	PLUME_ASSERT_HANDLE(sim);
@@ -735,14 +761,9 @@ plume_status plume_sim_solve_static(plume_sim *sim, plume_solve_report *report, 
 		total.substeps = substeps;
 		total.min_distance = INFINITY;
 		for (int s = 1; s <= substeps; ++s) {
-			plume_solve_report part = {0};
 			memcpy(sim->previous, sim->x, bytes);
 			plume_sim_place_handles(sim, (double)s / substeps);
-			status = plume_contact_begin(sim, (double)(s - 1) / substeps, (double)s / substeps, err);
-			if (status != PLUME_OK)
-				break;
-			status = plume_sim_newton(sim, &statics, &part, err);
-			add_report(&total, &part);
+			status = solve_substep(sim, &statics, (double)(s - 1) / substeps, (double)s / substeps, &total, err);
 			if (status != PLUME_OK)
 				break;
 		}
@@ -802,13 +823,7 @@ plume_status plume_sim_step(plume_sim *sim, plume_solve_report *report, plume_er
 			// Free vertices start from the prediction, handle vertices at their targets.
 			memcpy(sim->x, sim->predicted, bytes);
 			plume_sim_place_handles(sim, (double)s / substeps);
-			// Contact: the start iterate must be reached without passing through anything.
-			status = plume_contact_begin(sim, (double)(s - 1) / substeps, (double)s / substeps, &last);
-			if (status != PLUME_OK)
-				break;
-			plume_solve_report part = {0};
-			status = plume_sim_newton(sim, &problem, &part, &last);
-			add_report(&total, &part);
+			status = solve_substep(sim, &problem, (double)(s - 1) / substeps, (double)s / substeps, &total, &last);
 			if (status != PLUME_OK)
 				break;
 			plume_integrator_end(sim, &problem);
