@@ -13,7 +13,9 @@
 // line search on the exact l1
 // merit Phi + mu |c|_1 (mu above the largest multiplier) keeps every accepted
 // step a descent step; a second-order correction avoids the Maratos effect that
-// would otherwise reject full steps near the solution.
+// would otherwise reject full steps near the solution. With contact, continuous collision
+// detection caps every step first (contact.c; IPC's filtered line search), so no iterate
+// ever reaches a pair at distance 0.
 //
 // Why SQP and not an augmented Lagrangian or a stiff spring: the constraint is
 // the limit E_vv -> infinity, whose stiffness is what makes the unconstrained

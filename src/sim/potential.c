@@ -6,7 +6,8 @@
 // whose stationarity is the integrator's update (for implicit Euler, inertia = 1/h^2 and
 // s = 1/h: M (v_{n+1} - v_n) / h = f(x_{n+1}), thesis B.2), with R the Rayleigh dissipation
 // of the linear drag, (1/2) c A_i (v_i . n_i)^2, normals frozen at the start of the step,
-// plus the quadratic air model's (air.c), added per face.
+// plus the quadratic air model's (air.c), added per face. With contact, IPC's barrier over
+// the pairs of primitives within reach (contact.c) is added to Phi in statics and dynamics.
 //
 // Elements are evaluated in parallel into per-element buffers and summed in a
 // fixed order, so results do not depend on the number of threads.

@@ -126,7 +126,7 @@ struct plume_sim {
 };
 
 /// Potential of the problem at positions x: elastic + compression + bending + gravity
-/// (+ inertia and drag for a dynamic step). With gradient != NULL also fills the
+/// (+ inertia and drag for a dynamic step) (+ the contact barrier, contact.c). With gradient != NULL also fills the
 /// gradient (3 n); with the KKT matrix also fills its Hessian block (projected
 /// per element when project is true, exact otherwise). Returns NaN when the
 /// potential is not finite.
