@@ -6,7 +6,7 @@
 // Primitives: point-triangle pairs (a vertex of one surface against a face of the other,
 // or of the same surface when it does not own the vertex) and edge-edge pairs (no shared
 // vertex); IPC section 4.1 shows these two kinds cover every distance between two
-// triangle meshes. Candidates come from axis-aligned boxes inflated by the barrier's
+// triangle meshes. Candidates come from axis-aligned boxes inflated by half the barrier's
 // reach d-hat (sim/bvh.h): a pair whose boxes do not overlap is farther apart than d-hat
 // along some axis, so it contributes nothing, and the energy is exact whatever the
 // candidate set. The potential is a pure function of the positions: every evaluation
@@ -14,8 +14,8 @@
 //
 // The pattern of the Newton matrix must hold each active pair's 12 x 12 block. The pattern
 // is rebuilt (with its symbolic analysis) only when an active pair couples two vertices it
-// does not already couple; it then takes the blocks of every candidate in reach (boxes
-// inflated by d-hat, a superset of the active pairs), so pairs that come into reach over the
+// does not already couple; it then takes the blocks of every candidate (boxes inflated by
+// d-hat / 2: a superset of the active pairs), so pairs that come into reach over the
 // next iterations usually find their entries there.
 #include <math.h>
 #include <stdio.h>
