@@ -489,6 +489,92 @@ static void test_static_droop_onto_ground(void **state)
 	plume_mesh_destroy(mesh);
 }
 
+static double mean_speed_along(const plume_sim *sim, plume_vec3 direction)
+{
+	double sum = 0;
+	for (int i = 0; i < sim->vertex_count; ++i)
+		sum += plume_v3_dot(sim->v[i], direction);
+	return sum / sim->vertex_count;
+}
+
+/// A sheet on a ground tilted by 10 degrees, released at rest: frictionless it slides down with
+/// g sin(theta), with mu = 0.1 < tan(theta) with g (sin(theta) - mu cos(theta)), with mu = 0.5
+/// it stays (closed forms: a block on an incline).
+static void test_friction_on_slope(void **state)
+{
+	(void)state;
+	double theta = 10 * 3.14159265358979323846 / 180, duration = 0.2;
+	plume_mat3 tilt = plume_m3_rotation(plume_v3(0, 0, 1), theta);
+	plume_vec3 down = plume_m3_apply(tilt, plume_v3(-1, 0, 0)); // down the slope
+	const double coefficients[3] = {0, 0.1, 0.5};
+	for (int c = 0; c < 3; ++c) {
+		double mu = coefficients[c];
+		sheet sheets[1] = {{plume_v3(-0.01, 6e-5, -0.01), 0.02, 0.02, 5}};
+		plume_mesh *mesh = make_sheets(sheets, 1);
+		for (int i = 0; i < mesh->vertex_count; ++i)
+			mesh->rest[i] = plume_m3_apply(tilt, mesh->rest[i]);
+		plume_sim_def def = plume_sim_default_def();
+		def.contact.enabled = true;
+		def.time_step = 0.005;
+		plume_sim *sim = NULL;
+		plume_error err = {0};
+		assert_int_equal(plume_sim_create(mesh, &def, &sim, &err), PLUME_OK);
+		plume_vec3 corners[4] = {plume_v3(-0.1, 0, -0.1), plume_v3(0.1, 0, -0.1), plume_v3(0.1, 0, 0.1),
+		                         plume_v3(-0.1, 0, 0.1)};
+		for (int k = 0; k < 4; ++k)
+			corners[k] = plume_m3_apply(tilt, corners[k]);
+		int triangles[6] = {0, 1, 2, 0, 2, 3}, ground = -1;
+		assert_int_equal(plume_sim_add_obstacle(sim, corners, 4, triangles, 2, &ground, &err), PLUME_OK);
+		// Settle first, held by friction (mu = 1 > tan(theta)), so the slide starts at rest on the
+		// barrier's equilibrium gap rather than with the bounce of the release.
+		int steps = (int)lround(duration / def.time_step), iterations = 0;
+		double seconds = 0;
+		sim->def.contact.friction = 1;
+		for (int step = 0; step < 20; ++step) {
+			plume_solve_report report;
+			if (timed_step(sim, &report, &err, &seconds) != PLUME_OK)
+				fail_msg("settling, step %d: %s", step, err.message);
+		}
+		sim->def.contact.friction = mu;
+		seconds = 0;
+		plume_vec3 start = {0, 0, 0};
+		for (int i = 0; i < sim->vertex_count; ++i)
+			start = plume_v3_add(start, plume_v3_scale(sim->x[i], 1.0 / sim->vertex_count));
+		double speed_half = 0; // down the slope, at half the time
+		for (int step = 0; step < steps; ++step) {
+			plume_solve_report report;
+			if (timed_step(sim, &report, &err, &seconds) != PLUME_OK)
+				fail_msg("mu %g, step %d: %s", mu, step, err.message);
+			check_state(sim, &report);
+			iterations += report.newton_iterations;
+			if (step + 1 == steps / 2)
+				speed_half = mean_speed_along(sim, down);
+		}
+		plume_vec3 end = {0, 0, 0};
+		for (int i = 0; i < sim->vertex_count; ++i)
+			end = plume_v3_add(end, plume_v3_scale(sim->x[i], 1.0 / sim->vertex_count));
+		double travelled = plume_v3_dot(plume_v3_sub(end, start), down);
+		// The acceleration over the second half (BDF2's start-up transient has died out by then).
+		double acceleration = (mean_speed_along(sim, down) - speed_half) / (0.5 * duration);
+		double g = 9.81, a = fmax(0, g * (sin(theta) - mu * cos(theta)));
+		double lambda = 0, mass = 0;
+		for (int k = 0; k < sim->contact.friction_count; ++k)
+			lambda += sim->contact.friction[k].normal_force;
+		for (int i = 0; i < sim->vertex_count; ++i)
+			mass += sim->mass[i];
+		printf("slope, mu %.1f: %d steps (%.2f ms each), %d Newton iterations, acceleration %.4g m/s^2, closed form "
+		       "%.4g; slid %.4g m; %d friction pairs pressing with %.4g N, m g cos(theta) %.4g N\n",
+		       mu, steps, 1e3 * seconds / steps, iterations, acceleration, a, travelled, sim->contact.friction_count,
+		       lambda, mass * g * cos(theta));
+		if (a > 0)
+			assert_true(fabs(acceleration - a) <= 0.02 * a);
+		else
+			assert_true(fabs(travelled) <= 1e-4 && fabs(acceleration) <= 1e-3 * g);
+		plume_sim_destroy(sim);
+		plume_mesh_destroy(mesh);
+	}
+}
+
 /// Two sheets far apart: contact on and off give the same bits.
 static void test_far_apart_is_identical(void **state)
 {
@@ -631,6 +717,103 @@ static void test_assembled_barrier(void **state)
 	plume_mesh_destroy(mesh);
 }
 
+/// The friction potential's gradient against finite differences of the sim's potential and its
+/// Hessian against finite differences of that gradient, in the sliding and the sticking
+/// (smoothed) regimes: friction's part is taken as the difference of runs with and without it.
+static void test_friction_derivatives(void **state)
+{
+	(void)state;
+	double dhat = 1.2e-4;
+	sheet sheets[2] = {{plume_v3(0, 0, 0), 0.01, 0.01, 4}, {plume_v3(0.0011, 0.5 * dhat, 0.0013), 0.01, 0.01, 4}};
+	plume_mesh *mesh = make_sheets(sheets, 2);
+	plume_sim_def def = contact_def(1e5);
+	def.gravity = plume_v3(0, 0, 0);
+	def.contact.friction = 0.4;
+	plume_sim *sim = NULL;
+	plume_error err = {0};
+	assert_int_equal(plume_sim_create(mesh, &def, &sim, &err), PLUME_OK);
+	int n = sim->vertex_count, n3 = 3 * n, size = n3 + sim->constraint_count;
+	double h = 0.005;
+	memcpy(sim->previous, sim->x, sizeof(plume_vec3) * (size_t)n);
+	assert_true(plume_contact_lag_friction(sim, 0, h));
+	assert_true(sim->contact.friction_count > 0);
+	// No inertia: the dynamic potential is then elasticity + barrier + friction.
+	sim_problem problem = {.dynamic = true,
+	                       .h = h,
+	                       .inertia = 0,
+	                       .predicted = sim->previous,
+	                       .velocity_scale = 1 / h,
+	                       .velocity_base = sim->previous,
+	                       .drag_normals = sim->normals};
+	double *g = calloc((size_t)size, sizeof(double)), *g0 = calloc((size_t)size, sizeof(double));
+	double *gp = calloc((size_t)size, sizeof(double)), *gm = calloc((size_t)size, sizeof(double));
+	double *v = calloc((size_t)size, sizeof(double)), *kv = calloc((size_t)size, sizeof(double));
+	double *k0v = calloc((size_t)size, sizeof(double));
+	plume_vec3 *x = malloc(sizeof(plume_vec3) * (size_t)n);
+	const double slides[2] = {3 * 1e-4 * h, 0.3 * 1e-4 * h}; // above and below eps_v h
+	for (int regime = 0; regime < 2; ++regime) {
+		// The upper sheet slides sideways by slides[regime], each vertex a little differently.
+		memcpy(sim->x, sim->previous, sizeof(plume_vec3) * (size_t)n);
+		for (int i = n / 2; i < n; ++i)
+			sim->x[i] = plume_v3_add(
+			    sim->x[i], plume_v3(slides[regime] * (1 + 0.3 * sin(i)), 0, slides[regime] * 0.5 * cos(2.0 * i)));
+		double worst = 0, largest = 0;
+		sim->def.contact.friction = 0.4;
+		plume_sim_potential(sim, &problem, sim->x, g, true, true);
+		memset(kv, 0, sizeof(double) * (size_t)size);
+		for (int i = 0; i < size; ++i)
+			v[i] = i < n3 && i >= n3 / 2 ? cos(0.37 * i) : 0;
+		plume_kkt_multiply_add(&sim->kkt, v, kv);
+		sim->def.contact.friction = 0;
+		plume_sim_potential(sim, &problem, sim->x, g0, true, true);
+		memset(k0v, 0, sizeof(double) * (size_t)size);
+		plume_kkt_multiply_add(&sim->kkt, v, k0v);
+		for (int i = 0; i < n3; ++i)
+			largest = fmax(largest, fabs(g[i] - g0[i]));
+		// Gradient: central differences of the potential with friction, minus without.
+		sim->def.contact.friction = 0.4;
+		double step = 1e-3 * slides[regime];
+		for (int i = n3 / 2; i < n3; i += 5) {
+			memcpy(x, sim->x, sizeof(plume_vec3) * (size_t)n);
+			double *c = &x[i / 3].x + i % 3, saved = *c;
+			*c = saved + step;
+			double plus = plume_sim_potential(sim, &problem, x, NULL, false, true);
+			*c = saved - step;
+			double minus = plume_sim_potential(sim, &problem, x, NULL, false, true);
+			worst = fmax(worst, fabs((plus - minus) / (2 * step) - g[i]));
+		}
+		// Hessian: K v against central differences of the gradient along v.
+		double hworst = 0, hlargest = 0, hstep = 1e-3 * slides[regime];
+		for (int sign = -1; sign <= 1; sign += 2) {
+			for (int i = 0; i < n; ++i)
+				x[i] = plume_v3(sim->x[i].x + sign * hstep * v[3 * i], sim->x[i].y + sign * hstep * v[3 * i + 1],
+				                sim->x[i].z + sign * hstep * v[3 * i + 2]);
+			sim->def.contact.friction = 0.4;
+			plume_sim_potential(sim, &problem, x, sign > 0 ? gp : gm, false, true);
+			sim->def.contact.friction = 0;
+			double *without = calloc((size_t)size, sizeof(double));
+			plume_sim_potential(sim, &problem, x, without, false, true);
+			for (int i = 0; i < n3; ++i)
+				(sign > 0 ? gp : gm)[i] -= without[i];
+			free(without);
+		}
+		for (int i = 0; i < n3; ++i) {
+			if (sim->fixed[i])
+				continue;
+			double fd = (gp[i] - gm[i]) / (2 * hstep);
+			hworst = fmax(hworst, fabs(fd - (kv[i] - k0v[i])));
+			hlargest = fmax(hlargest, fabs(fd));
+		}
+		printf("friction derivatives (%s): gradient error %.3g of %.3g, Hessian error %.3g of %.3g\n",
+		       regime == 0 ? "sliding" : "sticking", worst, largest, hworst, hlargest);
+		assert_true(largest > 0 && worst <= 1e-6 * largest);
+		assert_true(hlargest > 0 && hworst <= 1e-5 * hlargest);
+	}
+	free(g), free(g0), free(gp), free(gm), free(v), free(kv), free(k0v), free(x);
+	plume_sim_destroy(sim);
+	plume_mesh_destroy(mesh);
+}
+
 /// Bad definitions and obstacles.
 static void test_bad_contact_input(void **state)
 {
@@ -729,6 +912,8 @@ int main(void)
 	    cmocka_unit_test(test_rising_ground_lifts_sheet),
 	    cmocka_unit_test_prestate(test_rising_ground_lifts_sheet, &fast_ground),
 	    cmocka_unit_test(test_static_droop_onto_ground),
+	    cmocka_unit_test(test_friction_on_slope),
+	    cmocka_unit_test(test_friction_derivatives),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

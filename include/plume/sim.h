@@ -138,6 +138,11 @@ typedef struct plume_contact_def {
 	/// step's start (continuous collision detection), in (0, 1). Default 0.1 (IPC uses
 	/// 0.1-0.2: the next iterate keeps room for the barrier to act).
 	double ccd_separation;
+	/// Coulomb friction coefficient mu, >= 0, in dynamic steps: IPC's lagged, smoothed
+	/// friction (Li et al. 2020, section 5), normal forces and sliding directions taken at
+	/// each step's start; below 1e-3 m/s of sliding it acts as a stiff viscous force.
+	/// Default 0 (frictionless).
+	double friction;
 } plume_contact_def;
 
 typedef struct plume_sim_def {

@@ -153,7 +153,8 @@ static void read_solver(plume_spec_reader *reader, const json_t *root, plume_sim
 /// $.contact.key in its message.
 static void read_contact(plume_spec_reader *reader, const json_t *root, plume_sim_def *def)
 {
-	static const char *const keys[] = {"enabled", "distance", "stiffness", "self_contact", "ccd_separation", NULL};
+	static const char *const keys[] = {"enabled",        "distance", "stiffness", "self_contact",
+	                                   "ccd_separation", "friction", NULL};
 	const json_t *contact = plume_spec_object(reader, root, "$", "contact");
 	if (contact == NULL)
 		return;
@@ -164,6 +165,7 @@ static void read_contact(plume_spec_reader *reader, const json_t *root, plume_si
 	plume_spec_number(reader, contact, "$.contact", "stiffness", &def->contact.stiffness);
 	plume_spec_bool(reader, contact, "$.contact", "self_contact", &def->contact.self_contact);
 	plume_spec_number(reader, contact, "$.contact", "ccd_separation", &def->contact.ccd_separation);
+	plume_spec_number(reader, contact, "$.contact", "friction", &def->contact.friction);
 }
 
 /// "integrator" (a word) and "air" (docs/scene.md); plume_sim_def_validate checks the numbers.

@@ -250,15 +250,17 @@ static bool rebuild_pattern(plume_sim *sim)
 {
 	sim_contact *contact = &sim->contact;
 	int n = sim->vertex_count;
-	int *blocks = plume_alloc(sizeof(int) * 4 * (size_t)(contact->pair_count > 0 ? contact->pair_count : 1));
+	int friction = contact->friction_used ? contact->friction_count : 0, count = contact->pair_count + friction;
+	int *blocks = plume_alloc(sizeof(int) * 4 * (size_t)(count > 0 ? count : 1));
 	if (blocks == NULL)
 		return false;
-	for (int p = 0; p < contact->pair_count; ++p)
+	for (int p = 0; p < count; ++p)
 		for (int k = 0; k < 4; ++k) {
-			int v = contact->pairs[p].vertices[k];
+			int v = p < contact->pair_count ? contact->pairs[p].vertices[k]
+			                                : contact->friction[p - contact->pair_count].vertices[k];
 			blocks[4 * p + k] = v < n ? v : -1;
 		}
-	plume_status status = plume_kkt_set_extra_blocks(&sim->kkt, contact->pair_count, blocks, NULL);
+	plume_status status = plume_kkt_set_extra_blocks(&sim->kkt, count, blocks, NULL);
 	plume_free(blocks);
 	++contact->pattern_rebuilds;
 	return status == PLUME_OK;
@@ -271,18 +273,18 @@ static double fail(sim_contact *contact, plume_status status, const char *messag
 	return NAN;
 }
 
-double plume_contact_evaluate(plume_sim *sim, const plume_vec3 *x, bool hessian)
+static double evaluate_friction(plume_sim *sim, const plume_vec3 *x, bool hessian);
+static bool friction_pattern_holds(const plume_sim *sim);
+
+/// Finds the pairs in reach at x (contact->active) and their smallest distance. Returns
+/// false when out of memory.
+static bool find_active(plume_sim *sim, const plume_vec3 *x)
 {
 	sim_contact *contact = &sim->contact;
-	const plume_contact_def *def = &sim->def.contact;
-	double dhat = def->distance, dhat2 = dhat * dhat;
-	contact->active_count = 0;
-	contact->min_distance = INFINITY;
-	contact->failure = PLUME_OK;
+	double dhat = sim->def.contact.distance, dhat2 = dhat * dhat, closest = INFINITY;
 	// Boxes inflated by d-hat / 2 overlap whenever the primitives are closer than d-hat.
 	if (!find_candidates(sim, x, x, contact->body_x, contact->body_x, 0.5 * dhat))
-		return fail(contact, PLUME_ERROR_MEMORY, "out of memory finding contact pairs");
-	double closest = INFINITY;
+		return false;
 	for (int p = 0; p < contact->pair_count; ++p) {
 		sim_contact_pair *pair = contact->pairs + p;
 		plume_vec3 points[4];
@@ -291,15 +293,46 @@ double plume_contact_evaluate(plume_sim *sim, const plume_vec3 *x, bool hessian)
 		if (pair->distance2 >= dhat2)
 			continue;
 		if (PLUME_GROW(contact->active, contact->active_capacity, contact->active_count + 1) != 0)
-			return fail(contact, PLUME_ERROR_MEMORY, "out of memory evaluating contact pairs");
+			return false;
 		contact->active[contact->active_count++] = p;
 		closest = fmin(closest, pair->distance2);
 	}
-	int count = contact->active_count;
-	if (count == 0)
-		return 0;
 	contact->min_distance = sqrt(closest);
-	if (!(closest > 0)) {
+	return true;
+}
+
+/// Per-pair buffers grow with the active list's capacity and are reused.
+static bool grow_buffers(sim_contact *contact)
+{
+	if (contact->active_count <= contact->buffer_capacity)
+		return true;
+	size_t capacity = (size_t)contact->active_capacity;
+	double *energy = plume_realloc(contact->energy, sizeof(double) * capacity);
+	if (energy != NULL)
+		contact->energy = energy;
+	double *gradient = energy ? plume_realloc(contact->gradient, sizeof(double) * 12 * capacity) : NULL;
+	if (gradient != NULL)
+		contact->gradient = gradient;
+	double *block = gradient ? plume_realloc(contact->hessian, sizeof(double) * 144 * capacity) : NULL;
+	if (block == NULL)
+		return false;
+	contact->hessian = block;
+	contact->buffer_capacity = contact->active_capacity;
+	return true;
+}
+
+double plume_contact_evaluate(plume_sim *sim, const plume_vec3 *x, bool hessian, bool friction)
+{
+	sim_contact *contact = &sim->contact;
+	const plume_contact_def *def = &sim->def.contact;
+	contact->active_count = 0;
+	contact->min_distance = INFINITY;
+	contact->failure = PLUME_OK;
+	contact->friction_used = friction && contact->friction_count > 0 && def->friction > 0;
+	if (!find_active(sim, x))
+		return fail(contact, PLUME_ERROR_MEMORY, "out of memory finding contact pairs");
+	int count = contact->active_count;
+	if (count > 0 && !(contact->min_distance > 0)) {
 		// In contact: outside the barrier's domain. A line search's trial never gets here
 		// (CCD); a start state can (a mesh or obstacle that touches itself).
 		const sim_contact_pair *pair = contact->pairs + contact->active[0];
@@ -313,28 +346,16 @@ double plume_contact_evaluate(plume_sim *sim, const plume_vec3 *x, bool hessian)
 		         pair->vertices[1], pair->vertices[2], pair->vertices[3], sim->vertex_count);
 		return INFINITY;
 	}
-	if (count > contact->buffer_capacity) {
-		// Per-pair buffers grow with the active list's capacity and are reused.
-		size_t capacity = (size_t)contact->active_capacity;
-		double *energy = plume_realloc(contact->energy, sizeof(double) * capacity);
-		if (energy != NULL)
-			contact->energy = energy;
-		double *gradient = energy ? plume_realloc(contact->gradient, sizeof(double) * 12 * capacity) : NULL;
-		if (gradient != NULL)
-			contact->gradient = gradient;
-		double *block = gradient ? plume_realloc(contact->hessian, sizeof(double) * 144 * capacity) : NULL;
-		if (block == NULL)
-			return fail(contact, PLUME_ERROR_MEMORY, "out of memory evaluating contact pairs");
-		contact->hessian = block;
-		contact->buffer_capacity = contact->active_capacity;
-	}
+	if (!grow_buffers(contact))
+		return fail(contact, PLUME_ERROR_MEMORY, "out of memory evaluating contact pairs");
 	if (hessian) {
-		bool holds = true;
+		bool holds = !contact->friction_used || friction_pattern_holds(sim);
 		for (int k = 0; k < count && holds; ++k)
 			holds = pattern_holds(sim, contact->pairs + contact->active[k]);
 		if (!holds && !rebuild_pattern(sim))
 			return fail(contact, PLUME_ERROR_MEMORY, "out of memory rebuilding the solver's pattern");
 	}
+	double dhat = def->distance;
 	plume_vec3 *rest = sim->rest;
 #pragma omp parallel for schedule(static) if (count >= 4096)
 	for (int k = 0; k < count; ++k) {
@@ -349,44 +370,59 @@ double plume_contact_evaluate(plume_sim *sim, const plume_vec3 *x, bool hessian)
 	double total = 0;
 	for (int k = 0; k < count; ++k)
 		total += contact->energy[k];
+	if (contact->friction_used) {
+		double dissipation = evaluate_friction(sim, x, hessian);
+		if (isnan(dissipation))
+			return fail(contact, PLUME_ERROR_MEMORY, "out of memory evaluating friction");
+		total += dissipation;
+	}
 	return total;
 }
 
-void plume_contact_scatter(plume_sim *sim, double *gradient, double *values)
+static void scatter_pair(plume_sim *sim, const int *vertices, const double *g, const double *h, double *gradient,
+                         double *values)
 {
-	const sim_contact *contact = &sim->contact;
 	int n = sim->vertex_count;
-	for (int k = 0; k < contact->active_count; ++k) {
-		const int *vertices = contact->pairs[contact->active[k]].vertices;
-		const double *g = contact->gradient + 12 * (size_t)k, *h = contact->hessian + 144 * (size_t)k;
-		for (int a = 0; a < 12; ++a) {
-			int va = vertices[a / 3];
-			if (va >= n)
+	for (int a = 0; a < 12; ++a) {
+		int va = vertices[a / 3];
+		if (va >= n)
+			continue;
+		int i = 3 * va + a % 3;
+		if (gradient != NULL)
+			gradient[i] += g[a];
+		if (values == NULL || sim->fixed[i])
+			continue;
+		for (int b = 0; b < 12; ++b) {
+			int vb = vertices[b / 3];
+			if (vb >= n)
 				continue;
-			int i = 3 * va + a % 3;
-			if (gradient != NULL)
-				gradient[i] += g[a];
-			if (values == NULL || sim->fixed[i])
-				continue;
-			for (int b = 0; b < 12; ++b) {
-				int vb = vertices[b / 3];
-				if (vb >= n)
-					continue;
-				int j = 3 * vb + b % 3;
-				if (i > j || sim->fixed[j])
-					continue; // the upper triangle holds each symmetric pair once
-				int slot = plume_sparse_find(&sim->kkt.system, i, j);
-				PLUME_ASSERT(slot >= 0); // plume_contact_evaluate made the pattern hold it
-				values[slot] += h[12 * a + b];
-			}
+			int j = 3 * vb + b % 3;
+			if (i > j || sim->fixed[j])
+				continue; // the upper triangle holds each symmetric pair once
+			int slot = plume_sparse_find(&sim->kkt.system, i, j);
+			PLUME_ASSERT(slot >= 0); // plume_contact_evaluate made the pattern hold it
+			values[slot] += h[12 * a + b];
 		}
 	}
+}
+
+bool plume_contact_any(const plume_sim *sim) { return sim->contact.active_count > 0 || sim->contact.friction_used; }
+
+void plume_contact_scatter(plume_sim *sim, double *gradient, double *values)
+{
+	sim_contact *contact = &sim->contact;
+	for (int k = 0; k < contact->active_count; ++k)
+		scatter_pair(sim, contact->pairs[contact->active[k]].vertices, contact->gradient + 12 * (size_t)k,
+		             contact->hessian + 144 * (size_t)k, gradient, values);
+	for (int k = 0; contact->friction_used && k < contact->friction_count; ++k)
+		scatter_pair(sim, contact->friction[k].vertices, contact->friction_gradient + 12 * (size_t)k,
+		             contact->friction_hessian + 144 * (size_t)k, gradient, values);
 }
 
 plume_vec3 plume_contact_obstacle_force(plume_sim *sim, int obstacle, const plume_vec3 *x)
 {
 	PLUME_ASSERT_INDEX(obstacle, sim->contact.obstacle_count);
-	plume_contact_evaluate(sim, x, false);
+	plume_contact_evaluate(sim, x, false, false);
 	const sim_contact *contact = &sim->contact;
 	const sim_obstacle *body = contact->obstacles + obstacle;
 	int n = sim->vertex_count;
@@ -401,6 +437,205 @@ plume_vec3 plume_contact_obstacle_force(plume_sim *sim, int obstacle, const plum
 		}
 	}
 	return force;
+}
+
+static void place_bodies(sim_contact *contact, double s, plume_vec3 *out)
+{
+	for (int i = 0; i < contact->body_vertex_count; ++i)
+		out[i] = s == 1 ? contact->body_end[i] : plume_v3_lerp(contact->body_start[i], contact->body_end[i], s);
+}
+
+// ---------------------------------------------------------------------------
+// Friction: IPC's lagged, smoothed Coulomb friction (Li et al. 2020, section 5.3 and
+// eqs. 16-21). At a step's start each pair in reach gets its normal force lambda (the
+// barrier's push), its tangent plane (normal to the closest points' direction) and the
+// weights that make the closest points' relative displacement u = sum_j w_j (x_j - x_j^t);
+// within the step the dissipation potential mu lambda f0(|T^T u|) opposes sliding, with f0
+// IPC's C1 smoothing of |.| over eps = eps_v h: its Hessian, mu lambda w_i w_j T M T^T, is
+// positive semidefinite as it is (M below), so it needs no projection.
+
+/// The smoothing speed eps_v, m/s: below it friction acts as a viscous force (IPC uses 1e-3
+/// times the scene's size per second; a feather is about a tenth of a metre).
+static const double FRICTION_SPEED = 1e-4;
+
+static bool friction_pattern_holds(const plume_sim *sim)
+{
+	for (int k = 0; k < sim->contact.friction_count; ++k) {
+		sim_contact_pair pair = {PLUME_CONTACT_POINT_TRIANGLE, {0, 0, 0, 0}, 0};
+		memcpy(pair.vertices, sim->contact.friction[k].vertices, sizeof pair.vertices);
+		if (!pattern_holds(sim, &pair))
+			return false;
+	}
+	return true;
+}
+
+static double clamp01(double t) { return t < 0 ? 0 : t > 1 ? 1 : t; }
+
+/// The weights of the closest points' difference (point minus triangle, or edge a minus edge
+/// b) in the region the distance function chose.
+static void closest_weights(const sim_contact_pair *pair, const plume_vec3 p[4], double w[4])
+{
+	plume_distance_kind kind;
+	if (pair->type == PLUME_CONTACT_POINT_TRIANGLE) {
+		plume_point_triangle_distance2(p[0], p[1], p[2], p[3], &kind);
+		double b[3] = {0, 0, 0};
+		int edge = kind == PLUME_PT_AB ? 0 : kind == PLUME_PT_BC ? 1 : kind == PLUME_PT_CA ? 2 : -1;
+		if (kind <= PLUME_PT_C) {
+			b[kind - PLUME_PT_A] = 1;
+		} else if (edge >= 0) {
+			int i = edge, j = (edge + 1) % 3;
+			plume_vec3 e = plume_v3_sub(p[1 + j], p[1 + i]);
+			double t = clamp01(plume_v3_dot(plume_v3_sub(p[0], p[1 + i]), e) / plume_v3_dot(e, e));
+			b[i] = 1 - t, b[j] = t;
+		} else {
+			plume_vec3 e0 = plume_v3_sub(p[2], p[1]), e1 = plume_v3_sub(p[3], p[1]), r = plume_v3_sub(p[0], p[1]);
+			double d00 = plume_v3_dot(e0, e0), d01 = plume_v3_dot(e0, e1), d11 = plume_v3_dot(e1, e1);
+			double d20 = plume_v3_dot(r, e0), d21 = plume_v3_dot(r, e1), det = d00 * d11 - d01 * d01;
+			b[1] = (d11 * d20 - d01 * d21) / det;
+			b[2] = (d00 * d21 - d01 * d20) / det;
+			b[0] = 1 - b[1] - b[2];
+		}
+		w[0] = 1, w[1] = -b[0], w[2] = -b[1], w[3] = -b[2];
+		return;
+	}
+	plume_edge_edge_distance2(p[0], p[1], p[2], p[3], &kind);
+	plume_vec3 ea = plume_v3_sub(p[1], p[0]), eb = plume_v3_sub(p[3], p[2]);
+	double s = 0, t = 0;
+	switch (kind) {
+	case PLUME_EE_A0_B0: break;
+	case PLUME_EE_A0_B1: t = 1; break;
+	case PLUME_EE_A1_B0: s = 1; break;
+	case PLUME_EE_A1_B1: s = 1, t = 1; break;
+	case PLUME_EE_A0_B: t = clamp01(plume_v3_dot(plume_v3_sub(p[0], p[2]), eb) / plume_v3_dot(eb, eb)); break;
+	case PLUME_EE_A1_B: s = 1, t = clamp01(plume_v3_dot(plume_v3_sub(p[1], p[2]), eb) / plume_v3_dot(eb, eb)); break;
+	case PLUME_EE_A_B0: s = clamp01(plume_v3_dot(plume_v3_sub(p[2], p[0]), ea) / plume_v3_dot(ea, ea)); break;
+	case PLUME_EE_A_B1: t = 1, s = clamp01(plume_v3_dot(plume_v3_sub(p[3], p[0]), ea) / plume_v3_dot(ea, ea)); break;
+	default: {
+		// The lines' closest points: minimise |a0 + s ea - b0 - t eb|^2.
+		plume_vec3 r = plume_v3_sub(p[0], p[2]);
+		double a = plume_v3_dot(ea, ea), b = plume_v3_dot(ea, eb), c = plume_v3_dot(eb, eb);
+		double d = plume_v3_dot(ea, r), e = plume_v3_dot(eb, r), det = a * c - b * b;
+		s = det > 0 ? clamp01((b * e - c * d) / det) : 0;
+		t = det > 0 ? clamp01((a * e - b * d) / det) : 0;
+	}
+	}
+	w[0] = 1 - s, w[1] = s, w[2] = -(1 - t), w[3] = -t;
+}
+
+bool plume_contact_lag_friction(plume_sim *sim, double s0, double h)
+{
+	sim_contact *contact = &sim->contact;
+	const plume_contact_def *def = &sim->def.contact;
+	contact->friction_count = 0;
+	if (!plume_contact_on(sim) || !(def->friction > 0) || !(h > 0))
+		return true;
+	contact->friction_epsilon = FRICTION_SPEED * h;
+	place_bodies(contact, s0, contact->body_lag);
+	double dhat = def->distance, dhat2 = dhat * dhat;
+	if (!find_candidates(sim, sim->previous, sim->previous, contact->body_lag, contact->body_lag, 0.5 * dhat))
+		return false;
+	for (int p = 0; p < contact->pair_count; ++p) {
+		const sim_contact_pair *pair = contact->pairs + p;
+		plume_vec3 points[4];
+		gather_pair(sim, pair, sim->previous, contact->body_lag, points);
+		double d2 = pair_distance2(pair, points), db;
+		if (!(d2 < dhat2 && d2 > 0))
+			continue;
+		plume_barrier(d2, dhat2, &db, NULL);
+		if (PLUME_GROW(contact->friction, contact->friction_capacity, contact->friction_count + 1) != 0)
+			return false;
+		sim_friction_pair *f = contact->friction + contact->friction_count;
+		memcpy(f->vertices, pair->vertices, sizeof f->vertices);
+		closest_weights(pair, points, f->weights);
+		plume_vec3 u = {0, 0, 0};
+		for (int k = 0; k < 4; ++k)
+			u = plume_v3_mad(u, f->weights[k], points[k]);
+		double d = plume_v3_length(u);
+		if (!(d > 0))
+			continue;
+		plume_vec3 n = plume_v3_scale(u, 1 / d);
+		// Any unit vector across n, then the third axis.
+		plume_vec3 axis = fabs(n.x) < 0.6 ? plume_v3(1, 0, 0) : plume_v3(0, 1, 0);
+		f->tangent[0] = plume_v3_normalize(plume_v3_cross(n, axis));
+		f->tangent[1] = plume_v3_cross(n, f->tangent[0]);
+		// -dE/dd = -kappa b'(d^2) 2 d: the barrier's push (b' < 0 within reach).
+		f->normal_force = -def->stiffness * db * 2 * sqrt(d2);
+		++contact->friction_count;
+	}
+	int count = contact->friction_count > 0 ? contact->friction_count : 1;
+	if (count > contact->friction_buffer_capacity) {
+		double *g = plume_realloc(contact->friction_gradient, sizeof(double) * 12 * (size_t)count);
+		if (g != NULL)
+			contact->friction_gradient = g;
+		double *hh = g ? plume_realloc(contact->friction_hessian, sizeof(double) * 144 * (size_t)count) : NULL;
+		if (hh == NULL)
+			return false;
+		contact->friction_hessian = hh;
+		contact->friction_buffer_capacity = count;
+	}
+	return true;
+}
+
+/// IPC's f0 (eq. 18) over eps, and f1(y) / y and the 2 x 2 matrix M of the Hessian.
+static double friction_f0(double y, double eps)
+{
+	return y < eps ? y * y / eps - y * y * y / (3 * eps * eps) + eps / 3 : y;
+}
+
+static double evaluate_friction(plume_sim *sim, const plume_vec3 *x, bool hessian)
+{
+	sim_contact *contact = &sim->contact;
+	double mu = sim->def.contact.friction, eps = contact->friction_epsilon, total = 0;
+	int n = sim->vertex_count;
+	for (int k = 0; k < contact->friction_count; ++k) {
+		const sim_friction_pair *f = contact->friction + k;
+		plume_vec3 u = {0, 0, 0};
+		for (int j = 0; j < 4; ++j) {
+			int v = f->vertices[j];
+			plume_vec3 now = v < n ? x[v] : contact->body_x[v - n];
+			plume_vec3 then = v < n ? sim->previous[v] : contact->body_lag[v - n];
+			u = plume_v3_mad(u, f->weights[j], plume_v3_sub(now, then));
+		}
+		double v2[2] = {plume_v3_dot(f->tangent[0], u), plume_v3_dot(f->tangent[1], u)};
+		double y = hypot(v2[0], v2[1]), scale = mu * f->normal_force;
+		total += scale * friction_f0(y, eps);
+		// d f0 / d v = (f1(y) / y) v; f1(y) / y = 2 / eps - y / eps^2 below eps, 1 / y above.
+		double f1_over_y = y < eps ? 2 / eps - y / (eps * eps) : 1 / y;
+		plume_vec3 tv = plume_v3_add(plume_v3_scale(f->tangent[0], v2[0]), plume_v3_scale(f->tangent[1], v2[1]));
+		double *g = contact->friction_gradient + 12 * (size_t)k;
+		for (int j = 0; j < 4; ++j) {
+			double c = scale * f1_over_y * f->weights[j];
+			g[3 * j] = c * tv.x, g[3 * j + 1] = c * tv.y, g[3 * j + 2] = c * tv.z;
+		}
+		if (!hessian)
+			continue;
+		// M = (f1/y) I + (d(f1/y)/dy / y) v v^T: below eps (2/eps - y/eps^2) I - v v^T / (eps^2 y),
+		// above (I - v v^T / y^2) / y; both positive semidefinite (eigenvalues >= 0 for y <= eps).
+		double m[2][2];
+		for (int a = 0; a < 2; ++a)
+			for (int b = 0; b < 2; ++b) {
+				double outer = v2[a] * v2[b];
+				double extra = y < eps ? (y > 0 ? -outer / (eps * eps * y) : 0) : -outer / (y * y * y);
+				m[a][b] = (a == b ? f1_over_y : 0) + extra;
+			}
+		// T M T^T (3 x 3), then the 12 x 12 blocks w_i w_j scale T M T^T.
+		double tm[3][3];
+		const double t[2][3] = {{f->tangent[0].x, f->tangent[0].y, f->tangent[0].z},
+		                        {f->tangent[1].x, f->tangent[1].y, f->tangent[1].z}};
+		for (int r = 0; r < 3; ++r)
+			for (int c = 0; c < 3; ++c) {
+				double sum = 0;
+				for (int a = 0; a < 2; ++a)
+					for (int b = 0; b < 2; ++b)
+						sum += t[a][r] * m[a][b] * t[b][c];
+				tm[r][c] = sum;
+			}
+		double *h = contact->friction_hessian + 144 * (size_t)k;
+		for (int i = 0; i < 12; ++i)
+			for (int j = 0; j < 12; ++j)
+				h[12 * i + j] = scale * f->weights[i / 3] * f->weights[j / 3] * tm[i % 3][j % 3];
+	}
+	return total;
 }
 
 // ---------------------------------------------------------------------------
@@ -428,12 +663,6 @@ double plume_contact_step_bound(plume_sim *sim, const plume_vec3 *x0, const plum
 		bound = fmin(bound, t);
 	}
 	return bound;
-}
-
-static void place_bodies(sim_contact *contact, double s, plume_vec3 *out)
-{
-	for (int i = 0; i < contact->body_vertex_count; ++i)
-		out[i] = s == 1 ? contact->body_end[i] : plume_v3_lerp(contact->body_start[i], contact->body_end[i], s);
 }
 
 /// The handle vertices of x at step fraction s (sim.c's plume_sim_place_handles, into any array).
@@ -545,8 +774,8 @@ plume_status plume_sim_add_obstacle(plume_sim *sim, const plume_vec3 *positions,
 	if (PLUME_GROW(contact->obstacles, contact->obstacle_capacity, contact->obstacle_count + 1) != 0 ||
 	    PLUME_GROW(contact->body_faces, contact->body_face_capacity, 3 * faces) != 0)
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory adding an obstacle");
-	plume_vec3 **arrays[] = {&contact->body_rest, &contact->body_start, &contact->body_end, &contact->body_x,
-	                         &contact->body_from};
+	plume_vec3 **arrays[] = {&contact->body_rest, &contact->body_start, &contact->body_end,
+	                         &contact->body_x,    &contact->body_from,  &contact->body_lag};
 	if (vertices > capacity) {
 		for (size_t a = 0; a < sizeof arrays / sizeof arrays[0]; ++a) {
 			plume_vec3 *grown = plume_realloc(*arrays[a], sizeof(plume_vec3) * (size_t)vertices);

@@ -19,6 +19,16 @@ typedef struct sim_contact_pair {
 	double distance2;
 } sim_contact_pair;
 
+/// A pair of IPC's lagged friction (Li et al. 2020, section 5.3), fixed at a step's start:
+/// the relative sliding u = sum_j weights[j] (x_j - x_j at the start) of the pair's closest
+/// points, its tangent plane, and the normal force the barrier pressed with there.
+typedef struct sim_friction_pair {
+	int vertices[4];
+	double weights[4];
+	plume_vec3 tangent[2];
+	double normal_force;
+} sim_friction_pair;
+
 /// One obstacle: a range of the concatenated obstacle vertices and triangles.
 typedef struct sim_obstacle {
 	int first_vertex, vertex_count;
@@ -44,7 +54,7 @@ typedef struct sim_contact {
 	int obstacle_count, obstacle_capacity;
 	sim_obstacle *obstacles;
 	int body_vertex_count, body_vertex_capacity;
-	plume_vec3 *body_rest, *body_start, *body_end, *body_x, *body_from;
+	plume_vec3 *body_rest, *body_start, *body_end, *body_x, *body_from, *body_lag;
 	int body_face_count, body_face_capacity;
 	int *body_faces;
 	int body_edge_count;
@@ -63,6 +73,14 @@ typedef struct sim_contact {
 	int *active;
 	double *energy, *gradient, *hessian;
 	int buffer_capacity;
+	/// Friction (def.contact.friction > 0, dynamic steps): the lagged pairs, the smoothing
+	/// width epsilon_v h, m, and per-pair gradients and Hessians of the last evaluation.
+	int friction_count, friction_capacity;
+	sim_friction_pair *friction;
+	double friction_epsilon;
+	double *friction_gradient, *friction_hessian;
+	int friction_buffer_capacity;
+	bool friction_used;
 	/// The smallest pair distance of the last evaluation, m (+inf when no pair is in reach).
 	double min_distance;
 	/// Times the KKT pattern was rebuilt for new contact couplings, and continuation rounds
@@ -85,7 +103,15 @@ bool plume_contact_on(const struct plume_sim *sim);
 /// evaluates them (energies, gradients, PSD-projected Hessians) and, with hessian, makes
 /// sure the KKT pattern holds their blocks (rebuilding it when it does not). Returns the
 /// energy, +inf when a pair is in contact (distance 0), NaN when out of memory.
-double plume_contact_evaluate(struct plume_sim *sim, const plume_vec3 *x, bool hessian);
+/// With friction (dynamic problems), also the lagged friction of plume_contact_lag_friction.
+double plume_contact_evaluate(struct plume_sim *sim, const plume_vec3 *x, bool hessian, bool friction);
+
+/// Fixes the friction pairs of a (sub)step from fraction s0 of the step: the pairs within reach
+/// at its start (sim->previous, obstacles at s0), for a step of length h. None in statics
+/// (h = 0) or without friction. False when out of memory.
+bool plume_contact_lag_friction(struct plume_sim *sim, double s0, double h);
+/// The last evaluation found pairs in reach or used friction (something to scatter).
+bool plume_contact_any(const struct plume_sim *sim);
 /// Adds the last evaluation's gradient (when gradient != NULL) and Hessian blocks (when
 /// values != NULL) on free shell unknowns.
 void plume_contact_scatter(struct plume_sim *sim, double *gradient, double *values);

@@ -143,7 +143,7 @@ double plume_sim_potential(plume_sim *sim, const sim_problem *problem, const plu
 		plume_air_add(sim, problem, x, want_gradient, hessian);
 	// Contact first: it may rebuild the matrix's pattern (contact.c).
 	bool contact = plume_contact_on(sim);
-	double contact_energy = contact ? plume_contact_evaluate(sim, x, hessian) : 0;
+	double contact_energy = contact ? plume_contact_evaluate(sim, x, hessian, problem->dynamic) : 0;
 	if (!isfinite(contact_energy))
 		return NAN; // out of memory, or a pair in contact: outside the barrier's domain
 
@@ -210,8 +210,9 @@ double plume_sim_potential(plume_sim *sim, const sim_problem *problem, const plu
 			scatter_block(sim, values, &i, 1, sim->kkt.vertex_slots + 9 * i, block);
 	}
 
-	if (contact && sim->contact.active_count > 0) {
-		// The IPC barrier over the pairs in reach (Li et al. 2020, eq. 6), Hessian projected.
+	if (contact && plume_contact_any(sim)) {
+		// The IPC barrier over the pairs in reach (Li et al. 2020, eq. 6), Hessian projected,
+		// and the lagged friction of a dynamic step.
 		energy += contact_energy;
 		plume_contact_scatter(sim, gradient, values);
 	}

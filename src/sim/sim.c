@@ -37,6 +37,7 @@ plume_sim_def plume_sim_default_def(void)
 	def.contact.stiffness = 1e6;
 	def.contact.self_contact = true;
 	def.contact.ccd_separation = 0.1;
+	def.contact.friction = 0;
 	def.cookie = PLUME_DEF_COOKIE;
 	return def;
 }
@@ -94,6 +95,8 @@ static plume_status check_contact(const plume_contact_def *contact, plume_error 
 	if (!(contact->ccd_separation > 0 && contact->ccd_separation < 1))
 		return plume_error_set(err, PLUME_ERROR_SPEC, "$.contact.ccd_separation is %g, allowed (0, 1)",
 		                       contact->ccd_separation);
+	if (!(contact->friction >= 0 && contact->friction <= 1e3))
+		return plume_error_set(err, PLUME_ERROR_SPEC, "$.contact.friction is %g, allowed [0, 1000]", contact->friction);
 	return PLUME_OK;
 }
 
@@ -729,6 +732,8 @@ static plume_status solve_substep(plume_sim *sim, const sim_problem *problem, do
                                   plume_solve_report *total, plume_error *err)
 {
 	double reached = 0;
+	if (!plume_contact_lag_friction(sim, s0, problem->dynamic ? problem->h : 0))
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory finding friction pairs");
 	for (int round = 0; round < MAX_CONTACT_ROUNDS; ++round) {
 		plume_status status = plume_contact_begin(sim, s0, s1, &reached, err);
 		if (status != PLUME_OK)
