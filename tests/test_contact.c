@@ -873,12 +873,12 @@ static void test_scene_contact(void **state)
 	assert_true(scene->sim.contact.distance == 1.2e-4 && scene->sim.contact.stiffness == 1e6);
 	plume_scene_destroy(scene);
 	assert_int_equal(parse_contact("{\"distance\": 2e-4, \"stiffness\": 5e5, \"self_contact\": false, "
-	                               "\"ccd_separation\": 0.2}",
+	                               "\"ccd_separation\": 0.2, \"friction\": 0.3}",
 	                               &scene, &err),
 	                 PLUME_OK);
 	assert_true(scene->sim.contact.enabled && !scene->sim.contact.self_contact);
 	assert_true(scene->sim.contact.distance == 2e-4 && scene->sim.contact.stiffness == 5e5 &&
-	            scene->sim.contact.ccd_separation == 0.2);
+	            scene->sim.contact.ccd_separation == 0.2 && scene->sim.contact.friction == 0.3);
 	plume_scene_destroy(scene);
 	assert_int_equal(parse_contact("{\"enabled\": false}", &scene, &err), PLUME_OK);
 	assert_false(scene->sim.contact.enabled);
@@ -887,6 +887,7 @@ static void test_scene_contact(void **state)
 	    {"{\"distance\": 0}", "$.contact.distance is 0, allowed [1e-09, 1] m"},
 	    {"{\"stiffness\": -1}", "$.contact.stiffness is -1, allowed (0, 1e30]"},
 	    {"{\"ccd_separation\": 1.5}", "$.contact.ccd_separation is 1.5, allowed (0, 1)"},
+	    {"{\"friction\": -0.1}", "$.contact.friction is -0.1, allowed [0, 1000]"},
 	    {"{\"reach\": 1}", "$.contact"},
 	    {"{\"enabled\": 1}", "$.contact.enabled"},
 	};
