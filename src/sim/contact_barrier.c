@@ -345,7 +345,7 @@ double plume_contact_pair_energy(plume_contact_pair_type type, const plume_vec3 
 	// The mollifier of edge-edge pairs, m(x) with x = |e0 x e1|² (IPC eq. 14-15).
 	double m = 1, dm = 0, d2m = 0;
 	bool mollified = false;
-	double mg[12] = {0}, mh[144] = {0};
+	double xg[12] = {0}, xh[144] = {0}; // x = |e0 x e1|²
 	if (type == PLUME_CONTACT_EDGE_EDGE) {
 		PLUME_ASSERT(rest != NULL);
 		plume_vec3 r0 = plume_v3_sub(rest[1], rest[0]), r1 = plume_v3_sub(rest[3], rest[2]);
@@ -357,19 +357,20 @@ double plume_contact_pair_energy(plume_contact_pair_type type, const plume_vec3 
 		m = mollifier(cross2, epsilon, &dm, &d2m);
 		mollified = m < 1;
 		if (mollified)
-			scatter(form2(1, 0, 3, 2), lg, lh, mg, mh);
+			scatter(form2(1, 0, 3, 2), lg, lh, xg, xh);
 	}
 	// E = k m b: grad E = k (b grad m + m grad b), with grad m = m' grad x and
-	// grad b = b' grad d²; hess E = k (b hess m + grad m grad bᵀ + grad b grad mᵀ + m hess b).
+	// grad b = b' grad d²; hess E = k (b hess m + grad m grad bᵀ + grad b grad mᵀ + m hess b),
+	// hess m = m'' grad x grad xᵀ + m' hess x, hess b = b'' grad d² grad d²ᵀ + b' hess d².
 	if (gradient != NULL)
 		for (int i = 0; i < 12; ++i)
-			gradient[i] = stiffness * (b * dm * mg[i] + m * db * dg[i]);
+			gradient[i] = stiffness * (b * dm * xg[i] + m * db * dg[i]);
 	if (hessian != NULL) {
 		for (int i = 0; i < 12; ++i)
 			for (int j = i; j < 12; ++j) {
-				double hess_m = d2m * mg[i] * mg[j] + dm * mh[i * 12 + j];
+				double hess_m = d2m * xg[i] * xg[j] + dm * xh[i * 12 + j];
 				double hess_b = d2b * dg[i] * dg[j] + db * dh[i * 12 + j];
-				double cross_terms = dm * db * (mg[i] * dg[j] + dg[i] * mg[j]);
+				double cross_terms = dm * db * (xg[i] * dg[j] + dg[i] * xg[j]);
 				hessian[i * 12 + j] = stiffness * (b * hess_m + cross_terms + m * hess_b);
 			}
 		symmetrize(hessian);

@@ -24,8 +24,7 @@ static plume_distance_kind segment_kind(double t, plume_distance_kind at_from, p
 	return t <= 0 ? at_from : t >= 1 ? at_to : interior;
 }
 
-double plume_point_triangle_distance2(plume_vec3 p, plume_vec3 a, plume_vec3 b, plume_vec3 c,
-                                      plume_distance_kind *kind)
+double plume_point_triangle_distance2(plume_vec3 p, plume_vec3 a, plume_vec3 b, plume_vec3 c, plume_distance_kind *kind)
 {
 	plume_vec3 ab = plume_v3_sub(b, a), ac = plume_v3_sub(c, a);
 	plume_vec3 n = plume_v3_cross(ab, ac);
@@ -68,8 +67,7 @@ double plume_point_triangle_distance2(plume_vec3 p, plume_vec3 a, plume_vec3 b, 
 	return best;
 }
 
-double plume_edge_edge_distance2(plume_vec3 a0, plume_vec3 a1, plume_vec3 b0, plume_vec3 b1,
-                                 plume_distance_kind *kind)
+double plume_edge_edge_distance2(plume_vec3 a0, plume_vec3 a1, plume_vec3 b0, plume_vec3 b1, plume_distance_kind *kind)
 {
 	// The closest pair has an endpoint in it unless both closest points are interior,
 	// which needs the lines not to be parallel: try the lines, then the four endpoints.
