@@ -115,6 +115,36 @@ typedef enum plume_bending_model {
 	PLUME_BENDING_PAPER_HINGE = 1,
 } plume_bending_model;
 
+/// Contact (docs/contact.md): IPC's log barrier (Li et al. 2020, "Incremental Potential Contact")
+/// between the shell and itself and between the shell and obstacles, with continuous collision
+/// detection bounding every Newton step, so no accepted state has two surfaces in contact.
+typedef struct plume_contact_def {
+	/// Turn contact on. Default false (scenes turn it on).
+	bool enabled;
+	/// The barrier's reach d-hat, m, > 0: pairs of primitives closer than this repel. Default
+	/// 1.2e-4, the vane's thickness (thesis Table 3.1 and Table 6.1), so two vanes at rest lie
+	/// about a thickness apart.
+	double distance;
+	/// Barrier stiffness kappa, J/m^4, > 0: a pair's energy is kappa b(d^2) with IPC's
+	/// b(d^2) = -(d^2 - dhat^2)^2 ln(d^2 / dhat^2) (m^4). Default 1e6: a point over a plane at
+	/// d = dhat / 2 is then pushed with 4.33 kappa dhat^3 = 7.5e-6 N, about the weight of a vane
+	/// vertex at the default 5 mm mesh (0.026 kg/m^2 x 2.2e-5 m^2 x 9.81 m/s^2), so vanes at rest
+	/// lie about half the contact distance apart (docs/contact.md).
+	double stiffness;
+	/// A feather against itself and against other feathers of the same mesh. Default true;
+	/// false keeps contact with obstacles only.
+	bool self_contact;
+	/// Every line-search step keeps each pair at least this fraction of its distance at the
+	/// step's start (continuous collision detection), in (0, 1). Default 0.1 (IPC uses
+	/// 0.1-0.2: the next iterate keeps room for the barrier to act).
+	double ccd_separation;
+	/// Coulomb friction coefficient mu, >= 0, in dynamic steps: IPC's lagged, smoothed
+	/// friction (Li et al. 2020, section 5), normal forces and sliding directions taken at
+	/// each step's start; below 1e-3 m/s of sliding it acts as a stiff viscous force.
+	/// Default 0 (frictionless).
+	double friction;
+} plume_contact_def;
+
 typedef struct plume_sim_def {
 	/// Material table indexed by plume_mesh.material. Default: [vane, rachis].
 	plume_material materials[PLUME_MAX_MATERIALS];
@@ -137,6 +167,8 @@ typedef struct plume_sim_def {
 	/// Fix every vertex's z: in-plane problems (the lab's samples). Default false.
 	bool planar;
 	plume_solver_def solver;
+	/// Contact with itself and with obstacles. Default off.
+	plume_contact_def contact;
 	/// PLUME_DEF_COOKIE, set by plume_sim_default_def; do not change.
 	uint32_t cookie;
 } plume_sim_def;
@@ -179,6 +211,11 @@ typedef struct plume_solve_report {
 	double seconds_assembly;
 	double seconds_factor;
 	double seconds_solve;
+	/// Contact (with def.contact.enabled): pairs of primitives within the barrier's reach at the
+	/// end, and the smallest pair distance seen at accepted iterates, m (+inf when none was
+	/// within reach).
+	int contact_pairs;
+	double min_distance;
 } plume_solve_report;
 
 /// Minimises the elastic + gravity potential with the handles where they are.
@@ -190,6 +227,17 @@ plume_status plume_sim_solve_static(plume_sim *sim, plume_solve_report *report, 
 /// A step that does not converge is retried with substeps (handles interpolated linearly);
 /// if that fails too, the state is left as before the step and PLUME_ERROR_NUMERIC returned.
 plume_status plume_sim_step(plume_sim *sim, plume_solve_report *report, plume_error *err);
+
+/// Obstacles: triangle meshes moved by prescription (bodies). The shell collides with them
+/// (with def.contact.enabled); they do not move in response. The positions are copied;
+/// triangles index them. Returns the obstacle's index in *obstacle. PLUME_ERROR_SPEC for
+/// out-of-range indices, non-finite positions or an obstacle that intersects or touches the
+/// shell; PLUME_ERROR_MEMORY.
+plume_status plume_sim_add_obstacle(plume_sim *sim, const plume_vec3 *positions, int vertex_count, const int *triangles,
+                                    int triangle_count, int *obstacle, plume_error *err);
+/// The obstacle's positions at the end of the next step or static solve (vertex_count of
+/// them); within the step it moves linearly from where it was.
+void plume_sim_set_obstacle_positions(plume_sim *sim, int obstacle, const plume_vec3 *positions);
 
 int plume_sim_vertex_count(const plume_sim *sim);
 /// Barb-aligned edges held inextensible.

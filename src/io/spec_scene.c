@@ -20,7 +20,7 @@
 static const char *const top_keys[] = {
     "description", "feather",    "feathers", "guides",       "seed",      "mesh",     "materials",   "handles",
     "forces",      "gravity",    "drag",     "bending",      "time_step", "duration", "frame_every", "quasi_static",
-    "solver",      "integrator", "air",      "cycle_period", "body",      NULL,
+    "solver",      "integrator", "air",      "cycle_period", "body",      "contact",  NULL,
 };
 static const char *const feather_entry_keys[] = {
     "shaft", "front", "name", "feather", "coat", "mesh", "position", "rotation_axis", "rotation_deg", "follicle", NULL};
@@ -155,6 +155,26 @@ static void read_solver(plume_spec_reader *reader, const json_t *root, plume_sim
 	plume_spec_number(reader, solver, "$.solver", "tolerance", &def->solver.tolerance);
 	plume_spec_int(reader, solver, "$.solver", "max_iterations", &def->solver.max_iterations);
 	plume_spec_int(reader, solver, "$.solver", "max_substep_halvings", &def->solver.max_substep_halvings);
+}
+
+/// The optional "contact" object (docs/scene.md, docs/contact.md): a scene that has one gets
+/// contact unless it says "enabled": false; plume_sim_def_validate checks the ranges and names
+/// $.contact.key in its message.
+static void read_contact(plume_spec_reader *reader, const json_t *root, plume_sim_def *def)
+{
+	static const char *const keys[] = {"enabled",        "distance", "stiffness", "self_contact",
+	                                   "ccd_separation", "friction", NULL};
+	const json_t *contact = plume_spec_object(reader, root, "$", "contact");
+	if (contact == NULL)
+		return;
+	plume_spec_check_keys(reader, contact, "$.contact", keys);
+	def->contact.enabled = true;
+	plume_spec_bool(reader, contact, "$.contact", "enabled", &def->contact.enabled);
+	plume_spec_number(reader, contact, "$.contact", "distance", &def->contact.distance);
+	plume_spec_number(reader, contact, "$.contact", "stiffness", &def->contact.stiffness);
+	plume_spec_bool(reader, contact, "$.contact", "self_contact", &def->contact.self_contact);
+	plume_spec_number(reader, contact, "$.contact", "ccd_separation", &def->contact.ccd_separation);
+	plume_spec_number(reader, contact, "$.contact", "friction", &def->contact.friction);
 }
 
 /// "integrator" (a word) and "air" (docs/scene.md); plume_sim_def_validate checks the numbers.
@@ -1190,6 +1210,7 @@ static plume_status scene_from_json(const char *path, json_t *root, const plume_
 	plume_spec_bool(&reader, root, "$", "quasi_static", &scene->quasi_static);
 	read_solver(&reader, root, &scene->sim);
 	read_dynamics(&reader, root, &scene->sim);
+	read_contact(&reader, root, &scene->sim);
 	if (reader.status == PLUME_OK && !(scene->duration > 0 && isfinite(scene->duration)))
 		plume_spec_fail(&reader, "$.duration", "is %g, allowed > 0 (seconds)", scene->duration);
 	if (reader.status == PLUME_OK && scene->frame_every < 1)

@@ -40,11 +40,19 @@ static void fill_block_slots(const plume_sparse *system, const int *vertices, in
 		}
 }
 
-plume_status plume_kkt_init(plume_kkt *kkt, int vertex_count, int face_count, const int *faces, int bending_count,
-                            const int *bending_vertices, int bending_stride, int bending_size, int constraint_count,
-                            const int *constraint_vertices, plume_error *err)
+static plume_status build(plume_kkt *kkt, int vertex_count, int face_count, const int *faces, int bending_count,
+                          const int *bending_vertices, int bending_stride, int bending_size, int constraint_count,
+                          const int *constraint_vertices, int extra_count, const int *extra, plume_error *err)
 {
 	memset(kkt, 0, sizeof *kkt);
+	kkt->vertex_count = vertex_count;
+	kkt->face_count = face_count;
+	kkt->faces = faces;
+	kkt->bending_count = bending_count;
+	kkt->bending_vertices = bending_vertices;
+	kkt->bending_stride = bending_stride;
+	kkt->constraint_vertices = constraint_vertices;
+	kkt->extra_count = extra_count;
 	kkt->dof_count = 3 * vertex_count;
 	kkt->constraint_count = constraint_count;
 	int size = kkt->dof_count + constraint_count;
@@ -60,6 +68,8 @@ plume_status plume_kkt_init(plume_kkt *kkt, int vertex_count, int face_count, co
 		    push_block(&list, (const int *)((const char *)bending_vertices + (size_t)h * bending_stride), bending_size);
 	for (int k = 0; k < constraint_count && !failed; ++k)
 		failed = push_block(&list, constraint_vertices + 2 * k, 2);
+	for (int k = 0; k < extra_count && !failed; ++k)
+		failed = push_block(&list, extra + 4 * k, 4);
 	for (int k = 0; k < constraint_count && !failed; ++k) {
 		int column = kkt->dof_count + k;
 		if (PLUME_GROW(list.items, list.capacity, list.count + 7) != 0) {
@@ -113,6 +123,27 @@ plume_status plume_kkt_init(plume_kkt *kkt, int vertex_count, int face_count, co
 		kkt->constraint_slots[7 * k + 6] = plume_sparse_find(matrix, column, column);
 	}
 
+	return PLUME_OK;
+}
+
+plume_status plume_kkt_init(plume_kkt *kkt, int vertex_count, int face_count, const int *faces, int bending_count,
+                            const int *bending_vertices, int bending_stride, int bending_size, int constraint_count,
+                            const int *constraint_vertices, plume_error *err)
+{
+	return build(kkt, vertex_count, face_count, faces, bending_count, bending_vertices, bending_stride, bending_size,
+	             constraint_count, constraint_vertices, 0, NULL, err);
+}
+
+plume_status plume_kkt_set_extra_blocks(plume_kkt *kkt, int count, const int *vertices, plume_error *err)
+{
+	plume_kkt rebuilt;
+	plume_status status = build(&rebuilt, kkt->vertex_count, kkt->face_count, kkt->faces, kkt->bending_count,
+	                            kkt->bending_vertices, kkt->bending_stride, kkt->bending_size, kkt->constraint_count,
+	                            kkt->constraint_vertices, count, vertices, err);
+	if (status != PLUME_OK)
+		return status;
+	plume_kkt_free(kkt);
+	*kkt = rebuilt;
 	return PLUME_OK;
 }
 

@@ -9,7 +9,8 @@
 // symmetric ordering (Vanderbei 1995), so CHOLMOD's simplicial LDL' factors it
 // without pivoting; its supernodal mode computes LL' only and cannot. Without
 // constraints the matrix is H alone, factored by Cholesky (LL', sim/sparse.h).
-// The pattern is fixed per mesh: the symbolic analysis runs once.
+// The pattern is fixed per mesh, the symbolic analysis runs once, except when contact
+// (sim/contact.c) couples vertices the mesh does not: plume_kkt_set_extra_blocks.
 #ifndef PLUME_SIM_KKT_H
 #define PLUME_SIM_KKT_H
 
@@ -31,6 +32,11 @@ typedef struct plume_kkt {
 	int *constraint_slots; ///< 7 per constraint: 6 Jacobian entries and the diagonal
 	int *pair_slots;       ///< 36 per constraint: the 6x6 position block of its two vertices
 	double *refine;        ///< scratch for iterative refinement (3 x size)
+	/// plume_kkt_init's arguments (the caller keeps the arrays alive), for plume_kkt_set_extra_blocks.
+	int vertex_count, face_count, bending_count, bending_stride;
+	const int *faces, *bending_vertices, *constraint_vertices;
+	/// 4-vertex blocks beyond the mesh's (contact pairs) in the current pattern.
+	int extra_count;
 } plume_kkt;
 
 /// Builds the pattern from faces (3 vertices), bending elements (bending_size vertices
@@ -40,6 +46,11 @@ plume_status plume_kkt_init(plume_kkt *kkt, int vertex_count, int face_count, co
                             const int *bending_vertices, int bending_stride, int bending_size, int constraint_count,
                             const int *constraint_vertices, plume_error *err);
 void plume_kkt_free(plume_kkt *kkt);
+
+/// Rebuilds the pattern (and its symbolic analysis) with count extra blocks of 4 vertices
+/// each (a negative vertex is absent) beside plume_kkt_init's: the contact pairs' couplings.
+/// Slots of the old pattern are invalid afterwards. On failure the old pattern stays.
+plume_status plume_kkt_set_extra_blocks(plume_kkt *kkt, int count, const int *vertices, plume_error *err);
 
 /// Values array of the matrix (zero it, then add into slots).
 double *plume_kkt_values(plume_kkt *kkt);

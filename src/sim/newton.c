@@ -13,7 +13,9 @@
 // line search on the exact l1
 // merit Phi + mu |c|_1 (mu above the largest multiplier) keeps every accepted
 // step a descent step; a second-order correction avoids the Maratos effect that
-// would otherwise reject full steps near the solution.
+// would otherwise reject full steps near the solution. With contact, continuous collision
+// detection caps every step first (contact.c; IPC's filtered line search), so no iterate
+// ever reaches a pair at distance 0.
 //
 // Why SQP and not an augmented Lagrangian or a stiff spring: the constraint is
 // the limit E_vv -> infinity, whose stiffness is what makes the unconstrained
@@ -36,6 +38,8 @@ enum { MAX_BACKTRACKS = 30 };
 static const double KKT_REGULARISATION = 1e-15;
 /// A solve also requires every constrained barb edge's strain below this.
 static const double STRAIN_TOLERANCE = 1e-10;
+/// IPC's Newton tolerance on the step per unit time, relative to the shell's size (1/s).
+static const double CONTACT_VELOCITY_TOLERANCE = 1e-6;
 
 /// c_k and the unit edge direction t_k (the constraint gradient is -t on vertex i, +t on j).
 static double constraint_value(const plume_sim *sim, const plume_vec3 *x, int k, plume_vec3 *direction, double *length)
@@ -214,8 +218,14 @@ static plume_status newton_system(plume_sim *sim, const sim_problem *problem, bo
 	double *g = sim->gradient;
 	double t0 = omp_get_wtime();
 	*phi = plume_sim_potential(sim, problem, sim->x, g, true, !exact);
+	if (isnan(*phi) && plume_contact_on(sim) && sim->contact.failure != PLUME_OK)
+		return plume_error_set(err, sim->contact.failure, "%s", sim->contact.message);
 	if (isnan(*phi))
 		return plume_error_set(err, PLUME_ERROR_NUMERIC, "the potential is not finite (NaN or infinite)");
+	if (plume_contact_on(sim)) {
+		report->contact_pairs = sim->contact.active_count;
+		report->min_distance = fmin(report->min_distance, sim->contact.min_distance);
+	}
 	for (int i = 0; i < n3; ++i)
 		if (sim->fixed[i])
 			g[i] = 0;
@@ -267,7 +277,14 @@ plume_status plume_sim_newton(plume_sim *sim, const sim_problem *problem, plume_
 	sim->exact_hessian_failed = false;
 	report->converged = false;
 	report->newton_iterations = 0;
+	report->contact_pairs = 0;
+	report->min_distance = INFINITY;
 	sim->trace_count = 0;
+	bool contact = plume_contact_on(sim);
+	// IPC's termination (Li et al. 2020, section 5.4): with pairs in reach, the barrier's
+	// stiffness makes force residuals a poor test; a step below CONTACT_VELOCITY_TOLERANCE
+	// of the shell's size per second (times the step length h) means the iterate has stopped.
+	double h = problem->dynamic ? problem->h : 1;
 
 	for (int iteration = 0;; ++iteration) {
 		double phi, residual;
@@ -322,9 +339,23 @@ plume_status plume_sim_newton(plume_sim *sim, const sim_problem *problem, plume_
 		slope -= mu * violation;
 		double current = phi + mu * violation;
 
+		// Continuous collision detection: the largest step fraction that keeps every pair at
+		// least ccd_separation of its distance (IPC section 5, "filtered line search").
+		double bound = 1;
+		if (contact) {
+			apply_step(sim, x, step, 1, sim->trial);
+			bound = plume_contact_step_bound(sim, x, sim->trial, sim->contact.body_x, sim->contact.body_x);
+			if (isnan(bound))
+				return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory finding contact pairs");
+		}
+
 		// The Newton decrement in length form: a step below tolerance of the shell's size
-		// changes nothing that matters; take it and stop.
-		if (feasible && step_size <= solver->tolerance * sim->length_scale) {
+		// changes nothing that matters; take it and stop. With contact pairs in reach, IPC's
+		// criterion on the step per unit time too.
+		bool stopped =
+		    step_size <= solver->tolerance * sim->length_scale ||
+		    (contact && report->contact_pairs > 0 && step_size <= CONTACT_VELOCITY_TOLERANCE * sim->length_scale * h);
+		if (feasible && bound >= 1 && stopped) {
 			apply_step(sim, x, step, 1, sim->trial);
 			memcpy(x, sim->trial, sizeof(plume_vec3) * (size_t)sim->vertex_count);
 			for (int k = 0; k < m; ++k)
@@ -335,8 +366,10 @@ plume_status plume_sim_newton(plume_sim *sim, const sim_problem *problem, plume_
 		}
 
 		// Backtracking (Armijo) on the merit; a second-order correction first when the full step fails.
-		double alpha = 1;
+		double alpha = bound;
 		bool accepted = false;
+		if (!(alpha > 0))
+			break; // CCD allows no motion at all (a pair that starts in contact): no step to take
 		for (int backtrack = 0; backtrack < MAX_BACKTRACKS && !accepted; ++backtrack) {
 			apply_step(sim, x, step, alpha, sim->trial);
 			double trial = merit(sim, problem, sim->trial, mu);
@@ -354,6 +387,12 @@ plume_status plume_sim_newton(plume_sim *sim, const sim_problem *problem, plume_
 				double *correction = g; // the gradient is not needed again this iteration
 				if (plume_kkt_solve(&sim->kkt, correction_rhs, correction, err) == PLUME_OK) {
 					apply_step(sim, sim->trial, correction, 1, sim->scratch);
+					// The corrected point must be reached without passing through anything, too.
+					if (contact && !(plume_contact_step_bound(sim, x, sim->scratch, sim->contact.body_x,
+					                                          sim->contact.body_x) >= 1)) {
+						alpha *= 0.5;
+						continue;
+					}
 					double corrected = merit(sim, problem, sim->scratch, mu);
 					if (isfinite(corrected) && corrected <= current + 1e-4 * fmin(slope, 0)) {
 						memcpy(sim->trial, sim->scratch, sizeof(plume_vec3) * (size_t)sim->vertex_count);

@@ -6,7 +6,8 @@
 // whose stationarity is the integrator's update (for implicit Euler, inertia = 1/h^2 and
 // s = 1/h: M (v_{n+1} - v_n) / h = f(x_{n+1}), thesis B.2), with R the Rayleigh dissipation
 // of the linear drag, (1/2) c A_i (v_i . n_i)^2, normals frozen at the start of the step,
-// plus the quadratic air model's (air.c), added per face.
+// plus the quadratic air model's (air.c), added per face. With contact, IPC's barrier over
+// the pairs of primitives within reach (contact.c) is added to Phi in statics and dynamics.
 //
 // Elements are evaluated in parallel into per-element buffers and summed in a
 // fixed order, so results do not depend on the number of threads.
@@ -140,6 +141,11 @@ double plume_sim_potential(plume_sim *sim, const sim_problem *problem, const plu
 		evaluate_ff_faces(sim, x, want_gradient, hessian, project);
 	if (problem->dynamic && sim->air.active)
 		plume_air_add(sim, problem, x, want_gradient, hessian);
+	// Contact first: it may rebuild the matrix's pattern (contact.c).
+	bool contact = plume_contact_on(sim);
+	double contact_energy = contact ? plume_contact_evaluate(sim, x, hessian, problem->dynamic) : 0;
+	if (!isfinite(contact_energy))
+		return NAN; // out of memory, or a pair in contact: outside the barrier's domain
 
 	double *values = hessian ? plume_kkt_values(&sim->kkt) : NULL;
 	if (hessian)
@@ -204,6 +210,12 @@ double plume_sim_potential(plume_sim *sim, const sim_problem *problem, const plu
 			scatter_block(sim, values, &i, 1, sim->kkt.vertex_slots + 9 * i, block);
 	}
 
+	if (contact && plume_contact_any(sim)) {
+		// The IPC barrier over the pairs in reach (Li et al. 2020, eq. 6), Hessian projected,
+		// and the lagged friction of a dynamic step.
+		energy += contact_energy;
+		plume_contact_scatter(sim, gradient, values);
+	}
 	if (hessian)
 		for (int i = 0; i < 3 * n; ++i)
 			if (sim->fixed[i])

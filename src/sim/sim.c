@@ -32,6 +32,12 @@ plume_sim_def plume_sim_default_def(void)
 	def.solver.tolerance = 1e-7;
 	def.solver.max_iterations = 50;
 	def.solver.max_substep_halvings = 4;
+	def.contact.enabled = false;
+	def.contact.distance = 1.2e-4;
+	def.contact.stiffness = 1e6;
+	def.contact.self_contact = true;
+	def.contact.ccd_separation = 0.1;
+	def.contact.friction = 0;
 	def.cookie = PLUME_DEF_COOKIE;
 	return def;
 }
@@ -77,6 +83,23 @@ static plume_status check_material(const plume_material *material, const char *p
 	return PLUME_OK;
 }
 
+static plume_status check_contact(const plume_contact_def *contact, plume_error *err)
+{
+	// Ceilings keep the barrier's energy (stiffness d-hat^4 scale) and its Hessian finite.
+	if (!(contact->distance >= 1e-9 && contact->distance <= 1.0))
+		return plume_error_set(err, PLUME_ERROR_SPEC, "$.contact.distance is %g, allowed [1e-09, 1] m",
+		                       contact->distance);
+	if (!(contact->stiffness > 0 && contact->stiffness <= 1e30))
+		return plume_error_set(err, PLUME_ERROR_SPEC, "$.contact.stiffness is %g, allowed (0, 1e30]",
+		                       contact->stiffness);
+	if (!(contact->ccd_separation > 0 && contact->ccd_separation < 1))
+		return plume_error_set(err, PLUME_ERROR_SPEC, "$.contact.ccd_separation is %g, allowed (0, 1)",
+		                       contact->ccd_separation);
+	if (!(contact->friction >= 0 && contact->friction <= 1e3))
+		return plume_error_set(err, PLUME_ERROR_SPEC, "$.contact.friction is %g, allowed [0, 1000]", contact->friction);
+	return PLUME_OK;
+}
+
 plume_status plume_sim_def_validate(const plume_sim_def *def, int mesh_material_count, plume_error *err)
 {
 	PLUME_ASSERT_DEF(def);
@@ -117,7 +140,7 @@ plume_status plume_sim_def_validate(const plume_sim_def *def, int mesh_material_
 	if (def->solver.max_substep_halvings < 0 || def->solver.max_substep_halvings > 12)
 		return plume_error_set(err, PLUME_ERROR_SPEC, "$.solver.max_substep_halvings is %d, allowed [0, 12]",
 		                       def->solver.max_substep_halvings);
-	return PLUME_OK;
+	return check_contact(&def->contact, err);
 }
 
 // ---------------------------------------------------------------------------
@@ -491,6 +514,8 @@ plume_status plume_sim_create(const plume_mesh *mesh, const plume_sim_def *def, 
 		status = plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory creating the simulation");
 	if (status == PLUME_OK)
 		status = copy_groups(sim, mesh, err);
+	if (status == PLUME_OK && !plume_contact_init(sim))
+		status = plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory creating the simulation");
 	if (status == PLUME_OK)
 		status = plume_kkt_init(&sim->kkt, sim->vertex_count, sim->face_count, sim->faces,
 		                        def->bending ? plume_sim_bending_count(sim) : 0, plume_sim_bending_vertices(sim, 0),
@@ -513,6 +538,7 @@ void plume_sim_destroy(plume_sim *sim)
 	plume_kkt_free(&sim->kkt);
 	plume_integrator_free(&sim->integrator);
 	plume_air_free(&sim->air);
+	plume_contact_free(&sim->contact);
 	void *arrays[] = {sim->x,
 	                  sim->v,
 	                  sim->rest,
@@ -692,6 +718,36 @@ static void add_report(plume_solve_report *total, const plume_solve_report *part
 	total->gradient_norm = part->gradient_norm;
 	total->energy = part->energy;
 	total->converged = part->converged;
+	total->contact_pairs = part->contact_pairs;
+	total->min_distance = fmin(total->min_distance, part->min_distance);
+}
+
+/// Contact's continuation rounds a substep may take (contact.h: plume_contact_begin).
+enum { MAX_CONTACT_ROUNDS = 64 };
+
+/// One substep's solve from fraction s0 to s1 of the step, sim->x at its start iterate.
+/// With contact, the start iterate must be reached without passing through anything; when
+/// the prescribed motion cannot be taken at once, it is taken in rounds, each solved.
+static plume_status solve_substep(plume_sim *sim, const sim_problem *problem, double s0, double s1,
+                                  plume_solve_report *total, plume_error *err)
+{
+	double reached = 0;
+	if (!plume_contact_lag_friction(sim, s0, problem->dynamic ? problem->h : 0))
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory finding friction pairs");
+	for (int round = 0; round < MAX_CONTACT_ROUNDS; ++round) {
+		plume_status status = plume_contact_begin(sim, s0, s1, &reached, err);
+		if (status != PLUME_OK)
+			return status;
+		plume_solve_report part = {0};
+		status = plume_sim_newton(sim, problem, &part, err);
+		add_report(total, &part);
+		sim->contact.rounds += round > 0;
+		if (status != PLUME_OK || reached >= 1)
+			return status;
+	}
+	return plume_error_set(err, PLUME_ERROR_NUMERIC,
+	                       "the prescribed motion (handles, obstacles) needed more than %d contact rounds: subdividing",
+	                       MAX_CONTACT_ROUNDS);
 }
 
 plume_status plume_sim_solve_static(plume_sim *sim, plume_solve_report *report, plume_error *err)
@@ -708,11 +764,11 @@ plume_status plume_sim_solve_static(plume_sim *sim, plume_solve_report *report, 
 		if (halvings > 0)
 			memcpy(sim->x, sim->saved_x, bytes);
 		total.substeps = substeps;
+		total.min_distance = INFINITY;
 		for (int s = 1; s <= substeps; ++s) {
-			plume_solve_report part = {0};
+			memcpy(sim->previous, sim->x, bytes);
 			plume_sim_place_handles(sim, (double)s / substeps);
-			status = plume_sim_newton(sim, &statics, &part, err);
-			add_report(&total, &part);
+			status = solve_substep(sim, &statics, (double)(s - 1) / substeps, (double)s / substeps, &total, err);
 			if (status != PLUME_OK)
 				break;
 		}
@@ -722,8 +778,10 @@ plume_status plume_sim_solve_static(plume_sim *sim, plume_solve_report *report, 
 			break;
 	}
 	total.max_barb_strain = plume_sim_max_barb_strain(sim, sim->x);
-	if (status == PLUME_OK)
+	if (status == PLUME_OK) {
 		finish_handles(sim);
+		plume_contact_finish(sim);
+	}
 	if (report != NULL)
 		*report = total;
 	return status;
@@ -759,6 +817,7 @@ plume_status plume_sim_step(plume_sim *sim, plume_solve_report *report, plume_er
 		memcpy(sim->v, sim->saved_v, bytes);
 		plume_integrator_restore(&sim->integrator, sim->vertex_count);
 		total.substeps = substeps;
+		total.min_distance = INFINITY;
 		for (int s = 1; s <= substeps; ++s) {
 			sim_problem problem;
 			plume_integrator_begin(sim, h, &problem);
@@ -769,9 +828,7 @@ plume_status plume_sim_step(plume_sim *sim, plume_solve_report *report, plume_er
 			// Free vertices start from the prediction, handle vertices at their targets.
 			memcpy(sim->x, sim->predicted, bytes);
 			plume_sim_place_handles(sim, (double)s / substeps);
-			plume_solve_report part = {0};
-			status = plume_sim_newton(sim, &problem, &part, &last);
-			add_report(&total, &part);
+			status = solve_substep(sim, &problem, (double)(s - 1) / substeps, (double)s / substeps, &total, &last);
 			if (status != PLUME_OK)
 				break;
 			plume_integrator_end(sim, &problem);
@@ -792,6 +849,7 @@ plume_status plume_sim_step(plume_sim *sim, plume_solve_report *report, plume_er
 	}
 	sim->time += sim->def.time_step;
 	finish_handles(sim);
+	plume_contact_finish(sim);
 	total.max_barb_strain = plume_sim_max_barb_strain(sim, sim->x);
 	if (report != NULL)
 		*report = total;

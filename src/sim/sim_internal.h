@@ -7,6 +7,7 @@
 #include "plume/sim.h"
 #include "sim/air.h"
 #include "sim/bending.h"
+#include "sim/contact.h"
 #include "sim/integrator.h"
 #include "sim/fundamental_form.h"
 #include "sim/kkt.h"
@@ -117,13 +118,15 @@ struct plume_sim {
 	/// Time integration history (integrator.c) and the air's per-step state (air.c).
 	sim_integrator integrator;
 	sim_air air;
+	/// Contact pairs, obstacles and the broad phase (contact.c).
+	sim_contact contact;
 	/// Merit at each iteration of the last solve (tests check it decreases).
 	double trace[PLUME_SIM_TRACE];
 	int trace_count;
 };
 
 /// Potential of the problem at positions x: elastic + compression + bending + gravity
-/// (+ inertia and drag for a dynamic step). With gradient != NULL also fills the
+/// (+ inertia and drag for a dynamic step) (+ the contact barrier, contact.c). With gradient != NULL also fills the
 /// gradient (3 n); with the KKT matrix also fills its Hessian block (projected
 /// per element when project is true, exact otherwise). Returns NaN when the
 /// potential is not finite.
