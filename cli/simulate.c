@@ -361,7 +361,7 @@ static const char *vane_base_group(const plume_scene *scene)
 }
 
 /// A JSON number, or null for NaN (a measure never defined in the run).
-static json_t *json_measure(double value) { return isnan(value) ? json_null() : json_real(value); }
+static json_t *json_measure(double value) { return !isfinite(value) ? json_null() : json_real(value); }
 
 static plume_status write_summary(cli_output *output, const plume_scene *scene, const plume_scene_summary *summary,
                                   const run_state *run, const plume_error *failure, plume_error *err)
@@ -404,8 +404,13 @@ static plume_status write_summary(cli_output *output, const plume_scene *scene, 
 		json_object_set_new(root, "contact_pairs_max", json_integer(summary->contact_pairs_max));
 		json_object_set_new(root, "min_distance", json_measure(summary->min_distance));
 	}
-	if (summary->intersections_checked)
+	if (summary->intersections_checked) {
 		json_object_set_new(root, "intersecting_pairs", json_integer(summary->intersecting_pairs));
+		json_object_set_new(root, "frames_checked", json_integer(summary->frames_checked));
+		json_object_set_new(root, "first_intersecting_step",
+		                    summary->first_intersecting_step >= 0 ? json_integer(summary->first_intersecting_step)
+		                                                          : json_null());
+	}
 	json_t *feathers = json_array();
 	for (int i = 0; i < scene->feather_count; ++i) {
 		const plume_scene_feather *f = scene->feathers + i;

@@ -161,7 +161,12 @@ typedef struct plume_scene_summary {
 	/// Smallest distance between contact primitives over the run, m.
 	double min_distance;
 	bool intersections_checked;
+	/// The most pairs of intersecting triangles in any checked frame (must be 0), the
+	/// frames checked (the output frames: step 0, every frame_every steps and the last)
+	/// and the first step with a pair (-1: none).
 	int intersecting_pairs;
+	int frames_checked;
+	int first_intersecting_step;
 } plume_scene_summary;
 
 /// Called after the initial state (step 0, report NULL) and after every step.

@@ -12,6 +12,7 @@
 #include "plume/intersect.h"
 #include "plume/io.h"
 #include "plume/scene.h"
+#include "sim/scene_contact.h"
 #include "spec.h"
 #include "spec_body.h"
 #include "spec_mesh.h"
@@ -841,14 +842,6 @@ static plume_vec3 face_centroid(const plume_mesh *mesh, int face)
 	return plume_v3_scale(sum, 1.0 / 3.0);
 }
 
-/// Whether face f of the joined mesh has a vertex in the calamus of a feather the body carries:
-/// those faces sit on the body at the follicle and may touch it.
-static bool on_follicle(const plume_scene *scene, const bool *carried_clamp, int face)
-{
-	const int *v = scene->mesh->faces + 3 * face;
-	return carried_clamp[v[0]] || carried_clamp[v[1]] || carried_clamp[v[2]];
-}
-
 /// Every pair of intersecting triangles of the soup (plume_find_intersections, exact): into
 /// *pairs (plume_free), their count into *count.
 static plume_status all_intersections(const plume_vec3 *positions, int vertex_count, const int *triangles,
@@ -885,11 +878,11 @@ static plume_status check_rest_intersections(const char *file, const char *where
 	int vertex_count = mesh->vertex_count + body_vertices, triangle_count = mesh->face_count + body_triangles;
 	plume_vec3 *positions = plume_alloc(sizeof(plume_vec3) * (size_t)vertex_count);
 	int *triangles = plume_alloc(sizeof(int) * 3 * (size_t)triangle_count);
-	bool *carried_clamp = plume_calloc((size_t)mesh->vertex_count, sizeof(bool));
-	if (positions == NULL || triangles == NULL || carried_clamp == NULL) {
+	bool *follicle_face = plume_alloc(sizeof(bool) * (size_t)(mesh->face_count + 1));
+	if (positions == NULL || triangles == NULL || follicle_face == NULL) {
 		plume_free(positions);
 		plume_free(triangles);
-		plume_free(carried_clamp);
+		plume_free(follicle_face);
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "%s: out of memory checking the feathers at rest", file);
 	}
 	memcpy(positions, mesh->rest, sizeof(plume_vec3) * (size_t)mesh->vertex_count);
@@ -901,13 +894,7 @@ static plume_status check_rest_intersections(const char *file, const char *where
 		for (int k = 0; k < 3 * body_triangles; ++k)
 			triangles[3 * mesh->face_count + k] = body[k] + mesh->vertex_count;
 	}
-	for (int i = 0; i < scene->feather_count; ++i) {
-		char name[64];
-		snprintf(name, sizeof name, "%s/rachis_clamp", scene->feathers[i].name);
-		const plume_vertex_group *clamp = plume_mesh_find_group(mesh, name);
-		for (int k = 0; scene->feathers[i].follicle && clamp != NULL && k < clamp->count; ++k)
-			carried_clamp[clamp->vertices[k]] = true;
-	}
+	plume_scene_follicle_faces(scene, follicle_face);
 	int *pairs = NULL, count = 0;
 	plume_status status = all_intersections(positions, vertex_count, triangles, triangle_count, &pairs, &count, err);
 	if (status != PLUME_OK) {
@@ -918,7 +905,7 @@ static plume_status check_rest_intersections(const char *file, const char *where
 	int first = -1, reported = 0;
 	for (int k = 0; status == PLUME_OK && k < count; ++k) {
 		int a = pairs[2 * k], b = pairs[2 * k + 1]; // a < b: a body triangle comes second
-		bool counts = b >= mesh->face_count ? a < mesh->face_count && !on_follicle(scene, carried_clamp, a)
+		bool counts = b >= mesh->face_count ? a < mesh->face_count && !follicle_face[a]
 		                                    : feather_of_face(scene, a) != feather_of_face(scene, b);
 		if (counts && first < 0)
 			first = k;
@@ -951,7 +938,7 @@ static plume_status check_rest_intersections(const char *file, const char *where
 	plume_free(pairs);
 	plume_free(positions);
 	plume_free(triangles);
-	plume_free(carried_clamp);
+	plume_free(follicle_face);
 	return status;
 }
 

@@ -10,6 +10,7 @@
 #include "core/alloc.h"
 #include "plume/body.h"
 #include "plume/scene.h"
+#include "sim/scene_contact.h"
 
 void plume_scene_destroy(plume_scene *scene)
 {
@@ -121,6 +122,35 @@ static double rachis_tip_deflection(const plume_scene *scene, const plume_sim *s
 	return plume_v3_length(plume_v3_scale(sum, 1.0 / tip->count));
 }
 
+/// Whether a run checks its frames for intersecting surfaces: with contact, several feathers
+/// or a body (a single free feather without contact has nothing to keep apart).
+static bool checks_intersections(const plume_scene *scene)
+{
+	return scene->sim.contact.enabled || scene->feather_count > 1 || scene->body != NULL;
+}
+
+/// The independent check of one output frame (docs/contact.md): the count goes into the
+/// summary as the largest over the frames; the first frame with a pair is named in the
+/// summary's step.
+static plume_status check_frame(plume_scene_surfaces *surfaces, const plume_sim *sim, const plume_vec3 *body_pose,
+                                int step, plume_scene_summary *summary, plume_error *err)
+{
+	int count = 0, pair[2] = {-1, -1};
+	plume_status status =
+	    plume_scene_surfaces_intersections(surfaces, plume_sim_positions(sim), body_pose, &count, pair, err);
+	if (status != PLUME_OK) {
+		plume_error_prefix(err, "the intersection check");
+		return status;
+	}
+	summary->intersections_checked = true;
+	summary->frames_checked += 1;
+	if (count > summary->intersecting_pairs)
+		summary->intersecting_pairs = count;
+	if (count > 0 && summary->first_intersecting_step < 0)
+		summary->first_intersecting_step = step;
+	return PLUME_OK;
+}
+
 plume_status plume_scene_run(const plume_scene *scene, plume_scene_step_fn *on_step, void *user,
                              plume_scene_summary *summary, plume_error *err)
 {
@@ -154,6 +184,16 @@ plume_status plume_scene_run(const plume_scene *scene, plume_scene_step_fn *on_s
 	summary->feather_count = scene->feather_count;
 	summary->face_count = scene->mesh->face_count;
 	summary->constraint_count = plume_sim_constraint_count(sim);
+	summary->first_intersecting_step = -1;
+	summary->min_distance = INFINITY;
+	summary->contact_measured = scene->sim.contact.enabled;
+	plume_scene_surfaces *surfaces = NULL;
+	if (body_positions != NULL)
+		plume_scene_body_pose(scene, 0, body_positions);
+	if (status == PLUME_OK && (checks_intersections(scene) || scene->sim.contact.enabled))
+		status = plume_scene_surfaces_create(scene, sim, body_positions, &surfaces, err);
+	if (status == PLUME_OK && checks_intersections(scene))
+		status = check_frame(surfaces, sim, body_positions, 0, summary, err);
 	if (status == PLUME_OK && on_step != NULL)
 		status = on_step(user, 0, 0, sim, NULL, omp_get_wtime() - start, err);
 
@@ -175,8 +215,10 @@ plume_status plume_scene_run(const plume_scene *scene, plume_scene_step_fn *on_s
 		// The body where it is at the end of the step: with contact, the obstacle's positions
 		// for this step (plume_sim_set_obstacle_positions; plume_sim_add_obstacle takes the
 		// pose at t = 0 when the simulation is created).
-		if (body_positions != NULL)
+		if (body_positions != NULL) {
 			plume_scene_body_pose(scene, t, body_positions);
+			plume_scene_surfaces_move_body(surfaces, sim, body_positions);
+		}
 		plume_solve_report report;
 		double step_start = omp_get_wtime();
 		status = scene->quasi_static ? plume_sim_solve_static(sim, &report, err) : plume_sim_step(sim, &report, err);
@@ -191,12 +233,22 @@ plume_status plume_scene_run(const plume_scene *scene, plume_scene_step_fn *on_s
 		summary->seconds_solve += report.seconds_solve;
 		summary->max_barb_strain = fmax(summary->max_barb_strain, report.max_barb_strain);
 		summary->retried_steps += report.substeps > 1;
+		if (scene->sim.contact.enabled) {
+			summary->contact_pairs_max =
+			    report.contact_pairs > summary->contact_pairs_max ? report.contact_pairs : summary->contact_pairs_max;
+			summary->min_distance = fmin(summary->min_distance, report.min_distance);
+		}
+		if (checks_intersections(scene) && (n % scene->frame_every == 0 || n == steps))
+			status = check_frame(surfaces, sim, body_positions, n, summary, err);
+		if (status != PLUME_OK)
+			break;
 		if (on_step != NULL)
 			status = on_step(user, n, t, sim, &report, omp_get_wtime() - step_start, err);
 	}
 	summary->rachis_tip_deflection = rachis_tip_deflection(scene, sim);
 	summary->wall_seconds = omp_get_wtime() - start;
 	plume_free(ids);
+	plume_scene_surfaces_destroy(surfaces);
 	plume_free(body_positions);
 	plume_sim_destroy(sim);
 	return status;
