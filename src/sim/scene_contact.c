@@ -6,8 +6,9 @@
 // step. The obstacle therefore leaves out the body triangles that come within reach of a
 // follicle face — every body triangle closer than the contact distance plus the face's
 // longest edge to one of the face's corners, which covers every point of the face — and the
-// intersection check leaves out exactly the pairs (follicle face, body triangle). Everything
-// else counts: feather against feather, a feather against itself, a feather against the body.
+// intersection check leaves out exactly the pairs (follicle face, body triangle), and the body
+// against itself. Everything else counts: feather against feather, a feather against itself,
+// a feather against the body.
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -221,7 +222,9 @@ plume_status plume_scene_surfaces_intersections(plume_scene_surfaces *s, const p
 	*count = 0;
 	for (int k = 0; k < total; ++k) {
 		int a = s->pairs[2 * k], b = s->pairs[2 * k + 1]; // a < b: a body triangle comes second
-		if (b >= s->shell_face_count && a < s->shell_face_count && s->follicle_face[a])
+		// The body against itself is its author's (a bird's limbs may be overlapping closed
+		// shells) and a follicle face against the body sits in its skin: neither counts.
+		if (b >= s->shell_face_count && (a >= s->shell_face_count || s->follicle_face[a]))
 			continue;
 		if (*count == 0 && first_pair != NULL) {
 			first_pair[0] = a;

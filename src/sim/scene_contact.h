@@ -25,7 +25,7 @@ void plume_scene_surfaces_move_body(plume_scene_surfaces *surfaces, plume_sim *s
 
 /// Exact count (plume_find_intersections) of the pairs of triangles that intersect among
 /// the shell at shell_positions and the body at body_pose (NULL without a body): every
-/// pair counts except a follicle face against the body. With a pair, *first_pair gets
+/// pair counts except a follicle face against the body and the body against itself. With a pair, *first_pair gets
 /// its two triangles (shell faces first, then body triangles from face_count on).
 plume_status plume_scene_surfaces_intersections(plume_scene_surfaces *surfaces, const plume_vec3 *shell_positions,
                                                 const plume_vec3 *body_pose, int *count, int first_pair[2],
