@@ -321,7 +321,7 @@ static bool grow_buffers(sim_contact *contact)
 	return true;
 }
 
-double plume_contact_evaluate(plume_sim *sim, const plume_vec3 *x, bool hessian, bool friction)
+double plume_contact_evaluate(plume_sim *sim, const plume_vec3 *x, bool gradient, bool hessian, bool friction)
 {
 	sim_contact *contact = &sim->contact;
 	const plume_contact_def *def = &sim->def.contact;
@@ -364,7 +364,7 @@ double plume_contact_evaluate(plume_sim *sim, const plume_vec3 *x, bool hessian,
 		gather_pair(sim, pair, x, contact->body_x, points);
 		gather_pair(sim, pair, rest, contact->body_rest, reference);
 		contact->energy[k] = plume_contact_pair_energy(pair->type, points, reference, dhat, def->stiffness, true,
-		                                               contact->gradient + 12 * (size_t)k,
+		                                               gradient || hessian ? contact->gradient + 12 * (size_t)k : NULL,
 		                                               hessian ? contact->hessian + 144 * (size_t)k : NULL);
 	}
 	double total = 0;
@@ -422,7 +422,7 @@ void plume_contact_scatter(plume_sim *sim, double *gradient, double *values)
 plume_vec3 plume_contact_obstacle_force(plume_sim *sim, int obstacle, const plume_vec3 *x)
 {
 	PLUME_ASSERT_INDEX(obstacle, sim->contact.obstacle_count);
-	plume_contact_evaluate(sim, x, false, false);
+	plume_contact_evaluate(sim, x, true, false, false);
 	const sim_contact *contact = &sim->contact;
 	const sim_obstacle *body = contact->obstacles + obstacle;
 	int n = sim->vertex_count;
