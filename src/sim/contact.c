@@ -283,7 +283,7 @@ static bool find_active(plume_sim *sim, const plume_vec3 *x)
 	sim_contact *contact = &sim->contact;
 	double dhat = sim->def.contact.distance, dhat2 = dhat * dhat, closest = INFINITY;
 	// Boxes inflated by d-hat / 2 overlap whenever the primitives are closer than d-hat.
-	if (!find_candidates(sim, x, x, contact->body_x, contact->body_x, 0.5 * dhat))
+	if (!contact->reuse_candidates && !find_candidates(sim, x, x, contact->body_x, contact->body_x, 0.5 * dhat))
 		return false;
 	for (int p = 0; p < contact->pair_count; ++p) {
 		sim_contact_pair *pair = contact->pairs + p;

@@ -87,6 +87,10 @@ typedef struct sim_contact {
 	/// taken beyond the first solve of a substep (plume_contact_begin), since creation.
 	int pattern_rebuilds;
 	int rounds;
+	/// The candidates hold every pair within reach of the positions the next evaluations see
+	/// (newton.c sets it after a step's CCD, for the points of that step's segment): the
+	/// evaluations skip the broad phase.
+	bool reuse_candidates;
 	/// Why the last evaluation failed (out of memory: PLUME_ERROR_MEMORY; primitives touching:
 	/// PLUME_ERROR_NUMERIC), for the caller's error; PLUME_OK when it did not.
 	plume_status failure;
