@@ -9,8 +9,9 @@
 // triangle meshes. Candidates come from axis-aligned boxes inflated by half the barrier's
 // reach d-hat (sim/bvh.h): a pair whose boxes do not overlap is farther apart than d-hat
 // along some axis, so it contributes nothing, and the energy is exact whatever the
-// candidate set. The potential is a pure function of the positions: every evaluation
-// queries the broad phase again (a refit and a traversal, cheaper than the elements).
+// candidate set. The potential is a pure function of the positions: an evaluation
+// queries the broad phase again (a refit and a traversal), except along a Newton step,
+// whose CCD candidates, over boxes swept along it, hold every pair in reach on it.
 //
 // The pattern of the Newton matrix must hold each active pair's 12 x 12 block. The pattern
 // is rebuilt (with its symbolic analysis) only when an active pair couples two vertices it
