@@ -73,9 +73,13 @@ void plume_contact_free(sim_contact *contact)
 {
 	for (int t = 0; t < SIM_TREE_COUNT; ++t)
 		plume_bvh_destroy(contact->trees[t]);
-	void *arrays[] = {contact->edges,  contact->obstacles, contact->body_rest,  contact->body_start, contact->body_end,
-	                  contact->body_x, contact->body_from, contact->body_faces, contact->body_edges, contact->boxes,
-	                  contact->pairs,  contact->active,    contact->energy,     contact->gradient,   contact->hessian};
+	void *arrays[] = {contact->edges,           contact->obstacles,  contact->body_rest,
+	                  contact->body_start,      contact->body_end,   contact->body_x,
+	                  contact->body_from,       contact->body_faces, contact->body_edges,
+	                  contact->boxes,           contact->pairs,      contact->active,
+	                  contact->energy,          contact->gradient,   contact->hessian,
+	                  contact->body_lag,        contact->friction,   contact->friction_gradient,
+	                  contact->friction_hessian};
 	for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i)
 		plume_free(arrays[i]);
 	plume_pair_list_free(&contact->overlaps);
@@ -713,6 +717,10 @@ plume_status plume_contact_begin(plume_sim *sim, double s0, double s1, double *r
 	}
 	if (*reached > 0)
 		return advance_prescribed(sim, s0, s1, reached, err);
+	// Refitting keeps the trees' topology, which loosens as the shell deforms: build them
+	// anew once a (sub)step.
+	for (int t = 0; t < SIM_TREE_COUNT; ++t)
+		contact->tree_size[t] = -1;
 	place_bodies(contact, s0, contact->body_from);
 	place_bodies(contact, s1, contact->body_x);
 	double bound = plume_contact_step_bound(sim, sim->previous, sim->x, contact->body_from, contact->body_x);
