@@ -749,7 +749,8 @@ plume_status plume_contact_begin(plume_sim *sim, double s0, double s1, double *r
 void plume_contact_finish(plume_sim *sim)
 {
 	sim_contact *contact = &sim->contact;
-	memcpy(contact->body_start, contact->body_end, sizeof(plume_vec3) * (size_t)contact->body_vertex_count);
+	if (contact->body_vertex_count > 0) // no obstacles: no arrays (memcpy wants pointers even for 0 bytes)
+		memcpy(contact->body_start, contact->body_end, sizeof(plume_vec3) * (size_t)contact->body_vertex_count);
 }
 
 // ---------------------------------------------------------------------------
