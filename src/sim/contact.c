@@ -148,9 +148,26 @@ static void push_pair(sim_contact *contact, plume_contact_pair_type type, int a,
 /// Point-triangle candidates: points of tree `points` (indices `point_index`, offset into
 /// the combined numbering) against triangles of tree `faces`; pairs where the point is a
 /// vertex of the triangle are left out.
-static bool query_point_triangle(sim_contact *contact, int points, int point_offset, int faces,
-                                 const int *face_vertices, int face_offset)
+/// A shell vertex a handle holds (all three coordinates), for shell-obstacle pairs.
+static bool held(const plume_sim *sim, int v)
 {
+	return v < sim->vertex_count && sim->fixed[3 * v] && sim->fixed[3 * v + 1] && sim->fixed[3 * v + 2];
+}
+
+static bool any_held(const plume_sim *sim, const int *vertices, int count)
+{
+	for (int k = 0; k < count; ++k)
+		if (held(sim, vertices[k]))
+			return true;
+	return false;
+}
+
+static bool query_point_triangle(plume_sim *sim, int points, int point_offset, int faces, const int *face_vertices,
+                                 int face_offset)
+{
+	sim_contact *contact = &sim->contact;
+	// Shell-obstacle pairs leave out the shell's primitives at a held vertex (the attachment).
+	bool attachment = point_offset != face_offset;
 	contact->overlaps.count = 0;
 	if (contact->tree_size[points] == 0 || contact->tree_size[faces] == 0)
 		return true;
@@ -161,16 +178,19 @@ static bool query_point_triangle(sim_contact *contact, int points, int point_off
 		int p = contact->overlaps.pairs[2 * k] + point_offset;
 		const int *t = face_vertices + 3 * contact->overlaps.pairs[2 * k + 1];
 		int a = t[0] + face_offset, b = t[1] + face_offset, c = t[2] + face_offset;
-		if (p == a || p == b || p == c)
+		int vertices[4] = {p, a, b, c};
+		if (p == a || p == b || p == c || (attachment && any_held(sim, vertices, 4)))
 			continue;
 		push_pair(contact, PLUME_CONTACT_POINT_TRIANGLE, p, a, b, c);
 	}
 	return true;
 }
 
-static bool query_edge_edge(sim_contact *contact, int first, const int *first_edges, int first_offset, int second,
+static bool query_edge_edge(plume_sim *sim, int first, const int *first_edges, int first_offset, int second,
                             const int *second_edges, int second_offset)
 {
+	sim_contact *contact = &sim->contact;
+	bool attachment = first_offset != second_offset;
 	contact->overlaps.count = 0;
 	if (contact->tree_size[first] == 0 || contact->tree_size[second] == 0)
 		return true;
@@ -181,7 +201,8 @@ static bool query_edge_edge(sim_contact *contact, int first, const int *first_ed
 		const int *e = first_edges + 2 * contact->overlaps.pairs[2 * k];
 		const int *f = second_edges + 2 * contact->overlaps.pairs[2 * k + 1];
 		int a0 = e[0] + first_offset, a1 = e[1] + first_offset, b0 = f[0] + second_offset, b1 = f[1] + second_offset;
-		if (a0 == b0 || a0 == b1 || a1 == b0 || a1 == b1)
+		int vertices[4] = {a0, a1, b0, b1};
+		if (a0 == b0 || a0 == b1 || a1 == b0 || a1 == b1 || (attachment && any_held(sim, vertices, 4)))
 			continue;
 		push_pair(contact, PLUME_CONTACT_EDGE_EDGE, a0, a1, b0, b1);
 	}
@@ -208,12 +229,12 @@ static bool find_candidates(plume_sim *sim, const plume_vec3 *x0, const plume_ve
 		     fill_tree(contact, SIM_TREE_BODY_EDGE, contact->body_edges, 2, contact->body_edge_count, body0, body1,
 		               inflate);
 	if (ok && self)
-		ok = query_point_triangle(contact, SIM_TREE_VERTEX, 0, SIM_TREE_FACE, sim->faces, 0) &&
-		     query_edge_edge(contact, SIM_TREE_EDGE, contact->edges, 0, SIM_TREE_EDGE, contact->edges, 0);
+		ok = query_point_triangle(sim, SIM_TREE_VERTEX, 0, SIM_TREE_FACE, sim->faces, 0) &&
+		     query_edge_edge(sim, SIM_TREE_EDGE, contact->edges, 0, SIM_TREE_EDGE, contact->edges, 0);
 	if (ok && bodies)
-		ok = query_point_triangle(contact, SIM_TREE_VERTEX, 0, SIM_TREE_BODY_FACE, contact->body_faces, n) &&
-		     query_point_triangle(contact, SIM_TREE_BODY_VERTEX, n, SIM_TREE_FACE, sim->faces, 0) &&
-		     query_edge_edge(contact, SIM_TREE_EDGE, contact->edges, 0, SIM_TREE_BODY_EDGE, contact->body_edges, n);
+		ok = query_point_triangle(sim, SIM_TREE_VERTEX, 0, SIM_TREE_BODY_FACE, contact->body_faces, n) &&
+		     query_point_triangle(sim, SIM_TREE_BODY_VERTEX, n, SIM_TREE_FACE, sim->faces, 0) &&
+		     query_edge_edge(sim, SIM_TREE_EDGE, contact->edges, 0, SIM_TREE_BODY_EDGE, contact->body_edges, n);
 	return ok;
 }
 
