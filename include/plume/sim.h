@@ -229,10 +229,11 @@ plume_status plume_sim_solve_static(plume_sim *sim, plume_solve_report *report, 
 plume_status plume_sim_step(plume_sim *sim, plume_solve_report *report, plume_error *err);
 
 /// Obstacles: triangle meshes moved by prescription (bodies). The shell collides with them
-/// (with def.contact.enabled); they do not move in response. The positions are copied;
-/// triangles index them. Returns the obstacle's index in *obstacle. PLUME_ERROR_SPEC for
-/// out-of-range indices, non-finite positions or an obstacle that intersects or touches the
-/// shell; PLUME_ERROR_MEMORY.
+/// (with def.contact.enabled); they do not move in response. Shell primitives at a vertex a
+/// handle holds are left out of contact with obstacles (the attachment: a calamus in its
+/// follicle), so add the handles first. The positions are copied; triangles index them.
+/// Returns the obstacle's index in *obstacle. PLUME_ERROR_SPEC for out-of-range indices,
+/// non-finite positions or an obstacle that touches the shell; PLUME_ERROR_MEMORY.
 plume_status plume_sim_add_obstacle(plume_sim *sim, const plume_vec3 *positions, int vertex_count, const int *triangles,
                                     int triangle_count, int *obstacle, plume_error *err);
 /// The obstacle's positions at the end of the next step or static solve (vertex_count of

@@ -9,8 +9,9 @@
 // triangle meshes. Candidates come from axis-aligned boxes inflated by half the barrier's
 // reach d-hat (sim/bvh.h): a pair whose boxes do not overlap is farther apart than d-hat
 // along some axis, so it contributes nothing, and the energy is exact whatever the
-// candidate set. The potential is a pure function of the positions: every evaluation
-// queries the broad phase again (a refit and a traversal, cheaper than the elements).
+// candidate set. The potential is a pure function of the positions: an evaluation
+// queries the broad phase again (a refit and a traversal), except along a Newton step,
+// whose CCD candidates, over boxes swept along it, hold every pair in reach on it.
 //
 // The pattern of the Newton matrix must hold each active pair's 12 x 12 block. The pattern
 // is rebuilt (with its symbolic analysis) only when an active pair couples two vertices it
@@ -72,9 +73,13 @@ void plume_contact_free(sim_contact *contact)
 {
 	for (int t = 0; t < SIM_TREE_COUNT; ++t)
 		plume_bvh_destroy(contact->trees[t]);
-	void *arrays[] = {contact->edges,  contact->obstacles, contact->body_rest,  contact->body_start, contact->body_end,
-	                  contact->body_x, contact->body_from, contact->body_faces, contact->body_edges, contact->boxes,
-	                  contact->pairs,  contact->active,    contact->energy,     contact->gradient,   contact->hessian};
+	void *arrays[] = {contact->edges,           contact->obstacles,  contact->body_rest,
+	                  contact->body_start,      contact->body_end,   contact->body_x,
+	                  contact->body_from,       contact->body_faces, contact->body_edges,
+	                  contact->boxes,           contact->pairs,      contact->active,
+	                  contact->energy,          contact->gradient,   contact->hessian,
+	                  contact->body_lag,        contact->friction,   contact->friction_gradient,
+	                  contact->friction_hessian};
 	for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i)
 		plume_free(arrays[i]);
 	plume_pair_list_free(&contact->overlaps);
@@ -143,9 +148,26 @@ static void push_pair(sim_contact *contact, plume_contact_pair_type type, int a,
 /// Point-triangle candidates: points of tree `points` (indices `point_index`, offset into
 /// the combined numbering) against triangles of tree `faces`; pairs where the point is a
 /// vertex of the triangle are left out.
-static bool query_point_triangle(sim_contact *contact, int points, int point_offset, int faces,
-                                 const int *face_vertices, int face_offset)
+/// A shell vertex a handle holds (all three coordinates), for shell-obstacle pairs.
+static bool held(const plume_sim *sim, int v)
 {
+	return v < sim->vertex_count && sim->fixed[3 * v] && sim->fixed[3 * v + 1] && sim->fixed[3 * v + 2];
+}
+
+static bool any_held(const plume_sim *sim, const int *vertices, int count)
+{
+	for (int k = 0; k < count; ++k)
+		if (held(sim, vertices[k]))
+			return true;
+	return false;
+}
+
+static bool query_point_triangle(plume_sim *sim, int points, int point_offset, int faces, const int *face_vertices,
+                                 int face_offset)
+{
+	sim_contact *contact = &sim->contact;
+	// Shell-obstacle pairs leave out the shell's primitives at a held vertex (the attachment).
+	bool attachment = point_offset != face_offset;
 	contact->overlaps.count = 0;
 	if (contact->tree_size[points] == 0 || contact->tree_size[faces] == 0)
 		return true;
@@ -156,16 +178,19 @@ static bool query_point_triangle(sim_contact *contact, int points, int point_off
 		int p = contact->overlaps.pairs[2 * k] + point_offset;
 		const int *t = face_vertices + 3 * contact->overlaps.pairs[2 * k + 1];
 		int a = t[0] + face_offset, b = t[1] + face_offset, c = t[2] + face_offset;
-		if (p == a || p == b || p == c)
+		int vertices[4] = {p, a, b, c};
+		if (p == a || p == b || p == c || (attachment && any_held(sim, vertices, 4)))
 			continue;
 		push_pair(contact, PLUME_CONTACT_POINT_TRIANGLE, p, a, b, c);
 	}
 	return true;
 }
 
-static bool query_edge_edge(sim_contact *contact, int first, const int *first_edges, int first_offset, int second,
+static bool query_edge_edge(plume_sim *sim, int first, const int *first_edges, int first_offset, int second,
                             const int *second_edges, int second_offset)
 {
+	sim_contact *contact = &sim->contact;
+	bool attachment = first_offset != second_offset;
 	contact->overlaps.count = 0;
 	if (contact->tree_size[first] == 0 || contact->tree_size[second] == 0)
 		return true;
@@ -176,7 +201,8 @@ static bool query_edge_edge(sim_contact *contact, int first, const int *first_ed
 		const int *e = first_edges + 2 * contact->overlaps.pairs[2 * k];
 		const int *f = second_edges + 2 * contact->overlaps.pairs[2 * k + 1];
 		int a0 = e[0] + first_offset, a1 = e[1] + first_offset, b0 = f[0] + second_offset, b1 = f[1] + second_offset;
-		if (a0 == b0 || a0 == b1 || a1 == b0 || a1 == b1)
+		int vertices[4] = {a0, a1, b0, b1};
+		if (a0 == b0 || a0 == b1 || a1 == b0 || a1 == b1 || (attachment && any_held(sim, vertices, 4)))
 			continue;
 		push_pair(contact, PLUME_CONTACT_EDGE_EDGE, a0, a1, b0, b1);
 	}
@@ -203,12 +229,12 @@ static bool find_candidates(plume_sim *sim, const plume_vec3 *x0, const plume_ve
 		     fill_tree(contact, SIM_TREE_BODY_EDGE, contact->body_edges, 2, contact->body_edge_count, body0, body1,
 		               inflate);
 	if (ok && self)
-		ok = query_point_triangle(contact, SIM_TREE_VERTEX, 0, SIM_TREE_FACE, sim->faces, 0) &&
-		     query_edge_edge(contact, SIM_TREE_EDGE, contact->edges, 0, SIM_TREE_EDGE, contact->edges, 0);
+		ok = query_point_triangle(sim, SIM_TREE_VERTEX, 0, SIM_TREE_FACE, sim->faces, 0) &&
+		     query_edge_edge(sim, SIM_TREE_EDGE, contact->edges, 0, SIM_TREE_EDGE, contact->edges, 0);
 	if (ok && bodies)
-		ok = query_point_triangle(contact, SIM_TREE_VERTEX, 0, SIM_TREE_BODY_FACE, contact->body_faces, n) &&
-		     query_point_triangle(contact, SIM_TREE_BODY_VERTEX, n, SIM_TREE_FACE, sim->faces, 0) &&
-		     query_edge_edge(contact, SIM_TREE_EDGE, contact->edges, 0, SIM_TREE_BODY_EDGE, contact->body_edges, n);
+		ok = query_point_triangle(sim, SIM_TREE_VERTEX, 0, SIM_TREE_BODY_FACE, contact->body_faces, n) &&
+		     query_point_triangle(sim, SIM_TREE_BODY_VERTEX, n, SIM_TREE_FACE, sim->faces, 0) &&
+		     query_edge_edge(sim, SIM_TREE_EDGE, contact->edges, 0, SIM_TREE_BODY_EDGE, contact->body_edges, n);
 	return ok;
 }
 
@@ -283,7 +309,7 @@ static bool find_active(plume_sim *sim, const plume_vec3 *x)
 	sim_contact *contact = &sim->contact;
 	double dhat = sim->def.contact.distance, dhat2 = dhat * dhat, closest = INFINITY;
 	// Boxes inflated by d-hat / 2 overlap whenever the primitives are closer than d-hat.
-	if (!find_candidates(sim, x, x, contact->body_x, contact->body_x, 0.5 * dhat))
+	if (!contact->reuse_candidates && !find_candidates(sim, x, x, contact->body_x, contact->body_x, 0.5 * dhat))
 		return false;
 	for (int p = 0; p < contact->pair_count; ++p) {
 		sim_contact_pair *pair = contact->pairs + p;
@@ -321,7 +347,7 @@ static bool grow_buffers(sim_contact *contact)
 	return true;
 }
 
-double plume_contact_evaluate(plume_sim *sim, const plume_vec3 *x, bool hessian, bool friction)
+double plume_contact_evaluate(plume_sim *sim, const plume_vec3 *x, bool gradient, bool hessian, bool friction)
 {
 	sim_contact *contact = &sim->contact;
 	const plume_contact_def *def = &sim->def.contact;
@@ -364,7 +390,7 @@ double plume_contact_evaluate(plume_sim *sim, const plume_vec3 *x, bool hessian,
 		gather_pair(sim, pair, x, contact->body_x, points);
 		gather_pair(sim, pair, rest, contact->body_rest, reference);
 		contact->energy[k] = plume_contact_pair_energy(pair->type, points, reference, dhat, def->stiffness, true,
-		                                               contact->gradient + 12 * (size_t)k,
+		                                               gradient || hessian ? contact->gradient + 12 * (size_t)k : NULL,
 		                                               hessian ? contact->hessian + 144 * (size_t)k : NULL);
 	}
 	double total = 0;
@@ -422,7 +448,7 @@ void plume_contact_scatter(plume_sim *sim, double *gradient, double *values)
 plume_vec3 plume_contact_obstacle_force(plume_sim *sim, int obstacle, const plume_vec3 *x)
 {
 	PLUME_ASSERT_INDEX(obstacle, sim->contact.obstacle_count);
-	plume_contact_evaluate(sim, x, false, false);
+	plume_contact_evaluate(sim, x, true, false, false);
 	const sim_contact *contact = &sim->contact;
 	const sim_obstacle *body = contact->obstacles + obstacle;
 	int n = sim->vertex_count;
@@ -712,6 +738,10 @@ plume_status plume_contact_begin(plume_sim *sim, double s0, double s1, double *r
 	}
 	if (*reached > 0)
 		return advance_prescribed(sim, s0, s1, reached, err);
+	// Refitting keeps the trees' topology, which loosens as the shell deforms: build them
+	// anew once a (sub)step.
+	for (int t = 0; t < SIM_TREE_COUNT; ++t)
+		contact->tree_size[t] = -1;
 	place_bodies(contact, s0, contact->body_from);
 	place_bodies(contact, s1, contact->body_x);
 	double bound = plume_contact_step_bound(sim, sim->previous, sim->x, contact->body_from, contact->body_x);
@@ -740,7 +770,8 @@ plume_status plume_contact_begin(plume_sim *sim, double s0, double s1, double *r
 void plume_contact_finish(plume_sim *sim)
 {
 	sim_contact *contact = &sim->contact;
-	memcpy(contact->body_start, contact->body_end, sizeof(plume_vec3) * (size_t)contact->body_vertex_count);
+	if (contact->body_vertex_count > 0) // no obstacles: no arrays (memcpy wants pointers even for 0 bytes)
+		memcpy(contact->body_start, contact->body_end, sizeof(plume_vec3) * (size_t)contact->body_vertex_count);
 }
 
 // ---------------------------------------------------------------------------

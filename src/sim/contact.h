@@ -87,6 +87,10 @@ typedef struct sim_contact {
 	/// taken beyond the first solve of a substep (plume_contact_begin), since creation.
 	int pattern_rebuilds;
 	int rounds;
+	/// The candidates hold every pair within reach of the positions the next evaluations see
+	/// (newton.c sets it after a step's CCD, for the points of that step's segment): the
+	/// evaluations skip the broad phase.
+	bool reuse_candidates;
 	/// Why the last evaluation failed (out of memory: PLUME_ERROR_MEMORY; primitives touching:
 	/// PLUME_ERROR_NUMERIC), for the caller's error; PLUME_OK when it did not.
 	plume_status failure;
@@ -103,8 +107,9 @@ bool plume_contact_on(const struct plume_sim *sim);
 /// evaluates them (energies, gradients, PSD-projected Hessians) and, with hessian, makes
 /// sure the KKT pattern holds their blocks (rebuilding it when it does not). Returns the
 /// energy, +inf when a pair is in contact (distance 0), NaN when out of memory.
-/// With friction (dynamic problems), also the lagged friction of plume_contact_lag_friction.
-double plume_contact_evaluate(struct plume_sim *sim, const plume_vec3 *x, bool hessian, bool friction);
+/// Gradients only when asked for (or with hessian). With friction (dynamic problems), also the
+/// lagged friction of plume_contact_lag_friction.
+double plume_contact_evaluate(struct plume_sim *sim, const plume_vec3 *x, bool gradient, bool hessian, bool friction);
 
 /// Fixes the friction pairs of a (sub)step from fraction s0 of the step: the pairs within reach
 /// at its start (sim->previous, obstacles at s0), for a step of length h. None in statics

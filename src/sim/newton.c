@@ -259,7 +259,7 @@ static double largest_force(const plume_sim *sim, const double *gradient)
 	return largest;
 }
 
-plume_status plume_sim_newton(plume_sim *sim, const sim_problem *problem, plume_solve_report *report, plume_error *err)
+static plume_status newton(plume_sim *sim, const sim_problem *problem, plume_solve_report *report, plume_error *err)
 {
 	const plume_solver_def *solver = &sim->def.solver;
 	int n3 = 3 * sim->vertex_count, m = sim->constraint_count;
@@ -347,6 +347,9 @@ plume_status plume_sim_newton(plume_sim *sim, const sim_problem *problem, plume_
 			bound = plume_contact_step_bound(sim, x, sim->trial, sim->contact.body_x, sim->contact.body_x);
 			if (isnan(bound))
 				return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory finding contact pairs");
+			// Those candidates hold every pair in reach anywhere on the segment x -> x + step:
+			// the line search's evaluations and the next iteration's assembly use them.
+			sim->contact.reuse_candidates = true;
 		}
 
 		// The Newton decrement in length form: a step below tolerance of the shell's size
@@ -387,7 +390,9 @@ plume_status plume_sim_newton(plume_sim *sim, const sim_problem *problem, plume_
 				double *correction = g; // the gradient is not needed again this iteration
 				if (plume_kkt_solve(&sim->kkt, correction_rhs, correction, err) == PLUME_OK) {
 					apply_step(sim, sim->trial, correction, 1, sim->scratch);
-					// The corrected point must be reached without passing through anything, too.
+					// The corrected point must be reached without passing through anything, too;
+					// it leaves the segment, so the evaluations from here on query again.
+					sim->contact.reuse_candidates = false;
 					if (contact && !(plume_contact_step_bound(sim, x, sim->scratch, sim->contact.body_x,
 					                                          sim->contact.body_x) >= 1)) {
 						alpha *= 0.5;
@@ -414,4 +419,12 @@ plume_status plume_sim_newton(plume_sim *sim, const sim_problem *problem, plume_
 	return plume_error_set(err, PLUME_ERROR_NUMERIC,
 	                       "Newton did not converge in %d iterations (gradient norm %.3g N, barb strain %.3g)",
 	                       report->newton_iterations, report->gradient_norm, report->max_barb_strain);
+}
+
+plume_status plume_sim_newton(plume_sim *sim, const sim_problem *problem, plume_solve_report *report, plume_error *err)
+{
+	sim->contact.reuse_candidates = false;
+	plume_status status = newton(sim, problem, report, err);
+	sim->contact.reuse_candidates = false;
+	return status;
 }

@@ -143,7 +143,7 @@ double plume_sim_potential(plume_sim *sim, const sim_problem *problem, const plu
 		plume_air_add(sim, problem, x, want_gradient, hessian);
 	// Contact first: it may rebuild the matrix's pattern (contact.c).
 	bool contact = plume_contact_on(sim);
-	double contact_energy = contact ? plume_contact_evaluate(sim, x, hessian, problem->dynamic) : 0;
+	double contact_energy = contact ? plume_contact_evaluate(sim, x, want_gradient, hessian, problem->dynamic) : 0;
 	if (!isfinite(contact_energy))
 		return NAN; // out of memory, or a pair in contact: outside the barrier's domain
 
