@@ -109,7 +109,9 @@ typedef struct plume_mesh_report {
 	/// Junction faces: vane faces with an angle under PLUME_MESH_QUALITY_ANGLE_DEG where every such angle
 	/// lies between the face's barb edge and an edge on the vane's border (the rachis
 	/// band or the outline), that is where a guide meets the rachis or the outline at a
-	/// shallow angle that the feather's shape, not the mesher, sets (docs/meshing.md).
+	/// shallow angle that the feather's shape, not the mesher, sets, or faces the rachis
+	/// tip edge (group rachis_tip), where the two vanes' last guides meet the rachis: the
+	/// angle the shaft's width at its tip subtends (docs/meshing.md).
 	int excepted_count;
 } plume_mesh_report;
 

@@ -195,6 +195,10 @@ bool mesh_measure(const plume_mesh *mesh, plume_mesh_report *out)
 	if (keys == NULL)
 		return false;
 	qsort(keys, (size_t)key_count, sizeof *keys, compare_keys);
+	// The rachis tip edge: the band's top row, where the two vanes' last guides are rooted.
+	const plume_vertex_group *tip = plume_mesh_find_group(mesh, "rachis_tip");
+	int tip_a = tip != NULL && tip->count == 2 ? tip->vertices[0] : -1;
+	int tip_b = tip != NULL && tip->count == 2 ? tip->vertices[1] : -1;
 	for (int f = 0; f < mesh->face_count; ++f) {
 		const int *v = mesh->faces + 3 * f;
 		double angles[3];
@@ -214,14 +218,23 @@ bool mesh_measure(const plume_mesh *mesh, plume_mesh_report *out)
 		aligned += barb >= 0;
 		// A junction face: each angle under the quality bound lies at a vertex where the
 		// face's barb edge (local edge k or k + 2 at vertex k) meets a border edge, the
-		// other edge at that vertex: the angle between a guide and the rachis or the outline.
+		// other edge at that vertex: the angle between a guide and the rachis or the
+		// outline; or it faces the rachis tip edge (group rachis_tip), where the two
+		// vanes' last guides meet the rachis: the angle the band's width at its tip
+		// subtends, as thin as the band's own top faces (docs/meshing.md).
 		int small = 0, junction = 0;
 		for (int k = 0; k < 3; ++k) {
 			if (!(angles[k] < quality))
 				continue;
 			++small;
 			int other = barb == k ? (k + 2) % 3 : barb == (k + 2) % 3 ? k : -1;
-			junction += barb >= 0 && other >= 0 && on_vane_border(mesh, keys, key_count, v[other], v[(other + 1) % 3]);
+			int a = v[(k + 1) % 3], b = v[(k + 2) % 3];
+			if (barb < 0)
+				continue;
+			if (other >= 0 && on_vane_border(mesh, keys, key_count, v[other], v[(other + 1) % 3]))
+				++junction;
+			else if (tip_a >= 0 && ((a == tip_a && b == tip_b) || (a == tip_b && b == tip_a)))
+				++junction;
 		}
 		if (small > 0 && junction == small) {
 			++report.excepted_count;
