@@ -67,6 +67,29 @@ assert s["max_barb_strain"] < 1e-8, s
 ' "$scratch/$scene-true/summary.json"
 done
 
+# The two examples of issue 14, shortened: the flapping bird's first 30 ms (its feathers
+# meet from step 4 on, where without contact they pass through each other) and the coat's
+# first 20 ms on the body.
+"$plume" simulate "$source_dir/examples/scenes/bird-flap.json" -o "$scratch/bird" --duration 0.03 \
+	--frames-every 3 >"$scratch/out.txt" 2>"$scratch/err.txt"
+succeeded "simulate bird-flap.json for 30 ms"
+check "bird-flap: 20 feathers, contact, no intersecting pair" /usr/bin/python3 -c '
+import json, sys
+s = json.load(open(sys.argv[1]))
+assert s["completed"] and s["feather_count"] == 20 and s["steps"] == 30, s
+assert s["intersecting_pairs"] == 0 and s["frames_checked"] == 11 and s["contact_pairs_max"] > 0, s
+assert 0 < s["min_distance"] < 1.2e-4 and s["max_barb_strain"] < 1e-8, s
+' "$scratch/bird/summary.json"
+"$plume" simulate "$source_dir/examples/scenes/coat-settle.json" -o "$scratch/coat" --duration 0.02 \
+	>"$scratch/out.txt" 2>"$scratch/err.txt"
+succeeded "simulate coat-settle.json for 20 ms"
+check "coat-settle: 64 feathers on the body, no intersecting pair" /usr/bin/python3 -c '
+import json, sys
+s = json.load(open(sys.argv[1]))
+assert s["completed"] and s["feather_count"] == 64 and s["intersecting_pairs"] == 0, s
+assert s["max_barb_strain"] < 1e-8, s
+' "$scratch/coat/summary.json"
+
 # The contact object's bad values name the key and the range, and nothing is written.
 sed 's/"enabled": CONTACT/"distance": -1/' "$scratch/across.json" >"$scratch/bad.json"
 expect_no_output "a negative contact distance" 3 '$.contact.distance is -1, allowed' "$scratch/bad-out" \
