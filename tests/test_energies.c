@@ -1172,7 +1172,9 @@ static void test_table_6_1_materials(void **state)
 	assert_int_equal(vane.kind, PLUME_MATERIAL_ORTHOTROPIC);
 	assert_close(vane.E_ww, 4.80e4, 0);
 	assert_close(vane.E_vv, vane.E_ww, 0);
-	assert_close(vane.E_vw, 1.02e4, 0); // plume lab calibrate --phi 0.14 --Eb 3.92e4 --EB 2.57e9
+	// plume lab calibrate --phi 0.14 --Eb 3.92e4 --EB 2.57e9 (the chapter-5 protocol, docs/lab.md)
+	// prints 19910.1 Pa; the default keeps three digits, inside its 1899 Pa spread.
+	assert_close(vane.E_vw, 1.99e4, 0);
 	assert_true(vane.barb_constraint);
 	assert_close(vane.thickness, 1.2e-4, 0);
 	assert_close(vane.surface_density, 2.6e-2, 0);

@@ -55,7 +55,7 @@ typedef struct plume_material {
 } plume_material;
 
 /// The vane of thesis Table 6.1 with the inextensibility constraint: E_ww = 4.80e4 Pa,
-/// E_vw = 1.02e4 Pa (plume's calibration, docs/lab.md), thickness 1.2e-4 m (mean of
+/// E_vw = 1.99e4 Pa (plume's calibration, docs/lab.md), thickness 1.2e-4 m (mean of
 /// Table 3.1), 2.6e-2 kg/m^2, bending 1e-7 / 2.5e-4 N m, kappa 5.04e7.
 plume_material plume_material_vane(void);
 /// The rachis of thesis Table 6.1: isotropic, E = 34 MPa, nu = 0.49, thickness 1.2e-2 m, 0.54 kg/m^2;
