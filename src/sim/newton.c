@@ -298,8 +298,6 @@ static plume_status newton(plume_sim *sim, const sim_problem *problem, plume_sol
 		report->energy = phi;
 		report->gradient_norm = free_norm2(sim, sim->residual);
 		report->max_barb_strain = plume_sim_max_barb_strain(sim, x);
-		if (sim->trace_count < PLUME_SIM_TRACE)
-			sim->trace[sim->trace_count++] = phi + (m > 0 ? mu * constraint_norm1(sim, x) : 0);
 		bool feasible = max_constraint_strain(sim, x) <= STRAIN_TOLERANCE;
 		if (feasible && residual <= solver->tolerance * tolerance_scale) {
 			report->converged = true;
@@ -369,7 +367,7 @@ static plume_status newton(plume_sim *sim, const sim_problem *problem, plume_sol
 		}
 
 		// Backtracking (Armijo) on the merit; a second-order correction first when the full step fails.
-		double alpha = bound;
+		double alpha = bound, accepted_merit = current;
 		bool accepted = false;
 		if (!(alpha > 0))
 			break; // CCD allows no motion at all (a pair that starts in contact): no step to take
@@ -378,6 +376,7 @@ static plume_status newton(plume_sim *sim, const sim_problem *problem, plume_sol
 			double trial = merit(sim, problem, sim->trial, mu);
 			if (isfinite(trial) && trial <= current + 1e-4 * alpha * fmin(slope, 0)) {
 				accepted = true;
+				accepted_merit = trial;
 				break;
 			}
 			if (backtrack == 0 && m > 0) {
@@ -402,6 +401,7 @@ static plume_status newton(plume_sim *sim, const sim_problem *problem, plume_sol
 					if (isfinite(corrected) && corrected <= current + 1e-4 * fmin(slope, 0)) {
 						memcpy(sim->trial, sim->scratch, sizeof(plume_vec3) * (size_t)sim->vertex_count);
 						accepted = true;
+						accepted_merit = corrected;
 						break;
 					}
 				}
@@ -410,6 +410,12 @@ static plume_status newton(plume_sim *sim, const sim_problem *problem, plume_sol
 		}
 		if (!accepted)
 			break;
+		// The merit before and after the step, under the same penalty (mu can grow from one
+		// iteration to the next, so merits of different iterations do not compare).
+		if (sim->trace_count + 2 <= PLUME_SIM_TRACE) {
+			sim->trace[sim->trace_count++] = current;
+			sim->trace[sim->trace_count++] = accepted_merit;
+		}
 		memcpy(x, sim->trial, sizeof(plume_vec3) * (size_t)sim->vertex_count);
 		for (int k = 0; k < m; ++k)
 			sim->lambda[k] += alpha * (step[n3 + k] - sim->lambda[k]);

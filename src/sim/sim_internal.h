@@ -120,7 +120,8 @@ struct plume_sim {
 	sim_air air;
 	/// Contact pairs, obstacles and the broad phase (contact.c).
 	sim_contact contact;
-	/// Merit at each iteration of the last solve (tests check it decreases).
+	/// For each accepted Newton step of the last solve, the merit before and after it under
+	/// one penalty (pairs: tests check that each step decreases it).
 	double trace[PLUME_SIM_TRACE];
 	int trace_count;
 };
