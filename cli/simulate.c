@@ -128,53 +128,62 @@ typedef struct run_state {
 	double max_out_of_plane;
 	double max_kinetic;
 	double max_elastic;
-	double *max_reaction;       ///< per handle: the largest |reaction|, N
-	plume_vec3 *body_positions; ///< the scene's body posed at a frame's time
+	double *max_reaction;                 ///< per handle: the largest |reaction|, N
+	plume_vec3 *body_positions;           ///< the scene's body posed at a frame's time
+	plume_mesh *body_mesh;                ///< the body at rest, for sim.glb
+	plume_mesh_animation *body_animation; ///< the body's frames, node "body" of sim.glb
+	cli_carried glb_carried;              ///< --glb-feather of many feathers: their embeddings
 	/// --render of a scene that lists "feathers" or has a body (cli/carry.c).
 	bool many;
 	cli_carried carried_scene;
 } run_state;
 
-/// Sets up --render for many feathers and a body: the camera as cli_barb_renderer_begin
-/// frames it, and the feathers and body drawn by cli_carried (the path `plume render` takes
-/// for the run folder).
-static plume_status many_renderer_begin(run_state *run, plume_vec3 lo, plume_vec3 hi, int spp, plume_error *err)
+/// The body's rest mesh as a plume_mesh (for drawing and sim.glb), or NULL when memory runs out.
+static plume_mesh *body_mesh(const plume_body *body)
 {
-	const plume_scene *scene = run->scene;
-	run->renderer.embedding = NULL;
-	run->renderer.def = plume_raytrace_default_def();
-	run->renderer.def.camera.width = run->view.width;
-	run->renderer.def.camera.height = run->view.height;
-	run->renderer.def.spp = spp;
-	run->renderer.def.camera = plume_camera_frame_bounds(&run->renderer.def.camera, lo, hi);
+	plume_mesh *mesh = plume_mesh_create(plume_body_vertex_count(body), plume_body_triangle_count(body));
+	if (mesh != NULL) {
+		memcpy(mesh->rest, plume_body_rest_positions(body), sizeof(plume_vec3) * (size_t)mesh->vertex_count);
+		memcpy(mesh->faces, plume_body_triangles(body), sizeof(int) * 3 * (size_t)mesh->face_count);
+	}
+	return mesh;
+}
+
+/// Every feather of the scene embedded in its own faces of the joined shell (cli/carry.c, the
+/// path `plume render` takes for the run folder), and the body when with_body.
+static plume_status carry_scene(const plume_scene *scene, bool with_body, cli_carried *carried, plume_error *err)
+{
 	const plume_feather **feathers = calloc((size_t)scene->feather_count, sizeof *feathers);
 	int *faces = calloc(2 * (size_t)scene->feather_count, sizeof *faces);
-	plume_mesh *body = NULL;
+	plume_mesh *body = with_body && scene->body != NULL ? body_mesh(scene->body) : NULL;
 	plume_status status = PLUME_OK;
-	if (feathers == NULL || faces == NULL)
+	if (feathers == NULL || faces == NULL || (with_body && scene->body != NULL && body == NULL))
 		status = plume_error_set(err, PLUME_ERROR_MEMORY, "simulate: out of memory");
 	for (int i = 0; i < scene->feather_count && status == PLUME_OK; ++i) {
 		feathers[i] = scene->feathers[i].feather;
 		faces[2 * i] = scene->feathers[i].face_offset;
 		faces[2 * i + 1] = scene->feathers[i].face_count;
 	}
-	if (status == PLUME_OK && scene->body != NULL) {
-		body = plume_mesh_create(plume_body_vertex_count(scene->body), plume_body_triangle_count(scene->body));
-		if (body == NULL)
-			status = plume_error_set(err, PLUME_ERROR_MEMORY, "simulate: out of memory");
-		else {
-			memcpy(body->rest, plume_body_rest_positions(scene->body), sizeof(plume_vec3) * (size_t)body->vertex_count);
-			memcpy(body->faces, plume_body_triangles(scene->body), sizeof(int) * 3 * (size_t)body->face_count);
-		}
-	}
 	if (status == PLUME_OK)
-		status = cli_carried_begin(&run->carried_scene, scene->mesh, scene->feather_count, feathers, faces, false, body,
-		                           err);
-	run->many = true;
+		status = cli_carried_begin(carried, scene->mesh, scene->feather_count, feathers, faces, false, body, err);
 	plume_mesh_destroy(body);
 	free(feathers);
 	free(faces);
 	return status;
+}
+
+/// Sets up --render for many feathers and a body: the camera as cli_barb_renderer_begin
+/// frames it, the feathers and the body drawn by carry_scene.
+static plume_status many_renderer_begin(run_state *run, plume_vec3 lo, plume_vec3 hi, int spp, plume_error *err)
+{
+	run->renderer.embedding = NULL;
+	run->renderer.def = plume_raytrace_default_def();
+	run->renderer.def.camera.width = run->view.width;
+	run->renderer.def.camera.height = run->view.height;
+	run->renderer.def.spp = spp;
+	run->renderer.def.camera = plume_camera_frame_bounds(&run->renderer.def.camera, lo, hi);
+	run->many = true;
+	return carry_scene(run->scene, true, &run->carried_scene, err);
 }
 
 /// Every feather carried by the shell at positions, and the body posed at time, to path (PNG).
@@ -225,6 +234,8 @@ static plume_status write_frame(run_state *run, int frame, double time, const pl
 	}
 	if (status == PLUME_OK)
 		status = plume_mesh_animation_add_frame(run->animation, time, plume_sim_positions(sim), err);
+	if (status == PLUME_OK && run->body_animation != NULL) // body_positions posed above
+		status = plume_mesh_animation_add_frame(run->body_animation, time, run->body_positions, err);
 	if (status == PLUME_OK && run->fields) {
 		if (frame >= run->field_capacity) {
 			int capacity = run->field_capacity > 0 ? 2 * run->field_capacity : 64;
@@ -540,10 +551,23 @@ static plume_status simulate(const plume_scene *scene, cli_output *output, run_s
 	status = plume_mesh_animation_create(scene->mesh, NULL, &run->animation, err);
 	if (status == PLUME_OK)
 		status = plume_mesh_obj_writer_create(scene->mesh, &run->obj, err);
-	if (status == PLUME_OK && run->glb_feather) {
+	if (status == PLUME_OK && run->glb_feather && scene->feather != NULL) {
 		status = plume_embedding_create(scene->feather, scene->mesh, &run->carried, err);
 		if (status == PLUME_OK)
 			plume_mesh_animation_set_feather(run->animation, run->carried);
+	} else if (status == PLUME_OK && run->glb_feather) { // many feathers: node feather_NAME each
+		status = carry_scene(scene, false, &run->glb_carried, err);
+		for (int i = 0; i < scene->feather_count && status == PLUME_OK; ++i)
+			if (run->glb_carried.embeddings[i] != NULL)
+				status = plume_mesh_animation_add_feather(run->animation, run->glb_carried.embeddings[i],
+				                                          scene->feathers[i].name, err);
+	}
+	if (status == PLUME_OK && scene->body != NULL) { // the body moves in sim.glb too
+		run->body_mesh = body_mesh(scene->body);
+		status = run->body_mesh != NULL ? plume_mesh_animation_create(run->body_mesh, NULL, &run->body_animation, err)
+		                                : plume_error_set(err, PLUME_ERROR_MEMORY, "simulate: out of memory");
+		if (status == PLUME_OK)
+			plume_mesh_animation_set_body(run->animation, run->body_animation);
 	}
 	if (status != PLUME_OK)
 		return status;
@@ -733,17 +757,15 @@ int cli_simulate(int argc, char **argv)
 		run.view.bounds_min = lo;
 		run.view.bounds_max = hi;
 	}
-	if (run.glb_feather && scene->feather == NULL) {
+	bool generated = false;
+	for (int i = 0; i < scene->feather_count; ++i)
+		generated = generated || scene->feathers[i].feather != NULL;
+	if (run.glb_feather && !generated) {
 		plume_scene_destroy(scene);
-		return cli_usage_error(
-		    "simulate",
-		    "--glb-feather needs a scene with one generated feather (\"feather\", not guides or \"feathers\")");
+		return cli_usage_error("simulate", "--glb-feather needs a scene whose feathers are generated (not guides)");
 	}
 	if (run.render) {
 		bool many = scene->feather_count > 1 || scene->feather == NULL || scene->body != NULL;
-		bool generated = false;
-		for (int i = 0; i < scene->feather_count; ++i)
-			generated = generated || scene->feathers[i].feather != NULL;
 		if (!generated) {
 			plume_scene_destroy(scene);
 			return cli_usage_error("simulate", "--render needs a scene whose feathers are generated (not guides)");
@@ -789,6 +811,9 @@ int cli_simulate(int argc, char **argv)
 	free(run.field_times);
 	free(run.max_reaction);
 	free(run.body_positions);
+	plume_mesh_animation_destroy(run.body_animation);
+	plume_mesh_destroy(run.body_mesh);
+	cli_carried_end(&run.glb_carried);
 	cli_barb_renderer_end(&run.renderer);
 	cli_carried_end(&run.carried_scene);
 	if (status != PLUME_OK)
