@@ -2,8 +2,9 @@
 //                          [--turntable N] [--threads N] [--shell] [--format LIST]
 //
 // INPUT is a feather or coat spec (ray-traced to DIR/feather.png, or a turntable in DIR/turntable/) or a simulation
-// output folder (docs/rendering.md): the generated feather's barbs are embedded in the rest shell and
-// carried to every frame, written as DIR/frames/NNNN.png, .obj and .usda.
+// output folder (docs/rendering.md): the generated feather's barbs (every feather's, each in its own
+// piece of the joined shell, for a many-feather run) are embedded in the rest shell and carried to
+// every frame, with the body of the frame, written as DIR/frames/NNNN.png, .obj and .usda.
 #define _POSIX_C_SOURCE 200809L
 #include <dirent.h>
 #include <errno.h>
@@ -33,7 +34,9 @@ void cli_help_render(void)
 	     "        written the same way.\n"
 	     "  INPUT a simulation folder (from plume simulate): embeds the barbs of feather.json in\n"
 	     "        mesh.obj, carries them to every frames/NNNN.obj and writes DIR/frames/NNNN.png,\n"
-	     "        NNNN.obj and NNNN.usda (barb-level curves).\n"
+	     "        NNNN.obj and NNNN.usda (barb-level curves). A run of many feathers\n"
+	     "        (feathers.json): every feather in its own piece of the shell, the curves in\n"
+	     "        NNNN-NAME.obj and .usda, and the body (frames/body-NNNN.obj) as a surface.\n"
 	     "All files appear together, or none when anything fails.\n"
 	     "\n"
 	     "Options:\n"
