@@ -70,7 +70,7 @@ typedef struct cli_output {
 	char stage[4160];
 	bool dir_existed;
 	bool stage_inside; ///< staged inside DIR (its parent is not writable): committed entry by entry
-	int stage_slot; ///< 1 + its slot in output.c's list for the signal handler, 0 when none
+	int stage_slot;    ///< 1 + its slot in output.c's list for the signal handler, 0 when none
 	char names[32][80];
 	int name_count;
 } cli_output;
@@ -93,6 +93,32 @@ typedef struct cli_barb_renderer {
 	plume_barb_embedding *embedding;
 	plume_raytrace_def def;
 } cli_barb_renderer;
+
+/// Many feathers carried by one joined shell, and a body, drawn together (cli/carry.c): the
+/// one path of `plume simulate --render` and `plume render` of a many-feather run folder.
+/// Each feather's barbs are embedded in its own face range of the shell
+/// (plume_embedding_create_faces); the body (and, when asked, the simulated shell) is one
+/// plain surface.
+typedef struct cli_carried {
+	int count;                         ///< feathers (NULL embeddings are not drawn: guides)
+	plume_barb_embedding **embeddings; ///< per feather
+	plume_feather **moved;             ///< per feather, after cli_carried_pose (NULL: not drawn)
+	int shell_vertices;                ///< vertices of the drawn shell taken from the feathers' shell (0: none)
+	plume_mesh *surface;               ///< the shell (--shell) then the body, or NULL
+	plume_vec3 *surface_positions;
+	const plume_feather **list; ///< the drawn feathers, for the ray tracer
+} cli_carried;
+
+/// feathers[i] (NULL: not drawn) is embedded in the faces [faces[2 i], faces[2 i] + faces[2 i + 1])
+/// of shell. draw_shell: the shell itself is drawn too. body may be NULL. shell and body are
+/// copied where needed; shell must outlive c.
+plume_status cli_carried_begin(cli_carried *c, const plume_mesh *shell, int count, const plume_feather *const *feathers,
+                               const int *faces, bool draw_shell, const plume_mesh *body, plume_error *err);
+/// Carries every feather to the shell's positions and places the body at body_positions (its
+/// rest when NULL): *scene then draws them until the next call or cli_carried_end.
+plume_status cli_carried_pose(cli_carried *c, const plume_vec3 *positions, const plume_vec3 *body_positions,
+                              plume_raytrace_scene *scene, plume_error *err);
+void cli_carried_end(cli_carried *c);
 
 /// The box a scene's sequence stays in: the rest shell grown by the largest handle
 /// translation (at least a tenth of its size), so every frame shares one framing.

@@ -2,8 +2,9 @@
 //                          [--turntable N] [--threads N] [--shell] [--format LIST]
 //
 // INPUT is a feather or coat spec (ray-traced to DIR/feather.png, or a turntable in DIR/turntable/) or a simulation
-// output folder (docs/rendering.md): the generated feather's barbs are embedded in the rest shell and
-// carried to every frame, written as DIR/frames/NNNN.png, .obj and .usda.
+// output folder (docs/rendering.md): the generated feather's barbs (every feather's, each in its own
+// piece of the joined shell, for a many-feather run) are embedded in the rest shell and carried to
+// every frame, with the body of the frame, written as DIR/frames/NNNN.png, .obj and .usda.
 #define _POSIX_C_SOURCE 200809L
 #include <dirent.h>
 #include <errno.h>
@@ -33,7 +34,9 @@ void cli_help_render(void)
 	     "        written the same way.\n"
 	     "  INPUT a simulation folder (from plume simulate): embeds the barbs of feather.json in\n"
 	     "        mesh.obj, carries them to every frames/NNNN.obj and writes DIR/frames/NNNN.png,\n"
-	     "        NNNN.obj and NNNN.usda (barb-level curves).\n"
+	     "        NNNN.obj and NNNN.usda (barb-level curves). A run of many feathers\n"
+	     "        (feathers.json): every feather in its own piece of the shell, the curves in\n"
+	     "        NNNN-NAME.obj and .usda, and the body (frames/body-NNNN.obj) as a surface.\n"
 	     "All files appear together, or none when anything fails.\n"
 	     "\n"
 	     "Options:\n"
@@ -320,21 +323,108 @@ static plume_status render_spec(const render_options *o, const plume_raytrace_de
 // A simulation folder
 
 typedef struct sim_input {
-	plume_feather *feather;
+	/// The feathers at rest, world coordinates: feather.json, or every feather of a
+	/// many-feather run (feathers.json). A NULL feather (guides) is not drawn.
+	int feather_count;
+	plume_feather **feathers;
+	char (*names)[64]; ///< "" for feather.json; else each feather's name
+	int *faces;        ///< per feather: first face and face count in the rest shell
 	plume_mesh *rest;
+	plume_mesh *body; ///< body.obj at rest, or NULL
 	int frame_count;
 	char (*frame_names)[64];
-	plume_vec3 **positions; ///< per frame, rest vertex order
+	plume_vec3 **positions;      ///< per frame, rest vertex order
+	plume_vec3 **body_positions; ///< per frame (frames/body-NNNN.obj), when there is a body
 } sim_input;
 
 static void sim_input_free(sim_input *in)
 {
-	plume_feather_destroy(in->feather);
+	for (int i = 0; i < in->feather_count && in->feathers != NULL; ++i)
+		plume_feather_destroy(in->feathers[i]);
+	free(in->feathers);
+	free(in->names);
+	free(in->faces);
 	plume_mesh_destroy(in->rest);
-	for (int i = 0; i < in->frame_count; ++i)
+	plume_mesh_destroy(in->body);
+	for (int i = 0; i < in->frame_count; ++i) {
 		free(in->positions != NULL ? in->positions[i] : NULL);
+		free(in->body_positions != NULL ? in->body_positions[i] : NULL);
+	}
 	free(in->positions);
+	free(in->body_positions);
 	free(in->frame_names);
+}
+
+static plume_status sim_input_reserve(sim_input *in, int count, plume_error *err)
+{
+	in->feather_count = count;
+	in->feathers = calloc((size_t)(count > 0 ? count : 1), sizeof *in->feathers);
+	in->names = calloc((size_t)(count > 0 ? count : 1), sizeof *in->names);
+	in->faces = calloc(2 * (size_t)(count > 0 ? count : 1), sizeof *in->faces);
+	if (in->feathers == NULL || in->names == NULL || in->faces == NULL)
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory");
+	return PLUME_OK;
+}
+
+/// The feathers of a many-feather run (DIR/feathers.json, written by plume simulate): each
+/// read from its dump (shared by the copies of one feather) and placed by its rotation and
+/// translation. The face ranges are checked against the rest shell by the caller.
+static plume_status read_feathers(const char *dir, const char *index_path, sim_input *in, plume_error *err)
+{
+	json_error_t error;
+	json_t *root = json_load_file(index_path, 0, &error);
+	if (root == NULL)
+		return plume_error_set(err, PLUME_ERROR_SPEC, "%s: line %d: %s", index_path, error.line, error.text);
+	json_t *list = json_object_get(root, "feathers");
+	plume_status status = json_is_array(list) && json_array_size(list) > 0
+	                          ? sim_input_reserve(in, (int)json_array_size(list), err)
+	                          : plume_error_set(err, PLUME_ERROR_SPEC,
+	                                            "%s: $.feathers: expected a non-empty array of feathers", index_path);
+	char path[4608];
+	for (int i = 0; i < in->feather_count && status == PLUME_OK; ++i) {
+		json_t *entry = json_array_get(list, (size_t)i), *rotation = json_object_get(entry, "rotation"),
+		       *translation = json_object_get(entry, "translation");
+		const char *name = json_string_value(json_object_get(entry, "name"));
+		const char *dump = json_string_value(json_object_get(entry, "dump"));
+		json_t *first = json_object_get(entry, "face_offset"), *count = json_object_get(entry, "face_count");
+		if (name == NULL || !json_is_integer(first) || !json_is_integer(count)) {
+			status = plume_error_set(err, PLUME_ERROR_SPEC,
+			                         "%s: $.feathers[%d]: needs \"name\", \"face_offset\" and \"face_count\"",
+			                         index_path, i);
+			break;
+		}
+		snprintf(in->names[i], sizeof in->names[i], "%s", name);
+		in->faces[2 * i] = (int)json_integer_value(first);
+		in->faces[2 * i + 1] = (int)json_integer_value(count);
+		if (dump == NULL) // guides: nothing to draw
+			continue;
+		if (strchr(dump, '/') != NULL || json_array_size(rotation) != 9 || json_array_size(translation) != 3) {
+			status = plume_error_set(err, PLUME_ERROR_SPEC,
+			                         "%s: $.feathers[%d]: \"dump\" must be a file name in feathers/, \"rotation\" 9 "
+			                         "numbers and \"translation\" 3",
+			                         index_path, i);
+			break;
+		}
+		snprintf(path, sizeof path, "%s/feathers/%s", dir, dump);
+		if (access(path, F_OK) != 0) {
+			status = plume_error_set(err, PLUME_ERROR_IO,
+			                         "%s: missing; feather \"%s\" of %s needs it (plume simulate writes one dump per "
+			                         "distinct feather)",
+			                         path, name, index_path);
+			break;
+		}
+		if ((status = plume_read_json(path, &in->feathers[i], err)) != PLUME_OK)
+			break;
+		plume_mat3 r;
+		for (int k = 0; k < 9; ++k)
+			r.m[k / 3][k % 3] = json_number_value(json_array_get(rotation, (size_t)k));
+		plume_vec3 t = plume_v3(json_number_value(json_array_get(translation, 0)),
+		                        json_number_value(json_array_get(translation, 1)),
+		                        json_number_value(json_array_get(translation, 2)));
+		plume_feather_move(in->feathers[i], r, t);
+	}
+	json_decref(root);
+	return status;
 }
 
 static int compare_names(const void *a, const void *b) { return strcmp(a, b); }
@@ -371,22 +461,71 @@ static plume_status list_frames(const char *dir, sim_input *in, plume_error *err
 	return status;
 }
 
-/// Reads feather.json, mesh.obj and every frame, checking that the frames match the rest shell.
-static plume_status read_sim(const char *dir, sim_input *in, plume_error *err)
+/// Frame i's body, frames/body-NNNN.obj, which must keep body.obj's vertices and faces.
+static plume_status read_body_frame(const char *frames_dir, sim_input *in, int i, plume_error *err)
 {
 	char path[4608];
-	snprintf(path, sizeof path, "%s/feather.json", dir);
-	plume_status status = plume_read_json(path, &in->feather, err);
+	snprintf(path, sizeof path, "%s/body-%s", frames_dir, in->frame_names[i]);
+	plume_mesh *frame = NULL;
+	plume_status status = plume_mesh_read_obj(path, &frame, err);
 	if (status != PLUME_OK) {
 		if (access(path, F_OK) != 0)
-			return plume_error_set(err, PLUME_ERROR_IO,
-			                       "%s: missing; plume render needs the generated feather of a simulation to carry "
-			                       "its barbs",
+			return plume_error_set(err, PLUME_ERROR_IO, "%s: missing; the run has a body (body.obj) in every frame",
 			                       path);
 		return status;
 	}
+	if (frame->vertex_count != in->body->vertex_count || frame->face_count != in->body->face_count ||
+	    memcmp(frame->faces, in->body->faces, 3 * sizeof(int) * (size_t)frame->face_count) != 0) {
+		plume_error_set(err, PLUME_ERROR_SPEC,
+		                "%s: has %d vertices and %d faces, but body.obj has %d and %d (or other faces)", path,
+		                frame->vertex_count, frame->face_count, in->body->vertex_count, in->body->face_count);
+		plume_mesh_destroy(frame);
+		return PLUME_ERROR_SPEC;
+	}
+	in->body_positions[i] = malloc((size_t)frame->vertex_count * sizeof(plume_vec3));
+	if (in->body_positions[i] != NULL)
+		memcpy(in->body_positions[i], frame->rest, (size_t)frame->vertex_count * sizeof(plume_vec3));
+	plume_mesh_destroy(frame);
+	return in->body_positions[i] != NULL ? PLUME_OK : plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory");
+}
+
+/// Reads feather.json (or feathers.json and the dumps), mesh.obj, body.obj and every frame, checking that the frames
+/// match the rest shell.
+static plume_status read_sim(const char *dir, sim_input *in, plume_error *err)
+{
+	char path[4608], index[4608];
+	snprintf(path, sizeof path, "%s/feather.json", dir);
+	snprintf(index, sizeof index, "%s/feathers.json", dir);
+	plume_status status;
+	if (access(path, F_OK) != 0 && access(index, F_OK) == 0) {
+		if ((status = read_feathers(dir, index, in, err)) != PLUME_OK)
+			return status;
+	} else {
+		if ((status = sim_input_reserve(in, 1, err)) != PLUME_OK)
+			return status;
+		if ((status = plume_read_json(path, &in->feathers[0], err)) != PLUME_OK) {
+			if (access(path, F_OK) != 0)
+				return plume_error_set(err, PLUME_ERROR_IO,
+				                       "%s: missing; plume render needs the generated feather of a simulation to "
+				                       "carry its barbs (or feathers.json, for a run of many feathers)",
+				                       path);
+			return status;
+		}
+	}
 	snprintf(path, sizeof path, "%s/mesh.obj", dir);
 	if ((status = plume_mesh_read_obj(path, &in->rest, err)) != PLUME_OK)
+		return status;
+	if (in->names[0][0] == '\0') {
+		in->faces[1] = in->rest->face_count;
+	}
+	for (int i = 0; i < in->feather_count; ++i)
+		if (in->faces[2 * i] < 0 || in->faces[2 * i + 1] < 0 ||
+		    in->faces[2 * i] + (int64_t)in->faces[2 * i + 1] > in->rest->face_count)
+			return plume_error_set(
+			    err, PLUME_ERROR_SPEC, "%s: feather \"%s\": faces %d to %d are not all in mesh.obj (%d faces)", index,
+			    in->names[i], in->faces[2 * i], in->faces[2 * i] + in->faces[2 * i + 1] - 1, in->rest->face_count);
+	snprintf(path, sizeof path, "%s/body.obj", dir);
+	if (access(path, F_OK) == 0 && (status = plume_mesh_read_obj(path, &in->body, err)) != PLUME_OK)
 		return status;
 	char frames_dir[4352];
 	snprintf(frames_dir, sizeof frames_dir, "%s/frames", dir);
@@ -396,7 +535,8 @@ static plume_status read_sim(const char *dir, sim_input *in, plume_error *err)
 		return status;
 	names = in->frame_count;
 	in->positions = calloc((size_t)names, sizeof *in->positions);
-	if (in->positions == NULL)
+	in->body_positions = calloc((size_t)names, sizeof *in->body_positions);
+	if (in->positions == NULL || in->body_positions == NULL)
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory");
 	for (int i = 0; i < names; ++i) {
 		snprintf(path, sizeof path, "%s/%s", frames_dir, in->frame_names[i]);
@@ -420,6 +560,8 @@ static plume_status read_sim(const char *dir, sim_input *in, plume_error *err)
 		}
 		memcpy(in->positions[i], frame->rest, (size_t)frame->vertex_count * sizeof(plume_vec3));
 		plume_mesh_destroy(frame);
+		if (in->body != NULL && (status = read_body_frame(frames_dir, in, i, err)) != PLUME_OK)
+			return status;
 	}
 	return PLUME_OK;
 }
@@ -485,23 +627,21 @@ static plume_status render_sim(const render_options *o, const plume_raytrace_def
                                plume_error *err)
 {
 	sim_input in = {0};
-	plume_barb_embedding *embedding = NULL;
+	cli_carried carried = {0};
 	plume_status status = read_sim(o->input, &in, err);
 	if (status == PLUME_OK)
-		status = plume_embedding_create(in.feather, in.rest, &embedding, err);
-	// One camera for the whole sequence, framing the carried feather over every frame.
+		status = cli_carried_begin(&carried, in.rest, in.feather_count, (const plume_feather *const *)in.feathers,
+		                           in.faces, o->shell, in.body, err);
+	// One camera for the whole sequence, framing the carried feathers (and the body) over every frame.
 	plume_raytrace_def frame_def = *def;
 	plume_vec3 lo = {INFINITY, INFINITY, INFINITY}, hi = {-INFINITY, -INFINITY, -INFINITY};
 	for (int i = 0; i < in.frame_count && status == PLUME_OK; ++i) {
-		plume_feather *moved = NULL;
-		if ((status = plume_embedding_apply(embedding, in.positions[i], &moved, err)) != PLUME_OK)
+		plume_raytrace_scene scene;
+		if ((status = cli_carried_pose(&carried, in.positions[i], in.body_positions[i], &scene, err)) != PLUME_OK)
 			break;
-		const plume_feather *list[1] = {moved};
-		plume_raytrace_scene scene = {1, list, o->shell ? in.rest : NULL, in.positions[i]};
 		plume_vec3 a, b;
 		plume_raytrace_scene_bounds(&scene, &a, &b);
 		grow_bounds(&lo, &hi, a, b);
-		plume_feather_destroy(moved);
 	}
 	if (status == PLUME_OK)
 		frame_def.camera = plume_camera_frame_bounds(&def->camera, lo, hi);
@@ -534,11 +674,9 @@ static plume_status render_sim(const render_options *o, const plume_raytrace_def
 	for (int i = 0; i < in.frame_count && status == PLUME_OK; ++i) {
 		if (!frame_selected(o, in.frame_names[i]))
 			continue;
-		plume_feather *moved = NULL;
-		if ((status = plume_embedding_apply(embedding, in.positions[i], &moved, err)) != PLUME_OK)
+		plume_raytrace_scene scene;
+		if ((status = cli_carried_pose(&carried, in.positions[i], in.body_positions[i], &scene, err)) != PLUME_OK)
 			break;
-		const plume_feather *list[1] = {moved};
-		plume_raytrace_scene scene = {1, list, o->shell ? in.rest : NULL, in.positions[i]};
 		char stem[64], path[4608];
 		snprintf(stem, sizeof stem, "%.*s", (int)(strlen(in.frame_names[i]) - 4), in.frame_names[i]);
 		if (status == PLUME_OK && (o->formats & CLI_FORMAT_PNG)) {
@@ -555,15 +693,22 @@ static plume_status render_sim(const render_options *o, const plume_raytrace_def
 				memcpy(strip + 4 * ((size_t)y * (size_t)(w * slots) + (size_t)(slot * w)),
 				       image + 4 * (size_t)y * (size_t)w, 4 * (size_t)w);
 		}
-		if (status == PLUME_OK && (o->formats & CLI_FORMAT_OBJ)) {
-			snprintf(path, sizeof path, "%s/%s.obj", folder, stem);
-			status = plume_write_obj(moved, path, err);
+		// Curves: NNNN.obj for one feather, NNNN-NAME.obj per feather of a many-feather run.
+		for (int f = 0; f < in.feather_count && status == PLUME_OK; ++f) {
+			const plume_feather *moved = carried.moved[f];
+			if (moved == NULL)
+				continue;
+			char file[128];
+			snprintf(file, sizeof file, "%s%s%s", stem, in.names[f][0] != '\0' ? "-" : "", in.names[f]);
+			if (o->formats & CLI_FORMAT_OBJ) {
+				snprintf(path, sizeof path, "%s/%s.obj", folder, file);
+				status = plume_write_obj(moved, path, err);
+			}
+			if (status == PLUME_OK && (o->formats & CLI_FORMAT_USDA)) {
+				snprintf(path, sizeof path, "%s/%s.usda", folder, file);
+				status = plume_write_usda(moved, path, err);
+			}
 		}
-		if (status == PLUME_OK && (o->formats & CLI_FORMAT_USDA)) {
-			snprintf(path, sizeof path, "%s/%s.usda", folder, stem);
-			status = plume_write_usda(moved, path, err);
-		}
-		plume_feather_destroy(moved);
 		if (status == PLUME_OK)
 			cli_progress_update(&progress, i + 1);
 	}
@@ -576,7 +721,7 @@ static plume_status render_sim(const render_options *o, const plume_raytrace_def
 		status = merge_frames(output, folder, err);
 	free(image);
 	free(strip);
-	plume_embedding_destroy(embedding);
+	cli_carried_end(&carried);
 	sim_input_free(&in);
 	return status;
 }

@@ -22,13 +22,15 @@ void cli_help_simulate(void)
 	     "  DIR/feather.json      the generated feather (barb-level geometry; its numbers\n"
 	     "                        in DIR/feather.bin, docs/feather-json.md)\n"
 	     "  DIR/feathers/NAME.json  instead, for a scene that lists \"feathers\": each\n"
-	     "                        feather placed at rest (world coordinates, like mesh.obj)\n"
+	     "                        distinct feather once, in its own frame; DIR/feathers.json\n"
+	     "                        maps every feather to its dump and its placement\n"
 	     "  DIR/frames/NNNN.obj   the shell at every written step (0000: the start); every\n"
 	     "                        feather of the scene in one mesh\n"
 	     "  DIR/body.obj, DIR/frames/body-NNNN.obj  the scene's body at rest and at every\n"
 	     "                        written step, when it has one\n"
 	     "  DIR/sim.glb           all frames as one animated glTF 2.0 file (morph\n"
-	     "                        targets, animation \"simulation\"; Blender, three.js)\n"
+	     "                        targets, animation \"simulation\"; Blender, three.js;\n"
+	     "                        the body too, node \"body\")\n"
 	     "  DIR/sim.usda          the same as USD text: time-sampled points\n"
 	     "  DIR/frames/NNNN.png   a shaded view of each frame, with --png\n"
 	     "  DIR/stats.csv         per step: time, Newton iterations, gradient norm,\n"
@@ -58,7 +60,8 @@ void cli_help_simulate(void)
 	     "                      is installed\n"
 	     "      --spp N         samples per pixel of --render (default 4)\n"
 	     "      --glb-feather   sim.glb also carries the feather's barbs (line segments\n"
-	     "                      moved by the shell, one morph target per frame; large:\n"
+	     "                      moved by the shell, one morph target per frame; every\n"
+	     "                      feather of a list, node feather_NAME each; large:\n"
 	     "                      about 12 bytes per barb point and frame)\n"
 	     "      --fields        also write DIR/fields/NNNN.vtu and DIR/fields.pvd for\n"
 	     "                      ParaView: per face Green strain and 2nd Piola-Kirchhoff\n"
@@ -128,84 +131,75 @@ typedef struct run_state {
 	double max_out_of_plane;
 	double max_kinetic;
 	double max_elastic;
-	double *max_reaction;       ///< per handle: the largest |reaction|, N
-	plume_vec3 *body_positions; ///< the scene's body posed at a frame's time
-	/// --render of a scene that lists "feathers" or has a body: each feather's barbs embedded
-	/// in the joined shell (NULL for guides), the body drawn as a shell.
-	plume_barb_embedding **embeddings;
-	int embedding_count;
-	plume_mesh *body_shell;
+	double *max_reaction;                 ///< per handle: the largest |reaction|, N
+	plume_vec3 *body_positions;           ///< the scene's body posed at a frame's time
+	plume_mesh *body_mesh;                ///< the body at rest, for sim.glb
+	plume_mesh_animation *body_animation; ///< the body's frames, node "body" of sim.glb
+	cli_carried glb_carried;              ///< --glb-feather of many feathers: their embeddings
+	/// --render of a scene that lists "feathers" or has a body (cli/carry.c).
+	bool many;
+	cli_carried carried_scene;
 } run_state;
 
+/// The body's rest mesh as a plume_mesh (for drawing and sim.glb), or NULL when memory runs out.
+static plume_mesh *body_mesh(const plume_body *body)
+{
+	plume_mesh *mesh = plume_mesh_create(plume_body_vertex_count(body), plume_body_triangle_count(body));
+	if (mesh != NULL) {
+		memcpy(mesh->rest, plume_body_rest_positions(body), sizeof(plume_vec3) * (size_t)mesh->vertex_count);
+		memcpy(mesh->faces, plume_body_triangles(body), sizeof(int) * 3 * (size_t)mesh->face_count);
+	}
+	return mesh;
+}
+
+/// Every feather of the scene embedded in its own faces of the joined shell (cli/carry.c, the
+/// path `plume render` takes for the run folder), and the body when with_body.
+static plume_status carry_scene(const plume_scene *scene, bool with_body, cli_carried *carried, plume_error *err)
+{
+	const plume_feather **feathers = calloc((size_t)scene->feather_count, sizeof *feathers);
+	int *faces = calloc(2 * (size_t)scene->feather_count, sizeof *faces);
+	plume_mesh *body = with_body && scene->body != NULL ? body_mesh(scene->body) : NULL;
+	plume_status status = PLUME_OK;
+	if (feathers == NULL || faces == NULL || (with_body && scene->body != NULL && body == NULL))
+		status = plume_error_set(err, PLUME_ERROR_MEMORY, "simulate: out of memory");
+	for (int i = 0; i < scene->feather_count && status == PLUME_OK; ++i) {
+		feathers[i] = scene->feathers[i].feather;
+		faces[2 * i] = scene->feathers[i].face_offset;
+		faces[2 * i + 1] = scene->feathers[i].face_count;
+	}
+	if (status == PLUME_OK)
+		status = cli_carried_begin(carried, scene->mesh, scene->feather_count, feathers, faces, false, body, err);
+	plume_mesh_destroy(body);
+	free(feathers);
+	free(faces);
+	return status;
+}
+
 /// Sets up --render for many feathers and a body: the camera as cli_barb_renderer_begin
-/// frames it, one embedding per feather in the joined rest shell (each feather's barbs lie
-/// on its own piece of it), and the body as a plain shell.
+/// frames it, the feathers and the body drawn by carry_scene.
 static plume_status many_renderer_begin(run_state *run, plume_vec3 lo, plume_vec3 hi, int spp, plume_error *err)
 {
-	const plume_scene *scene = run->scene;
 	run->renderer.embedding = NULL;
 	run->renderer.def = plume_raytrace_default_def();
 	run->renderer.def.camera.width = run->view.width;
 	run->renderer.def.camera.height = run->view.height;
 	run->renderer.def.spp = spp;
 	run->renderer.def.camera = plume_camera_frame_bounds(&run->renderer.def.camera, lo, hi);
-	run->embeddings = calloc((size_t)scene->feather_count, sizeof *run->embeddings);
-	if (run->embeddings == NULL)
-		return plume_error_set(err, PLUME_ERROR_MEMORY, "simulate: out of memory");
-	run->embedding_count = scene->feather_count;
-	for (int i = 0; i < scene->feather_count; ++i) {
-		if (scene->feathers[i].feather == NULL)
-			continue;
-		plume_status status = plume_embedding_create(scene->feathers[i].feather, scene->mesh, &run->embeddings[i], err);
-		if (status != PLUME_OK)
-			return status;
-	}
-	if (scene->body != NULL) {
-		const plume_body *body = scene->body;
-		run->body_shell = plume_mesh_create(plume_body_vertex_count(body), plume_body_triangle_count(body));
-		if (run->body_shell == NULL)
-			return plume_error_set(err, PLUME_ERROR_MEMORY, "simulate: out of memory");
-		memcpy(run->body_shell->rest, plume_body_rest_positions(body),
-		       sizeof(plume_vec3) * (size_t)plume_body_vertex_count(body));
-		memcpy(run->body_shell->faces, plume_body_triangles(body),
-		       sizeof(int) * 3 * (size_t)plume_body_triangle_count(body));
-	}
-	return PLUME_OK;
-}
-
-static void many_renderer_end(run_state *run)
-{
-	for (int i = 0; i < run->embedding_count; ++i)
-		plume_embedding_destroy(run->embeddings[i]);
-	free(run->embeddings);
-	run->embeddings = NULL;
-	plume_mesh_destroy(run->body_shell);
-	run->body_shell = NULL;
+	run->many = true;
+	return carry_scene(run->scene, true, &run->carried_scene, err);
 }
 
 /// Every feather carried by the shell at positions, and the body posed at time, to path (PNG).
 static plume_status many_renderer_frame(run_state *run, const plume_vec3 *positions, double time, const char *path,
                                         plume_error *err)
 {
-	const plume_scene *scene = run->scene;
-	plume_feather **moved = calloc((size_t)scene->feather_count, sizeof *moved);
-	if (moved == NULL)
-		return plume_error_set(err, PLUME_ERROR_MEMORY, "simulate: out of memory");
-	plume_status status = PLUME_OK;
-	int count = 0;
-	for (int i = 0; i < scene->feather_count && status == PLUME_OK; ++i)
-		if (run->embeddings[i] != NULL)
-			status = plume_embedding_apply(run->embeddings[i], positions, &moved[count++], err);
-	if (status == PLUME_OK) {
-		if (scene->body != NULL)
-			plume_scene_body_pose(scene, time, run->body_positions);
-		plume_raytrace_scene picture = {count, (const plume_feather *const *)moved, run->body_shell,
-		                                scene->body != NULL ? run->body_positions : NULL};
+	if (run->scene->body != NULL)
+		plume_scene_body_pose(run->scene, time, run->body_positions);
+	plume_raytrace_scene picture;
+	plume_status status = cli_carried_pose(&run->carried_scene, positions,
+	                                       run->scene->body != NULL ? run->body_positions : NULL, &picture, err);
+	if (status == PLUME_OK)
 		status = plume_raytrace_render_png(&picture, &run->renderer.def, path, NULL, err);
-	}
-	for (int i = 0; i < count; ++i)
-		plume_feather_destroy(moved[i]);
-	free(moved);
 	return status;
 }
 
@@ -243,6 +237,8 @@ static plume_status write_frame(run_state *run, int frame, double time, const pl
 	}
 	if (status == PLUME_OK)
 		status = plume_mesh_animation_add_frame(run->animation, time, plume_sim_positions(sim), err);
+	if (status == PLUME_OK && run->body_animation != NULL) // body_positions posed above
+		status = plume_mesh_animation_add_frame(run->body_animation, time, run->body_positions, err);
 	if (status == PLUME_OK && run->fields) {
 		if (frame >= run->field_capacity) {
 			int capacity = run->field_capacity > 0 ? 2 * run->field_capacity : 64;
@@ -263,8 +259,8 @@ static plume_status write_frame(run_state *run, int frame, double time, const pl
 	if (status == PLUME_OK && run->render) {
 		snprintf(name, sizeof name, "frames/%04d-rt.png", frame);
 		cli_output_path(run->output, name, path, sizeof path);
-		status = run->embeddings != NULL ? many_renderer_frame(run, plume_sim_positions(sim), time, path, err)
-		                                 : cli_barb_renderer_frame(&run->renderer, plume_sim_positions(sim), path, err);
+		status = run->many ? many_renderer_frame(run, plume_sim_positions(sim), time, path, err)
+		                   : cli_barb_renderer_frame(&run->renderer, plume_sim_positions(sim), path, err);
 	}
 	run->frames = frame + 1;
 	return status;
@@ -467,21 +463,73 @@ static void make_movie(cli_output *output)
 	}
 }
 
-/// A scene that lists "feathers": DIR/feathers/NAME.json (and .bin), each feather placed at rest.
+/// A scene that lists "feathers": each distinct feather once, in its own frame, as
+/// DIR/feathers/NAME.json (and NAME.bin; NAME: the first feather of that geometry), and
+/// DIR/feathers.json mapping every feather to its dump and its placement
+/// (docs/scene.md "Outputs"). Copies of one spec differ only by their placement: in their
+/// own frame they agree to rounding (1e-9 m is far above it and far below any real difference).
 static plume_status write_feathers(const plume_scene *scene, cli_output *output, plume_error *err)
 {
 	char path[4352], name[64];
 	snprintf(path, sizeof path, "%s/feathers", output->stage);
 	if (mkdir(path, 0777) != 0)
 		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot create: %s", path, "mkdir failed");
-	plume_status status = PLUME_OK;
-	for (int i = 0; i < scene->feather_count && status == PLUME_OK; ++i) {
-		if (scene->feathers[i].feather == NULL)
+	const int n = scene->feather_count;
+	plume_feather **own = calloc((size_t)n, sizeof *own); // per feather in its own frame; NULL: guides or a copy
+	int *dump = calloc((size_t)n, sizeof *dump);          // per feather: the feather whose dump it uses
+	json_t *index = json_object(), *list = json_array();
+	json_object_set_new(index, "version", json_integer(1));
+	json_object_set(index, "feathers", list);
+	plume_status status = own != NULL && dump != NULL && index != NULL && list != NULL
+	                          ? PLUME_OK
+	                          : plume_error_set(err, PLUME_ERROR_MEMORY, "simulate: out of memory");
+	for (int i = 0; i < n && status == PLUME_OK; ++i) {
+		const plume_scene_feather *f = scene->feathers + i;
+		json_t *entry =
+		    json_pack("{s:s, s:i, s:i, s:i, s:i}", "name", f->name, "vertex_offset", f->vertex_offset, "vertex_count",
+		              f->vertex_count, "face_offset", f->face_offset, "face_count", f->face_count);
+		json_array_append_new(list, entry);
+		if (f->feather == NULL)
 			continue;
-		snprintf(name, sizeof name, "feathers/%s.json", scene->feathers[i].name);
-		status =
-		    plume_write_json_binary(scene->feathers[i].feather, cli_output_path(output, name, path, sizeof path), err);
+		// Back to its own frame: own = R^T (world - t).
+		own[i] = plume_feather_clone(f->feather);
+		if (own[i] == NULL) {
+			status = plume_error_set(err, PLUME_ERROR_MEMORY, "simulate: out of memory");
+			break;
+		}
+		plume_mat3 back = plume_m3_transpose(f->rotation);
+		plume_feather_move(own[i], back, plume_v3_scale(plume_m3_apply(back, f->translation), -1.0));
+		dump[i] = i;
+		for (int k = 0; k < i; ++k)
+			if (own[k] != NULL && plume_feather_distance(own[k], own[i]) <= 1e-9) {
+				dump[i] = k;
+				break;
+			}
+		json_t *rotation = json_array(),
+		       *translation = json_pack("[f, f, f]", f->translation.x, f->translation.y, f->translation.z);
+		for (int r = 0; r < 9; ++r)
+			json_array_append_new(rotation, json_real(f->rotation.m[r / 3][r % 3]));
+		snprintf(name, sizeof name, "%s.json", scene->feathers[dump[i]].name);
+		json_object_set_new(entry, "dump", json_string(name));
+		json_object_set_new(entry, "rotation", rotation);
+		json_object_set_new(entry, "translation", translation);
+		if (dump[i] != i) {
+			plume_feather_destroy(own[i]);
+			own[i] = NULL;
+			continue;
+		}
+		snprintf(name, sizeof name, "feathers/%s.json", f->name);
+		status = plume_write_json_binary(own[i], cli_output_path(output, name, path, sizeof path), err);
 	}
+	if (status == PLUME_OK && json_dump_file(index, cli_output_path(output, "feathers.json", path, sizeof path),
+	                                         JSON_INDENT(1) | JSON_REAL_PRECISION(17)) != 0)
+		status = plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write", path);
+	for (int i = 0; i < n && own != NULL; ++i)
+		plume_feather_destroy(own[i]);
+	free(own);
+	free(dump);
+	json_decref(list);
+	json_decref(index);
 	return status;
 }
 
@@ -511,10 +559,23 @@ static plume_status simulate(const plume_scene *scene, cli_output *output, run_s
 	status = plume_mesh_animation_create(scene->mesh, NULL, &run->animation, err);
 	if (status == PLUME_OK)
 		status = plume_mesh_obj_writer_create(scene->mesh, &run->obj, err);
-	if (status == PLUME_OK && run->glb_feather) {
+	if (status == PLUME_OK && run->glb_feather && scene->feather != NULL) {
 		status = plume_embedding_create(scene->feather, scene->mesh, &run->carried, err);
 		if (status == PLUME_OK)
 			plume_mesh_animation_set_feather(run->animation, run->carried);
+	} else if (status == PLUME_OK && run->glb_feather) { // many feathers: node feather_NAME each
+		status = carry_scene(scene, false, &run->glb_carried, err);
+		for (int i = 0; i < scene->feather_count && status == PLUME_OK; ++i)
+			if (run->glb_carried.embeddings[i] != NULL)
+				status = plume_mesh_animation_add_feather(run->animation, run->glb_carried.embeddings[i],
+				                                          scene->feathers[i].name, err);
+	}
+	if (status == PLUME_OK && scene->body != NULL) { // the body moves in sim.glb too
+		run->body_mesh = body_mesh(scene->body);
+		status = run->body_mesh != NULL ? plume_mesh_animation_create(run->body_mesh, NULL, &run->body_animation, err)
+		                                : plume_error_set(err, PLUME_ERROR_MEMORY, "simulate: out of memory");
+		if (status == PLUME_OK)
+			plume_mesh_animation_set_body(run->animation, run->body_animation);
 	}
 	if (status != PLUME_OK)
 		return status;
@@ -704,17 +765,15 @@ int cli_simulate(int argc, char **argv)
 		run.view.bounds_min = lo;
 		run.view.bounds_max = hi;
 	}
-	if (run.glb_feather && scene->feather == NULL) {
+	bool generated = false;
+	for (int i = 0; i < scene->feather_count; ++i)
+		generated = generated || scene->feathers[i].feather != NULL;
+	if (run.glb_feather && !generated) {
 		plume_scene_destroy(scene);
-		return cli_usage_error(
-		    "simulate",
-		    "--glb-feather needs a scene with one generated feather (\"feather\", not guides or \"feathers\")");
+		return cli_usage_error("simulate", "--glb-feather needs a scene whose feathers are generated (not guides)");
 	}
 	if (run.render) {
 		bool many = scene->feather_count > 1 || scene->feather == NULL || scene->body != NULL;
-		bool generated = false;
-		for (int i = 0; i < scene->feather_count; ++i)
-			generated = generated || scene->feathers[i].feather != NULL;
 		if (!generated) {
 			plume_scene_destroy(scene);
 			return cli_usage_error("simulate", "--render needs a scene whose feathers are generated (not guides)");
@@ -730,7 +789,7 @@ int cli_simulate(int argc, char **argv)
 		              : cli_barb_renderer_begin(&run.renderer, scene->feather, scene->mesh, lo, hi, run.view.width,
 		                                        run.view.height, spp, &err);
 		if (status != PLUME_OK) {
-			many_renderer_end(&run);
+			cli_carried_end(&run.carried_scene);
 			plume_scene_destroy(scene);
 			cli_barb_renderer_end(&run.renderer);
 			return cli_fail(&err);
@@ -760,8 +819,11 @@ int cli_simulate(int argc, char **argv)
 	free(run.field_times);
 	free(run.max_reaction);
 	free(run.body_positions);
+	plume_mesh_animation_destroy(run.body_animation);
+	plume_mesh_destroy(run.body_mesh);
+	cli_carried_end(&run.glb_carried);
 	cli_barb_renderer_end(&run.renderer);
-	many_renderer_end(&run);
+	cli_carried_end(&run.carried_scene);
 	if (status != PLUME_OK)
 		return cli_fail(status == PLUME_ERROR_NUMERIC && failure.message[0] ? &failure : &err);
 	return CLI_EXIT_OK;

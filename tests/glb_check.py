@@ -2,7 +2,8 @@
 """Reads plume's .glb files back without plume's code (struct + json only).
 
   glb_check.py frames SIM.glb FRAMES_DIR   each frame (base + morph target k) equals
-                                           FRAMES_DIR/kkkk.obj's vertices to 1e-6 m
+                                           FRAMES_DIR/kkkk.obj's vertices to 1e-6 m (and the
+                                           node "body" FRAMES_DIR/body-kkkk.obj's, when there are)
   glb_check.py texture FILE.glb IMAGE.png  the embedded image has IMAGE's pixels (decoded by
                                            matplotlib), both curve materials read it through
                                            TEXCOORD_1, and TEXCOORD_1 is Franco & Walter's
@@ -10,7 +11,7 @@
                                            on the left/right vane, v = 1 - t
   glb_check.py counts FILE.glb             prints JSON: nodes, meshes, primitives,
                                            vertices (per-primitive, summed), triangles,
-                                           lines, morph targets, animation keys
+                                           lines, morph targets, animation keys, node names
 """
 import json
 import os
@@ -55,32 +56,61 @@ def obj_vertices(path):
         return [tuple(map(float, line.split()[1:4])) for line in f if line.startswith("v ")]
 
 
-def frames(glb_path, frames_dir):
-    doc, binary = load(glb_path)
-    mesh = doc["meshes"][0]
+def node_mesh(doc, name):
+    for node in doc.get("nodes", []):
+        if node.get("name") == name and "mesh" in node:
+            return doc["meshes"][node["mesh"]]
+    return None
+
+
+def check_frames(doc, binary, glb_path, mesh, files, frames_dir):
+    """Each file k equals the mesh's base + morph target k; returns the largest difference."""
     primitive = mesh["primitives"][0]
     base = accessor(doc, binary, primitive["attributes"]["POSITION"])
     targets = primitive.get("targets", [])
-    files = sorted(f for f in os.listdir(frames_dir) if f.endswith(".obj"))
     if len(targets) != len(files):
-        sys.exit(f"{glb_path}: {len(targets)} morph targets, {frames_dir} has {len(files)} frames")
+        sys.exit(f"{glb_path}: {mesh['name']}: {len(targets)} morph targets, {frames_dir} has {len(files)} frames")
+    worst = 0.0
+    for i, name in enumerate(files):
+        d = accessor(doc, binary, targets[i]["POSITION"])
+        want = obj_vertices(os.path.join(frames_dir, name))
+        if len(want) != len(base):
+            sys.exit(f"{name}: {len(want)} vertices, the .glb's {mesh['name']} has {len(base)}")
+        for b, dv, w in zip(base, d, want):
+            worst = max(worst, max(abs(b[c] + dv[c] - w[c]) for c in range(3)))
+    return worst, len(base)
+
+
+def frames(glb_path, frames_dir):
+    """The shell (mesh 0) against FRAMES_DIR/NNNN.obj, and the node "body", when there is one,
+    against FRAMES_DIR/body-NNNN.obj; every animated node is keyed by the one sampler."""
+    doc, binary = load(glb_path)
+    listing = sorted(os.listdir(frames_dir))
+    files = [f for f in listing if f.endswith(".obj") and f[:-4].isdigit()]
     sampler = doc["animations"][0]["samplers"][0]
     times = accessor(doc, binary, sampler["input"])
     weights = accessor(doc, binary, sampler["output"])
     k = len(files)
     if len(times) != k or len(weights) != k * k:
         sys.exit(f"{glb_path}: {len(times)} keys and {len(weights)} weights for {k} frames")
-    worst = 0.0
-    for i, name in enumerate(files):
+    for i in range(k):
         if any(weights[i * k + j] != (1.0 if i == j else 0.0) for j in range(k)):
             sys.exit(f"{glb_path}: key {i} does not select target {i} alone")
-        d = accessor(doc, binary, targets[i]["POSITION"])
-        want = obj_vertices(os.path.join(frames_dir, name))
-        if len(want) != len(base):
-            sys.exit(f"{name}: {len(want)} vertices, the .glb has {len(base)}")
-        for b, dv, w in zip(base, d, want):
-            worst = max(worst, max(abs(b[c] + dv[c] - w[c]) for c in range(3)))
-    print(f"{k} frames, {len(base)} vertices, largest difference {worst:.3g} m")
+    for channel in doc["animations"][0]["channels"]:
+        node = doc["nodes"][channel["target"]["node"]]
+        count = len(doc["meshes"][node["mesh"]]["primitives"][0].get("targets", []))
+        if channel["sampler"] != 0 or count != k:
+            sys.exit(f"{glb_path}: node {node['name']} has {count} morph targets for {k} keys")
+    worst, vertices = check_frames(doc, binary, glb_path, doc["meshes"][0], files, frames_dir)
+    body = node_mesh(doc, "body")
+    bodies = [f for f in listing if f.startswith("body-") and f.endswith(".obj")]
+    if body is not None or bodies:
+        if body is None:
+            sys.exit(f"{glb_path}: {frames_dir} has body frames, the .glb no node \"body\"")
+        worst_body, body_vertices = check_frames(doc, binary, glb_path, body, bodies, frames_dir)
+        worst = max(worst, worst_body)
+        print(f"body: {len(bodies)} frames, {body_vertices} vertices")
+    print(f"{k} frames, {vertices} vertices, largest difference {worst:.3g} m")
     if worst > 1e-6:
         sys.exit(f"{glb_path}: frames differ from the OBJ frames by {worst:.3g} m > 1e-6 m")
 
@@ -89,7 +119,8 @@ def counts(glb_path):
     doc, binary = load(glb_path)
     result = {"nodes": len(doc.get("nodes", [])), "meshes": len(doc.get("meshes", [])), "primitives": 0,
               "vertices": 0, "triangles": 0, "lines": 0, "morph_targets": 0, "animation_keys": 0,
-              "mesh_instances": sum(1 for n in doc.get("nodes", []) if "mesh" in n)}
+              "mesh_instances": sum(1 for n in doc.get("nodes", []) if "mesh" in n),
+              "node_names": [n.get("name", "") for n in doc.get("nodes", [])]}
     for mesh in doc.get("meshes", []):
         for p in mesh["primitives"]:
             result["primitives"] += 1

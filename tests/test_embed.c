@@ -242,6 +242,65 @@ static void test_render_with_shell(void **state)
 	plume_feather_destroy(feather);
 }
 
+/// Two copies of one shell in the same place, joined (as a scene joins its feathers): a feather
+/// embedded in the second copy's faces follows that copy alone. Embedded in all the faces, it
+/// hangs on the first copy (ties go to the lower face), so the face range is what makes it follow.
+static void test_face_range(void **state)
+{
+	(void)state;
+	int64_t bytes_before = plume_bytes_in_use();
+	plume_feather *feather = small_feather();
+	plume_mesh *mesh = mesh_of(feather), *joined = NULL;
+	plume_error err = {0};
+	plume_mesh_part parts[2] = {{mesh, plume_m3_identity(), {0, 0, 0}, "a"},
+	                            {mesh, plume_m3_identity(), {0, 0, 0}, "b"}};
+	assert_int_equal(plume_mesh_concatenate(parts, 2, &joined, &err), PLUME_OK);
+	plume_barb_embedding *own = NULL, *all = NULL;
+	assert_int_equal(plume_embedding_create_faces(feather, joined, mesh->face_count, mesh->face_count, &own, &err),
+	                 PLUME_OK);
+	assert_int_equal(plume_embedding_create(feather, joined, &all, &err), PLUME_OK);
+	// The first copy stays, the second turns and moves.
+	plume_mat3 rotation = plume_m3_rotation(plume_v3_normalize(plume_v3(1, 2, -0.5)), 0.7);
+	plume_vec3 shift = {0.1, 0.2, -0.3};
+	plume_vec3 *positions = malloc((size_t)joined->vertex_count * sizeof *positions);
+	for (int i = 0; i < joined->vertex_count; ++i)
+		positions[i] =
+		    i < mesh->vertex_count ? joined->rest[i] : plume_v3_add(plume_m3_apply(rotation, joined->rest[i]), shift);
+	plume_feather *moved = NULL, *stayed = NULL;
+	assert_int_equal(plume_embedding_apply(own, positions, &moved, &err), PLUME_OK);
+	assert_int_equal(plume_embedding_apply(all, positions, &stayed, &err), PLUME_OK);
+	// Expected: the rest feather moved by the rigid motion, point by point (compare) and by plume_feather_move.
+	plume_feather *expected = plume_feather_clone(feather);
+	plume_feather_move(expected, rotation, shift);
+	double point_error, normal_error;
+	compare(expected, moved, &point_error, &normal_error);
+	print_message("face range: points %.3g m, directions %.3g\n", point_error, normal_error);
+	assert_true(point_error <= 1e-9 && normal_error <= 1e-9);
+	assert_true(plume_feather_distance(expected, moved) <= 1e-9);
+	compare(feather, stayed, &point_error, &normal_error);
+	assert_true(point_error <= 1e-9);
+	// plume_feather_distance: a translated copy is |shift| away; another feather has another structure.
+	plume_feather *shifted = plume_feather_clone(feather);
+	plume_feather_move(shifted, plume_m3_identity(), plume_v3(0, 0.003, 0.004));
+	assert_close(plume_feather_distance(feather, shifted), 0.005, 1e-15);
+	plume_fw_def def = plume_fw_default_def();
+	plume_feather *other = NULL;
+	assert_int_equal(plume_fw_generate(&def, 4, &other, &err), PLUME_OK);
+	assert_true(isinf(plume_feather_distance(feather, other)));
+	plume_feather_destroy(other);
+	plume_feather_destroy(shifted);
+	plume_feather_destroy(expected);
+	plume_feather_destroy(moved);
+	plume_feather_destroy(stayed);
+	free(positions);
+	plume_embedding_destroy(own);
+	plume_embedding_destroy(all);
+	plume_mesh_destroy(joined);
+	plume_mesh_destroy(mesh);
+	plume_feather_destroy(feather);
+	assert_int_equal(plume_bytes_in_use(), bytes_before);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -250,6 +309,7 @@ int main(void)
 	    cmocka_unit_test(test_bent_shell_carries_barbs),
 	    cmocka_unit_test(test_bad_shells),
 	    cmocka_unit_test(test_render_with_shell),
+	    cmocka_unit_test(test_face_range),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

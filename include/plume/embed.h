@@ -31,6 +31,14 @@ typedef struct plume_barb_embedding plume_barb_embedding;
 plume_status plume_embedding_create(const plume_feather *feather, const plume_mesh *mesh, plume_barb_embedding **out,
                                     plume_error *err);
 
+/// plume_embedding_create restricted to the faces [first_face, first_face + face_count) of mesh: the
+/// feathers of a scene share one joined shell (plume_scene's mesh, each feather's vertex and face
+/// range), and each is embedded in its own piece, so where feathers overlap a barb never hangs on
+/// another feather's triangle. plume_embedding_create is this with all of the mesh's faces.
+/// plume_embedding_apply still takes positions of all of the mesh's vertices.
+plume_status plume_embedding_create_faces(const plume_feather *feather, const plume_mesh *mesh, int first_face,
+                                          int face_count, plume_barb_embedding **out, plume_error *err);
+
 /// The feather carried by the shell at `positions` (mesh vertex order): a new plume_feather, the
 /// caller's to destroy. Widths and texture coordinates are kept; arc lengths are measured anew.
 /// PLUME_ERROR_NUMERIC when a position is not finite, PLUME_ERROR_MEMORY.

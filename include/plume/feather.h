@@ -114,6 +114,17 @@ double plume_feather_afterfeather_t(const plume_feather *feather);
 /// Deep equality of two feathers (every array bit for bit). For tests and round trips.
 bool plume_feather_equal(const plume_feather *a, const plume_feather *b);
 
+/// Moves the feather (and its afterfeather) rigidly: every point p goes to rotation p + translation,
+/// directions (shaft frames, normals) turn with rotation. rotation must be a rotation matrix.
+void plume_feather_move(plume_feather *feather, plume_mat3 rotation, plume_vec3 translation);
+
+/// The largest distance, m, between corresponding points (shaft samples and barb and barbule
+/// points, afterfeathers included) of two feathers of the same structure (the same counts,
+/// curves, widths and texture coordinates, bit for bit); INFINITY when the structure differs.
+/// Tells apart copies of one feather that went through rigid motions (rounding only) from
+/// different feathers.
+double plume_feather_distance(const plume_feather *a, const plume_feather *b);
+
 /// A deep copy, or NULL when memory runs out.
 plume_feather *plume_feather_clone(const plume_feather *feather);
 

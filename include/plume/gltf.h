@@ -109,6 +109,20 @@ struct plume_barb_embedding;
 /// per feather point and frame. The embedding must outlive the animation.
 void plume_mesh_animation_set_feather(plume_mesh_animation *animation, const struct plume_barb_embedding *embedding);
 
+/// Carries one more feather by the shell (a scene's many feathers, each embedded in its own
+/// faces: plume_embedding_create_faces): node "feather_NAME" (NAME at most 23 bytes), written
+/// like plume_mesh_animation_set_feather's "feather". The embedding must outlive the animation.
+/// PLUME_ERROR_MEMORY.
+plume_status plume_mesh_animation_add_feather(plume_mesh_animation *animation,
+                                              const struct plume_barb_embedding *embedding, const char *name,
+                                              plume_error *err);
+
+/// Writes body's frames into this animation's .glb too: node "body", its mesh with one morph
+/// target per frame, played by the same animation (an animated body a scene's feathers hang
+/// on). body must hold as many frames as this animation, at the same times, when the .glb is
+/// written (else PLUME_ERROR_SPEC), and outlive it. NULL removes it.
+void plume_mesh_animation_set_body(plume_mesh_animation *animation, const plume_mesh_animation *body);
+
 /// Writes the frames so far (at least one) as .glb.
 plume_status plume_mesh_animation_write_glb(const plume_mesh_animation *animation, const char *path, plume_error *err);
 

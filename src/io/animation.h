@@ -11,7 +11,11 @@ struct plume_mesh_animation {
 	double *times;
 	double *first;        ///< the first frame in double, the base the displacements are taken from
 	float *displacements; ///< frame_count * vertex_count * 3: frame minus first frame
-	const struct plume_barb_embedding *embedding; ///< the carried feather (plume_mesh_animation_set_feather), or NULL
+	/// The carried feathers (plume_mesh_animation_set_feather, plume_mesh_animation_add_feather) and their node names.
+	const struct plume_barb_embedding **embeddings;
+	char (*names)[32];
+	int feather_count;
+	const struct plume_mesh_animation *body; ///< plume_mesh_animation_set_body, or NULL
 };
 
 #endif

@@ -87,11 +87,11 @@ int plume_glb_shell_node(plume_glb *glb, const struct plume_mesh *mesh, const pl
 
 struct plume_barb_embedding;
 
-/// A node "feather": the embedded feather carried by frames[0..frame_count) as one
+/// A node `name` (and its mesh): the embedded feather carried by frames[0..frame_count) as one
 /// LINES primitive whose morph target k moves it from frames[0] to frames[k].
 /// Sets *ok false on failure. Returns the node.
 int plume_glb_carried_feather(plume_glb *glb, const struct plume_barb_embedding *embedding,
-                              const plume_vec3 *const *frames, int frame_count, const struct plume_gltf_def *def,
-                              bool *ok);
+                              const plume_vec3 *const *frames, int frame_count, const char *name,
+                              const struct plume_gltf_def *def, bool *ok);
 
 #endif

@@ -593,7 +593,7 @@ static bool carried_lines(const plume_barb_embedding *embedding, const plume_vec
 }
 
 int plume_glb_carried_feather(plume_glb *glb, const plume_barb_embedding *embedding, const plume_vec3 *const *frames,
-                              int frame_count, const plume_gltf_def *def, bool *ok)
+                              int frame_count, const char *name, const plume_gltf_def *def, bool *ok)
 {
 	part base;
 	if (!carried_lines(embedding, frames[0], def, &base)) {
@@ -629,10 +629,10 @@ int plume_glb_carried_feather(plume_glb *glb, const plume_barb_embedding *embedd
 		    json_pack("{s:{s:i, s:i, s:i}, s:i, s:i, s:i, s:o}", "attributes", "POSITION", position, "TEXCOORD_0", uv,
 		              "COLOR_0", color, "indices", indices, "mode", 1, "material", material, "targets", targets);
 		targets = NULL;
-		int mesh = plume_glb_append(
-		    glb, glb->meshes,
-		    json_pack("{s:s, s:[o], s:o}", "name", "feather", "primitives", primitive, "weights", weights));
-		node = plume_glb_append(glb, glb->nodes, json_pack("{s:s, s:i}", "name", "feather", "mesh", mesh));
+		int mesh =
+		    plume_glb_append(glb, glb->meshes,
+		                     json_pack("{s:s, s:[o], s:o}", "name", name, "primitives", primitive, "weights", weights));
+		node = plume_glb_append(glb, glb->nodes, json_pack("{s:s, s:i}", "name", name, "mesh", mesh));
 	}
 	json_decref(targets);
 	plume_free(displacement);

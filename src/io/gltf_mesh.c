@@ -13,6 +13,7 @@
 // clients compute normals from the moving triangles (glTF requires flat normals
 // then; Blender recomputes smooth ones).
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "../core/asserts.h"
@@ -215,78 +216,142 @@ int plume_mesh_animation_frame_count(const plume_mesh_animation *a) { return a->
 
 void plume_mesh_animation_set_feather(plume_mesh_animation *a, const struct plume_barb_embedding *embedding)
 {
-	a->embedding = embedding;
+	a->feather_count = 0;
+	if (embedding == NULL)
+		return;
+	plume_error err;
+	if (plume_mesh_animation_add_feather(a, embedding, "", &err) != PLUME_OK)
+		a->feather_count = 0; // out of memory: no feather, as before the call (the shell is still written)
 }
 
-/// The feather carried by every frame (plume_glb_carried_feather), frames rebuilt from the stored floats.
-static int carried_feather(plume_glb *glb, const plume_mesh_animation *a, bool *ok)
+plume_status plume_mesh_animation_add_feather(plume_mesh_animation *a, const struct plume_barb_embedding *embedding,
+                                              const char *name, plume_error *err)
+{
+	PLUME_ASSERT(a != NULL && embedding != NULL && name != NULL);
+	const struct plume_barb_embedding **embeddings =
+	    plume_realloc(a->embeddings, (size_t)(a->feather_count + 1) * sizeof *embeddings);
+	if (embeddings != NULL)
+		a->embeddings = embeddings;
+	char(*names)[32] = plume_realloc(a->names, (size_t)(a->feather_count + 1) * sizeof *names);
+	if (names != NULL)
+		a->names = names;
+	if (embeddings == NULL || names == NULL)
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "animation: out of memory");
+	a->embeddings[a->feather_count] = embedding;
+	// "feather" for the one feather of plume_mesh_animation_set_feather, "feather_NAME" otherwise.
+	snprintf(a->names[a->feather_count], sizeof a->names[0], "feather%s%.23s", name[0] != '\0' ? "_" : "", name);
+	a->feather_count++;
+	return PLUME_OK;
+}
+
+void plume_mesh_animation_set_body(plume_mesh_animation *a, const plume_mesh_animation *body) { a->body = body; }
+
+/// The animation's frames in double (base + displacement), frame k at list[k]; NULL when memory runs out.
+static plume_vec3 *frame_positions(const plume_mesh_animation *a, const plume_vec3 ***list)
 {
 	int n = a->mesh->vertex_count, frames = a->frame_count;
 	plume_vec3 *positions = plume_alloc((size_t)frames * (size_t)(n > 0 ? n : 1) * sizeof(plume_vec3));
-	const plume_vec3 **list = plume_alloc((size_t)frames * sizeof *list);
-	int node = 0;
-	*ok = positions != NULL && list != NULL;
-	if (*ok) {
-		for (int k = 0; k < frames; ++k) {
-			plume_vec3 *x = positions + (size_t)k * (size_t)n;
-			const float *d = a->displacements + (size_t)k * 3 * (size_t)n;
-			for (int i = 0; i < n; ++i)
-				x[i] = plume_v3(a->first[3 * i] + d[3 * i], a->first[3 * i + 1] + d[3 * i + 1],
-				                a->first[3 * i + 2] + d[3 * i + 2]);
-			list[k] = x;
-		}
-		node = plume_glb_carried_feather(glb, a->embedding, list, frames, &a->def, ok);
+	*list = plume_alloc((size_t)frames * sizeof **list);
+	if (positions == NULL || *list == NULL) {
+		plume_free(positions);
+		plume_free(*list);
+		*list = NULL;
+		return NULL;
 	}
-	plume_free(positions);
-	plume_free(list);
-	return node;
+	for (int k = 0; k < frames; ++k) {
+		plume_vec3 *x = positions + (size_t)k * (size_t)n;
+		const float *d = a->displacements + (size_t)k * 3 * (size_t)n;
+		for (int i = 0; i < n; ++i)
+			x[i] = plume_v3(a->first[3 * i] + d[3 * i], a->first[3 * i + 1] + d[3 * i + 1],
+			                a->first[3 * i + 2] + d[3 * i + 2]);
+		(*list)[k] = x;
+	}
+	return positions;
+}
+
+/// The animation's mesh as node `name`: base positions the first frame, one morph target per frame.
+static int morph_node(plume_glb *glb, const plume_mesh_animation *a, const char *name, bool *ok)
+{
+	const plume_mesh *mesh = a->mesh;
+	int n = mesh->vertex_count, frames = a->frame_count;
+	double *uv = plume_alloc(2 * (size_t)(n > 0 ? n : 1) * sizeof(double));
+	if (uv == NULL) {
+		*ok = false;
+		return 0;
+	}
+	for (int i = 0; i < n; ++i) {
+		uv[2 * i] = mesh->uv != NULL ? mesh->uv[i].x : 0.0;
+		uv[2 * i + 1] = mesh->uv != NULL ? mesh->uv[i].y : 0.0;
+	}
+	json_t *attributes =
+	    json_pack("{s:i, s:i}", "POSITION", plume_glb_floats(glb, a->first, n, 3, GLB_ARRAY_BUFFER, true), "TEXCOORD_0",
+	              plume_glb_floats(glb, uv, n, 2, GLB_ARRAY_BUFFER, false));
+	plume_free(uv);
+	json_t *targets = json_array(), *names = json_array(), *initial = json_array();
+	for (int k = 0; k < frames; ++k) {
+		// Morph target POSITION accessors must have min and max (spec 3.7.2.2).
+		int accessor =
+		    plume_glb_floats_f(glb, a->displacements + (size_t)k * 3 * (size_t)n, n, 3, GLB_ARRAY_BUFFER, true);
+		json_array_append_new(targets, json_pack("{s:i}", "POSITION", accessor));
+		char target[32];
+		snprintf(target, sizeof target, "frame_%04d", k);
+		json_array_append_new(names, json_string(target));
+		json_array_append_new(initial, json_real(k == 0 ? 1.0 : 0.0));
+	}
+	json_t *primitives = shell_primitives(glb, mesh, attributes, &a->def, targets, ok);
+	json_decref(attributes);
+	json_decref(targets);
+	// targetNames in extras: Blender names the shape keys after them, three.js the morph targets.
+	int mesh_index = plume_glb_append(glb, glb->meshes,
+	                                  json_pack("{s:s, s:o, s:o, s:{s:o}}", "name", name, "primitives", primitives,
+	                                            "weights", initial, "extras", "targetNames", names));
+	return plume_glb_append(glb, glb->nodes, json_pack("{s:s, s:i}", "name", name, "mesh", mesh_index));
 }
 
 plume_status plume_mesh_animation_write_glb(const plume_mesh_animation *a, const char *path, plume_error *err)
 {
 	if (a->frame_count == 0)
 		return plume_error_set(err, PLUME_ERROR_SPEC, "%s: an animation needs at least one frame", path);
-	const plume_mesh *mesh = a->mesh;
-	int n = mesh->vertex_count, frames = a->frame_count;
+	const int frames = a->frame_count;
+	if (a->body != NULL) {
+		bool same = a->body->frame_count == frames;
+		for (int k = 0; same && k < frames; ++k)
+			same = a->body->times[k] == a->times[k];
+		if (!same)
+			return plume_error_set(err, PLUME_ERROR_SPEC,
+			                       "%s: the body has %d frames, the shell %d (or at other times); they must match",
+			                       path, a->body->frame_count, frames);
+	}
 	plume_glb glb;
 	plume_glb_init(&glb, "plume " PLUME_VERSION_STRING);
-	double *uv = plume_alloc(2 * (size_t)(n > 0 ? n : 1) * sizeof(double));
 	float *weights = plume_calloc((size_t)frames * (size_t)frames, sizeof(float));
-	bool ok = uv != NULL && weights != NULL;
+	bool ok = weights != NULL;
+	// Every node whose weights the animation keys: the shell, each carried feather (as many
+	// targets, one per frame), the body.
+	int *animated = plume_alloc((size_t)(a->feather_count + 2) * sizeof *animated);
+	int animated_count = 0;
+	ok = ok && animated != NULL;
 	if (ok) {
-		for (int i = 0; i < n; ++i) {
-			uv[2 * i] = mesh->uv != NULL ? mesh->uv[i].x : 0.0;
-			uv[2 * i + 1] = mesh->uv != NULL ? mesh->uv[i].y : 0.0;
+		animated[animated_count] = morph_node(&glb, a, "shell", &ok);
+		plume_glb_scene_root(&glb, animated[animated_count++]);
+		if (ok && a->feather_count > 0) {
+			const plume_vec3 **list = NULL;
+			plume_vec3 *positions = frame_positions(a, &list);
+			ok = positions != NULL;
+			for (int f = 0; ok && f < a->feather_count; ++f) {
+				int node = plume_glb_carried_feather(&glb, a->embeddings[f], list, frames, a->names[f], &a->def, &ok);
+				if (ok) {
+					plume_glb_scene_root(&glb, node);
+					animated[animated_count++] = node;
+				}
+			}
+			plume_free(positions);
+			plume_free(list);
 		}
-		json_t *attributes =
-		    json_pack("{s:i, s:i}", "POSITION", plume_glb_floats(&glb, a->first, n, 3, GLB_ARRAY_BUFFER, true),
-		              "TEXCOORD_0", plume_glb_floats(&glb, uv, n, 2, GLB_ARRAY_BUFFER, false));
-		json_t *targets = json_array(), *names = json_array(), *initial = json_array();
-		for (int k = 0; k < frames; ++k) {
-			// Morph target POSITION accessors must have min and max (spec 3.7.2.2).
-			int accessor =
-			    plume_glb_floats_f(&glb, a->displacements + (size_t)k * 3 * (size_t)n, n, 3, GLB_ARRAY_BUFFER, true);
-			json_array_append_new(targets, json_pack("{s:i}", "POSITION", accessor));
-			char name[32];
-			snprintf(name, sizeof name, "frame_%04d", k);
-			json_array_append_new(names, json_string(name));
-			json_array_append_new(initial, json_real(k == 0 ? 1.0 : 0.0));
+		if (ok && a->body != NULL) {
+			animated[animated_count] = morph_node(&glb, a->body, "body", &ok);
+			plume_glb_scene_root(&glb, animated[animated_count++]);
 		}
-		json_t *primitives = shell_primitives(&glb, mesh, attributes, &a->def, targets, &ok);
-		json_decref(attributes);
-		json_decref(targets);
-		// targetNames in extras: Blender names the shape keys after them, three.js the morph targets.
-		int mesh_index = plume_glb_append(&glb, glb.meshes,
-		                                  json_pack("{s:s, s:o, s:o, s:{s:o}}", "name", "shell", "primitives",
-		                                            primitives, "weights", initial, "extras", "targetNames", names));
-		int node = plume_glb_append(&glb, glb.nodes, json_pack("{s:s, s:i}", "name", "shell", "mesh", mesh_index));
-		plume_glb_scene_root(&glb, node);
-		int feather = -1;
-		if (ok && a->embedding != NULL) {
-			feather = carried_feather(&glb, a, &ok);
-			plume_glb_scene_root(&glb, feather);
-		}
-
 		float *times = plume_alloc((size_t)frames * sizeof(float));
 		ok = ok && times != NULL;
 		if (ok) {
@@ -297,14 +362,12 @@ plume_status plume_mesh_animation_write_glb(const plume_mesh_animation *a, const
 			// Sampler input must have min and max (spec 3.11).
 			int input = plume_glb_floats_f(&glb, times, frames, 1, GLB_NO_TARGET, true);
 			int output = plume_glb_floats_f(&glb, weights, frames * frames, 1, GLB_NO_TARGET, false);
-			json_t *animation = json_pack("{s:s, s:[{s:i, s:s, s:i}], s:[{s:i, s:{s:i, s:s}}]}", "name", "simulation",
-			                              "samplers", "input", input, "interpolation", "LINEAR", "output", output,
-			                              "channels", "sampler", 0, "target", "node", node, "path", "weights");
-			// The carried feather's weights follow the same keys (it has as many targets).
-			if (feather >= 0)
-				json_array_append_new(
-				    json_object_get(animation, "channels"),
-				    json_pack("{s:i, s:{s:i, s:s}}", "sampler", 0, "target", "node", feather, "path", "weights"));
+			json_t *channels = json_array();
+			for (int k = 0; k < animated_count; ++k)
+				json_array_append_new(channels, json_pack("{s:i, s:{s:i, s:s}}", "sampler", 0, "target", "node",
+				                                          animated[k], "path", "weights"));
+			json_t *animation = json_pack("{s:s, s:[{s:i, s:s, s:i}], s:o}", "name", "simulation", "samplers", "input",
+			                              input, "interpolation", "LINEAR", "output", output, "channels", channels);
 			json_t *animations = json_array();
 			plume_glb_append(&glb, animations, animation);
 			if (json_object_set_new(glb.root, "animations", animations) != 0)
@@ -312,7 +375,7 @@ plume_status plume_mesh_animation_write_glb(const plume_mesh_animation *a, const
 		}
 		plume_free(times);
 	}
-	plume_free(uv);
+	plume_free(animated);
 	plume_free(weights);
 	plume_status status =
 	    ok ? plume_glb_write(&glb, path, err) : plume_error_set(err, PLUME_ERROR_MEMORY, "%s: out of memory", path);
@@ -327,5 +390,7 @@ void plume_mesh_animation_destroy(plume_mesh_animation *a)
 	plume_free(a->times);
 	plume_free(a->first);
 	plume_free(a->displacements);
+	plume_free(a->embeddings);
+	plume_free(a->names);
 	plume_free(a);
 }

@@ -328,6 +328,58 @@ bool plume_feather_equal(const plume_feather *a, const plume_feather *b)
 	return plume_feather_equal(a->afterfeather, b->afterfeather);
 }
 
+void plume_feather_move(plume_feather *feather, plume_mat3 rotation, plume_vec3 translation)
+{
+	for (; feather != NULL; feather = feather->afterfeather) {
+		PLUME_ASSERT_HANDLE(feather);
+		for (int i = 0; i < feather->shaft_count; ++i) {
+			plume_shaft_sample *s = feather->shaft + i;
+			s->position = plume_v3_add(plume_m3_apply(rotation, s->position), translation);
+			s->tangent = plume_m3_apply(rotation, s->tangent);
+			s->normal = plume_m3_apply(rotation, s->normal);
+			s->binormal = plume_m3_apply(rotation, s->binormal);
+		}
+		for (int i = 0; i < feather->point_count; ++i) {
+			feather->points[i] = plume_v3_add(plume_m3_apply(rotation, feather->points[i]), translation);
+			feather->normals[i] = plume_m3_apply(rotation, feather->normals[i]);
+		}
+	}
+}
+
+double plume_feather_distance(const plume_feather *a, const plume_feather *b)
+{
+	double worst = 0.0;
+	for (; a != NULL && b != NULL; a = a->afterfeather, b = b->afterfeather) {
+		PLUME_ASSERT_HANDLE(a);
+		PLUME_ASSERT_HANDLE(b);
+		if (a->shaft_count != b->shaft_count || a->calamus_count != b->calamus_count ||
+		    a->point_count != b->point_count || a->barb_count != b->barb_count ||
+		    a->barbule_count != b->barbule_count || (a->afterfeather == NULL) != (b->afterfeather == NULL))
+			return INFINITY;
+		for (int i = 0; i < a->shaft_count; ++i) {
+			if (!same_bytes(&a->shaft[i].width, &b->shaft[i].width, sizeof a->shaft[i].width))
+				return INFINITY;
+			worst = fmax(worst, plume_v3_distance(a->shaft[i].position, b->shaft[i].position));
+		}
+		for (int i = 0; i < a->barb_count; ++i) {
+			const plume_barb_record *p = a->barbs + i, *q = b->barbs + i;
+			if (p->curve.first != q->curve.first || p->curve.count != q->curve.count || p->side != q->side ||
+			    p->segment != q->segment || p->barbule_count != q->barbule_count)
+				return INFINITY;
+		}
+		for (int i = 0; i < a->barbule_count; ++i)
+			if (a->barbules[i].curve.first != b->barbules[i].curve.first ||
+			    a->barbules[i].curve.count != b->barbules[i].curve.count || a->barbules[i].kind != b->barbules[i].kind)
+				return INFINITY;
+		if (!same_bytes(a->widths, b->widths, (size_t)a->point_count * sizeof *a->widths) ||
+		    !same_bytes(a->uv, b->uv, (size_t)a->point_count * sizeof *a->uv))
+			return INFINITY;
+		for (int i = 0; i < a->point_count; ++i)
+			worst = fmax(worst, plume_v3_distance(a->points[i], b->points[i]));
+	}
+	return a == NULL && b == NULL ? worst : INFINITY;
+}
+
 plume_feather *plume_feather_clone(const plume_feather *feather)
 {
 	PLUME_ASSERT_HANDLE(feather);

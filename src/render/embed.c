@@ -34,6 +34,7 @@ struct plume_barb_embedding {
 	uint32_t magic;         ///< PLUME_HANDLE_MAGIC while alive (core/asserts.h)
 	plume_feather *feather; ///< a copy of the rest feather: the template of every rebuilt one
 	const plume_mesh *mesh;
+	int first_face, face_count; ///< the faces the points are embedded in: [first_face, first_face + face_count)
 	int point_count;
 	anchor *anchors; ///< shaft samples then pool points, feather then afterfeather
 	/// Per shaft sample: tangent, normal; per pool point: normal (same order as anchors).
@@ -97,7 +98,8 @@ static double triangle_distance2(plume_vec3 p, plume_vec3 a, plume_vec3 b, plume
 
 typedef struct nearest_query {
 	const plume_mesh *mesh;
-	const triangle_frame *frames;
+	int first_face;               ///< Embree's primID k is face first_face + k
+	const triangle_frame *frames; ///< per face of the range (index primID)
 	plume_vec3 p;
 	double best2;
 	int best_face;
@@ -106,8 +108,8 @@ typedef struct nearest_query {
 static bool visit_triangle(struct RTCPointQueryFunctionArguments *args)
 {
 	nearest_query *q = args->userPtr;
-	int face = (int)args->primID;
-	if (!q->frames[face].valid)
+	int face = q->first_face + (int)args->primID;
+	if (!q->frames[args->primID].valid)
 		return false;
 	const int *f = q->mesh->faces + 3 * face;
 	double d2 = triangle_distance2(q->p, q->mesh->rest[f[0]], q->mesh->rest[f[1]], q->mesh->rest[f[2]]);
@@ -124,9 +126,10 @@ static bool visit_triangle(struct RTCPointQueryFunctionArguments *args)
 	return false;
 }
 
-static anchor embed_point(RTCScene scene, const plume_mesh *mesh, const triangle_frame *frames, plume_vec3 p)
+static anchor embed_point(RTCScene scene, const plume_mesh *mesh, int first_face, const triangle_frame *frames,
+                          plume_vec3 p)
 {
-	nearest_query q = {mesh, frames, p, INFINITY, -1};
+	nearest_query q = {mesh, first_face, frames, p, INFINITY, -1};
 	struct RTCPointQuery query = {.x = (float)p.x, .y = (float)p.y, .z = (float)p.z, .time = 0.0f, .radius = INFINITY};
 	struct RTCPointQueryContext context;
 	rtcInitPointQueryContext(&context);
@@ -137,8 +140,9 @@ static anchor embed_point(RTCScene scene, const plume_mesh *mesh, const triangle
 	const int *f = mesh->faces + 3 * q.best_face;
 	plume_vec3 x0 = mesh->rest[f[0]];
 	plume_vec3 v0 = plume_v3_sub(mesh->rest[f[1]], x0), v1 = plume_v3_sub(mesh->rest[f[2]], x0);
-	a.h = plume_v3_dot(plume_v3_sub(p, x0), frames[q.best_face].n);
-	plume_vec3 w = plume_v3_mad(plume_v3_sub(p, x0), -a.h, frames[q.best_face].n);
+	const plume_vec3 n = frames[q.best_face - first_face].n;
+	a.h = plume_v3_dot(plume_v3_sub(p, x0), n);
+	plume_vec3 w = plume_v3_mad(plume_v3_sub(p, x0), -a.h, n);
 	double d00 = plume_v3_dot(v0, v0), d01 = plume_v3_dot(v0, v1), d11 = plume_v3_dot(v1, v1);
 	double d20 = plume_v3_dot(w, v0), d21 = plume_v3_dot(w, v1);
 	double denom = d00 * d11 - d01 * d01;
@@ -190,19 +194,20 @@ void plume_embedding_destroy(plume_barb_embedding *embedding)
 	plume_free(embedding);
 }
 
-/// Rest frames of every face; PLUME_ERROR_SPEC when none is usable.
-static plume_status rest_frames(const plume_mesh *mesh, triangle_frame **out, plume_error *err)
+/// Rest frames of the faces [first, first + count) (index: face - first); PLUME_ERROR_SPEC when none is usable.
+static plume_status rest_frames(const plume_mesh *mesh, int first, int count, triangle_frame **out, plume_error *err)
 {
-	if (mesh->face_count <= 0)
+	if (count <= 0)
 		return plume_error_set(err, PLUME_ERROR_SPEC, "embedding: the shell has no faces");
-	triangle_frame *frames = plume_alloc((size_t)mesh->face_count * sizeof *frames);
+	triangle_frame *frames = plume_alloc((size_t)count * sizeof *frames);
 	if (frames == NULL)
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "embedding: out of memory");
 	int valid = 0;
-	for (int i = 0; i < mesh->face_count; ++i) {
+	for (int i = 0; i < count; ++i) {
+		const int *face = mesh->faces + 3 * (first + i);
 		for (int k = 0; k < 3; ++k)
-			PLUME_ASSERT(mesh->faces[3 * i + k] >= 0 && mesh->faces[3 * i + k] < mesh->vertex_count);
-		frames[i] = make_frame(mesh->rest, mesh->faces + 3 * i);
+			PLUME_ASSERT(face[k] >= 0 && face[k] < mesh->vertex_count);
+		frames[i] = make_frame(mesh->rest, face);
 		valid += frames[i].valid;
 	}
 	if (valid == 0) {
@@ -213,14 +218,15 @@ static plume_status rest_frames(const plume_mesh *mesh, triangle_frame **out, pl
 	return PLUME_OK;
 }
 
-static RTCScene build_scene(RTCDevice device, const plume_mesh *mesh)
+/// A BVH of the faces [first, first + count) over all of the mesh's vertices (primID k: face first + k).
+static RTCScene build_scene(RTCDevice device, const plume_mesh *mesh, int first, int count)
 {
 	RTCScene scene = rtcNewScene(device);
 	RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
 	float *vertices = rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
 	                                          (size_t)mesh->vertex_count);
 	unsigned *indices = rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-	                                            3 * sizeof(unsigned), (size_t)mesh->face_count);
+	                                            3 * sizeof(unsigned), (size_t)count);
 	if (vertices == NULL || indices == NULL) {
 		rtcReleaseGeometry(geometry);
 		rtcReleaseScene(scene);
@@ -231,8 +237,8 @@ static RTCScene build_scene(RTCDevice device, const plume_mesh *mesh)
 		vertices[3 * i + 1] = (float)mesh->rest[i].y;
 		vertices[3 * i + 2] = (float)mesh->rest[i].z;
 	}
-	for (int i = 0; i < 3 * mesh->face_count; ++i)
-		indices[i] = (unsigned)mesh->faces[i];
+	for (int i = 0; i < 3 * count; ++i)
+		indices[i] = (unsigned)mesh->faces[3 * first + i];
 	rtcCommitGeometry(geometry);
 	rtcAttachGeometry(scene, geometry);
 	rtcReleaseGeometry(geometry);
@@ -243,11 +249,19 @@ static RTCScene build_scene(RTCDevice device, const plume_mesh *mesh)
 plume_status plume_embedding_create(const plume_feather *feather, const plume_mesh *mesh, plume_barb_embedding **out,
                                     plume_error *err)
 {
+	PLUME_ASSERT(mesh != NULL);
+	return plume_embedding_create_faces(feather, mesh, 0, mesh->face_count, out, err);
+}
+
+plume_status plume_embedding_create_faces(const plume_feather *feather, const plume_mesh *mesh, int first_face,
+                                          int face_count, plume_barb_embedding **out, plume_error *err)
+{
 	PLUME_ASSERT_HANDLE(feather);
 	PLUME_ASSERT(mesh != NULL && out != NULL);
+	PLUME_ASSERT(first_face >= 0 && face_count >= 0 && first_face + face_count <= mesh->face_count);
 	*out = NULL;
 	triangle_frame *frames = NULL;
-	plume_status status = rest_frames(mesh, &frames, err);
+	plume_status status = rest_frames(mesh, first_face, face_count, &frames, err);
 	if (status != PLUME_OK)
 		return status;
 	plume_barb_embedding *e = plume_calloc(1, sizeof *e);
@@ -256,6 +270,8 @@ plume_status plume_embedding_create(const plume_feather *feather, const plume_me
 	if (e != NULL) {
 		e->magic = PLUME_HANDLE_MAGIC;
 		e->mesh = mesh;
+		e->first_face = first_face;
+		e->face_count = face_count;
 		e->point_count = points;
 		e->direction_count = directions;
 		e->feather = plume_feather_clone(feather);
@@ -263,7 +279,7 @@ plume_status plume_embedding_create(const plume_feather *feather, const plume_me
 		e->directions = plume_alloc((size_t)(directions > 0 ? directions : 1) * sizeof *e->directions);
 	}
 	RTCDevice device = rtcNewDevice(NULL);
-	RTCScene scene = device != NULL ? build_scene(device, mesh) : NULL;
+	RTCScene scene = device != NULL ? build_scene(device, mesh, first_face, face_count) : NULL;
 	if (e == NULL || e->feather == NULL || e->anchors == NULL || e->directions == NULL || scene == NULL) {
 		if (scene != NULL)
 			rtcReleaseScene(scene);
@@ -278,10 +294,10 @@ plume_status plume_embedding_create(const plume_feather *feather, const plume_me
 	for (const plume_feather *f = feather; f != NULL; f = f->afterfeather) {
 		int first_point = point;
 		for (int i = 0; i < f->shaft_count; ++i)
-			e->anchors[point++] = embed_point(scene, mesh, frames, f->shaft[i].position);
+			e->anchors[point++] = embed_point(scene, mesh, first_face, frames, f->shaft[i].position);
 #pragma omp parallel for schedule(static)
 		for (int i = 0; i < f->point_count; ++i)
-			e->anchors[point + i] = embed_point(scene, mesh, frames, f->points[i]);
+			e->anchors[point + i] = embed_point(scene, mesh, first_face, frames, f->points[i]);
 		point += f->point_count;
 		// A point with no nearest face (a coordinate Embree's float query cannot
 		// hold, or NaN) has no frame to carry it: refuse rather than index frames[-1].
@@ -298,12 +314,12 @@ plume_status plume_embedding_create(const plume_feather *feather, const plume_me
 			}
 		}
 		for (int i = 0; i < f->shaft_count; ++i) {
-			const triangle_frame *fr = frames + e->anchors[first_point + i].face;
+			const triangle_frame *fr = frames + e->anchors[first_point + i].face - first_face;
 			e->directions[direction++] = to_frame(fr, f->shaft[i].tangent);
 			e->directions[direction++] = to_frame(fr, f->shaft[i].normal);
 		}
 		for (int i = 0; i < f->point_count; ++i) {
-			const triangle_frame *fr = frames + e->anchors[first_point + f->shaft_count + i].face;
+			const triangle_frame *fr = frames + e->anchors[first_point + f->shaft_count + i].face - first_face;
 			e->directions[direction++] = to_frame(fr, f->normals[i]);
 		}
 	}
@@ -314,7 +330,7 @@ plume_status plume_embedding_create(const plume_feather *feather, const plume_me
 		plume_vec3 p = plume_v3_add(plume_v3_add(plume_v3_scale(mesh->rest[face[0]], 1.0 - a->b1 - a->b2),
 		                                         plume_v3_add(plume_v3_scale(mesh->rest[face[1]], a->b1),
 		                                                      plume_v3_scale(mesh->rest[face[2]], a->b2))),
-		                            plume_v3_scale(frames[a->face].n, a->h));
+		                            plume_v3_scale(frames[a->face - first_face].n, a->h));
 		double d = sqrt(triangle_distance2(p, mesh->rest[face[0]], mesh->rest[face[1]], mesh->rest[face[2]]));
 		e->max_offset = fmax(e->max_offset, d);
 	}
@@ -354,20 +370,22 @@ plume_status plume_embedding_apply(const plume_barb_embedding *embedding, const 
 	for (int i = 0; i < mesh->vertex_count; ++i)
 		if (!isfinite(positions[i].x) || !isfinite(positions[i].y) || !isfinite(positions[i].z))
 			return plume_error_set(err, PLUME_ERROR_NUMERIC, "embedding: shell vertex %d is not finite", i);
-	triangle_frame *frames = plume_alloc((size_t)mesh->face_count * sizeof *frames);
+	const int first = embedding->first_face;
+	triangle_frame *frames =
+	    plume_alloc((size_t)(embedding->face_count > 0 ? embedding->face_count : 1) * sizeof *frames);
 	plume_feather *moved = plume_feather_clone(embedding->feather);
 	if (frames == NULL || moved == NULL) {
 		plume_free(frames);
 		plume_feather_destroy(moved);
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "embedding: out of memory");
 	}
-	for (int i = 0; i < mesh->face_count; ++i)
-		frames[i] = make_frame(positions, mesh->faces + 3 * i);
+	for (int i = 0; i < embedding->face_count; ++i)
+		frames[i] = make_frame(positions, mesh->faces + 3 * (first + i));
 	int point = 0, direction = 0;
 	for (plume_feather *f = moved; f != NULL; f = f->afterfeather) {
 		for (int i = 0; i < f->shaft_count; ++i, ++point) {
 			anchor a = embedding->anchors[point];
-			const triangle_frame *fr = frames + a.face;
+			const triangle_frame *fr = frames + a.face - first;
 			plume_shaft_sample *s = f->shaft + i;
 			s->position = place(mesh, positions, fr, a);
 			plume_vec3 t = plume_v3_normalize(from_frame(fr, embedding->directions[direction++]));
@@ -379,7 +397,7 @@ plume_status plume_embedding_apply(const plume_barb_embedding *embedding, const 
 		}
 		for (int i = 0; i < f->point_count; ++i, ++point) {
 			anchor a = embedding->anchors[point];
-			const triangle_frame *fr = frames + a.face;
+			const triangle_frame *fr = frames + a.face - first;
 			f->points[i] = place(mesh, positions, fr, a);
 			f->normals[i] = plume_v3_normalize(from_frame(fr, embedding->directions[direction++]));
 		}

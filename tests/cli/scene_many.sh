@@ -30,11 +30,13 @@ JSON
 out=$scratch/three
 "$plume" simulate "$scratch/three.json" -o "$out" --duration 0.055 --frames-every 2 >"$scratch/out.txt" 2>"$scratch/err.txt"
 succeeded "simulate a 3-feather scene"
-for f in mesh.obj body.obj feathers/top.json feathers/top.bin feathers/bottom.json feathers/f2.json stats.csv \
+for f in mesh.obj body.obj feathers.json feathers/top.json feathers/top.bin stats.csv \
 	summary.json frames/0000.obj frames/0003.obj frames/body-0000.obj frames/body-0003.obj; do
 	check "writes $f" test -s "$out/$f"
 done
 check "no feather.json for a list of feathers" test ! -e "$out/feather.json"
+# Three copies of one feather: one dump (tests/cli/render_many.sh has more).
+check "one dump for three copies" test "$(ls "$out/feathers")" = "$(printf 'top.bin\ntop.json')"
 check "--frames-every 2 over 5 steps: frames 0, 2, 4 and the last" test ! -e "$out/frames/0004.obj"
 check "one merged mesh per frame" test "$(grep -c '^v ' "$out/frames/0003.obj")" -eq "$(grep -c '^v ' "$out/mesh.obj")"
 check "summary: counts, --duration, cycles" /usr/bin/python3 -c '

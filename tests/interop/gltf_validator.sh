@@ -45,5 +45,14 @@ cat >"$scratch/swing.json" <<JSON
  "handles": [{"group": "rachis_clamp"}], "gravity": [0, 0, -9.81], "duration": 0.055}
 JSON
 "$plume" simulate "$scratch/swing.json" -o "$scratch/sim" >/dev/null
+# Many feathers carried at barb level (--glb-feather) and a turning body, all keyed by one animation.
+cat >"$scratch/many.json" <<JSON
+{"body": {"mesh": {"shape": "ellipsoid", "center": [0, 0, 0], "radii": [0.05, 0.05, 0.05], "segments": 12},
+          "keyframes": [{"time": 0}, {"time": 0.1, "rotation_axis": [0, 0, 1], "rotation_deg": 30}]},
+ "feathers": [{"feather": "$PWD/examples/franco-walter/blue.json", "name": "top", "position": [0, 0, 0.05], "follicle": {}},
+              {"feather": "$PWD/examples/franco-walter/blue.json", "position": [0.5, 0, 0]}],
+ "mesh": {"edge_length": 0.015}, "handles": [{"group": "f1/rachis_clamp"}], "duration": 0.022}
+JSON
+"$plume" simulate "$scratch/many.json" -o "$scratch/many" --glb-feather >/dev/null
 set +e
-(cd "$scratch" && NODE_PATH="$scratch/node_modules" node validate.js feather/feather.glb textured/feather.glb mesh/mesh.glb coat/coat.glb sim/sim.glb)
+(cd "$scratch" && NODE_PATH="$scratch/node_modules" node validate.js feather/feather.glb textured/feather.glb mesh/mesh.glb coat/coat.glb sim/sim.glb many/sim.glb)
