@@ -237,6 +237,8 @@ double plume_contact_pair_stiffness(const plume_sim *sim, const sim_contact_pair
 	for (int k = 0; k < 4; ++k)
 		if (pair->vertices[k] < sim->vertex_count)
 			mass = fmax(mass, sim->mass[pair->vertices[k]]);
+	if (!(mass > 0))
+		return def->stiffness; // massless vertices (no density): nothing to scale by
 	double dhat = def->distance;
 	return sim->contact.acceleration * mass / (barrier_push_at_half() * dhat * dhat * dhat);
 }

@@ -164,9 +164,10 @@ plume_status plume_contact_begin(struct plume_sim *sim, double s0, double s1, do
 /// adaptive stiffness's floor doubles when the step's pairs came closer than d-hat / 10.
 void plume_contact_finish(struct plume_sim *sim);
 
-/// IPC's doubling within a solve: when the closest pair distance of two accepted iterates in a
-/// row, `previous` then `closest` (m), is below d-hat / 10 and falling, doubles the adaptive
-/// stiffness (up to its ceiling). True when it changed.
+/// IPC's doubling within a solve: when the closest pair distance at an accepted iterate,
+/// `closest` (m), is below d-hat / 10 and below `previous`, the one at the accepted iterate
+/// before (+inf for the first), doubles the adaptive stiffness (up to its ceiling). True when it
+/// changed.
 bool plume_contact_stiffen(struct plume_sim *sim, double previous, double closest);
 
 /// The barrier stiffness kappa of a pair (J/m^4) and its reach d-hat (m).

@@ -416,9 +416,9 @@ static plume_status newton(plume_sim *sim, const sim_problem *problem, plume_sol
 		for (int k = 0; k < m; ++k)
 			sim->lambda[k] += alpha * (step[n3 + k] - sim->lambda[k]);
 		exact = alpha == 1;
-		// IPC's adaptive stiffness within a solve (Li et al. 2020, supplement): two accepted
-		// iterates in a row far inside the barrier's reach, the second closer, say the barrier is
-		// too soft to stop this motion: double it. The potential changes, so the merit's trace
+		// IPC's adaptive stiffness within a solve (Li et al. 2020, supplement): an accepted
+		// iterate far inside the barrier's reach and closer than the one before says the barrier
+		// is too soft to stop this motion: double it. The potential changes, so the merit's trace
 		// (which must decrease) starts again. The last evaluation was at the accepted iterate.
 		if (contact && sim->def.contact.adaptive_stiffness) {
 			double closest = sim->contact.min_distance;
