@@ -11,6 +11,8 @@
 #include <string.h>
 #include <time.h>
 
+#include <omp.h>
+
 #include "sim/sim_internal.h"
 #include "support.h"
 
@@ -114,6 +116,7 @@ static plume_sim_def contact_def(double stiffness)
 {
 	plume_sim_def def = plume_sim_default_def();
 	def.contact.enabled = true;
+	def.contact.adaptive_stiffness = false;
 	def.contact.stiffness = stiffness;
 	return def;
 }
@@ -929,7 +932,8 @@ static void test_scene_contact(void **state)
 	if (parse_contact("{}", &scene, &err) != PLUME_OK)
 		fail_msg("%s", err.message);
 	assert_true(scene->sim.contact.enabled && scene->sim.contact.self_contact);
-	assert_true(scene->sim.contact.distance == 1.2e-4 && scene->sim.contact.stiffness == 1e6);
+	assert_true(scene->sim.contact.distance == 1.2e-4 && scene->sim.contact.stiffness == 1e6 &&
+	            scene->sim.contact.adaptive_stiffness);
 	plume_scene_destroy(scene);
 	assert_int_equal(parse_contact("{\"distance\": 2e-4, \"stiffness\": 5e5, \"self_contact\": false, "
 	                               "\"ccd_separation\": 0.2, \"friction\": 0.3}",
@@ -937,7 +941,8 @@ static void test_scene_contact(void **state)
 	                 PLUME_OK);
 	assert_true(scene->sim.contact.enabled && !scene->sim.contact.self_contact);
 	assert_true(scene->sim.contact.distance == 2e-4 && scene->sim.contact.stiffness == 5e5 &&
-	            scene->sim.contact.ccd_separation == 0.2 && scene->sim.contact.friction == 0.3);
+	            !scene->sim.contact.adaptive_stiffness && scene->sim.contact.ccd_separation == 0.2 &&
+	            scene->sim.contact.friction == 0.3);
 	plume_scene_destroy(scene);
 	assert_int_equal(parse_contact("{\"enabled\": false}", &scene, &err), PLUME_OK);
 	assert_false(scene->sim.contact.enabled);
@@ -958,6 +963,258 @@ static void test_scene_contact(void **state)
 	}
 }
 
+/// A vane thrown flat at the ground at 1 m/s (5 mm a 5 ms step against d-hat = 0.12 mm): with
+/// the adaptive stiffness the barrier stops it near d-hat / 2 within a few Newton iterations;
+/// with the fixed 1e6 J/m^4 it comes orders of magnitude closer. No pair ever touches.
+static void run_impact(bool adaptive, double speed, double *closest, double *settled, int *most_iterations)
+{
+	sheet sheets[1] = {{plume_v3(-0.01, 1.5e-3, -0.01), 0.02, 0.02, 5}};
+	plume_mesh *mesh = make_sheets(sheets, 1);
+	plume_sim_def def = contact_def(1e6);
+	def.contact.adaptive_stiffness = adaptive;
+	def.time_step = 0.005;
+	plume_sim *sim = NULL;
+	plume_error err = {0};
+	assert_int_equal(plume_sim_create(mesh, &def, &sim, &err), PLUME_OK);
+	add_ground(sim, 0, 0.05);
+	for (int i = 0; i < sim->vertex_count; ++i)
+		sim->v[i] = plume_v3(0, -speed, 0);
+	*closest = INFINITY, *settled = INFINITY, *most_iterations = 0;
+	for (int step = 0; step < 20; ++step) {
+		plume_solve_report report;
+		if (plume_sim_step(sim, &report, &err) != PLUME_OK)
+			fail_msg("step %d: %s", step, err.message);
+		*closest = fmin(*closest, check_state(sim, &report));
+		*most_iterations = report.newton_iterations > *most_iterations ? report.newton_iterations : *most_iterations;
+		if (step >= 10)
+			*settled = fmin(*settled, min_distance(shell_surface(sim), body_surface(sim), false));
+	}
+	plume_sim_destroy(sim);
+	plume_mesh_destroy(mesh);
+}
+
+static void test_impact_stiffness(void **state)
+{
+	(void)state;
+	double dhat = 1.2e-4, closest[2], settled[2], speed = 1;
+	int iterations[2];
+	for (int adaptive = 0; adaptive < 2; ++adaptive) {
+		run_impact(adaptive, speed, closest + adaptive, settled + adaptive, iterations + adaptive);
+		printf("impact at %g m/s, %s stiffness: closest %.3g m, gap at rest %.3g m, at most %d Newton iterations "
+		       "a step\n",
+		       speed, adaptive ? "adaptive" : "fixed 1e6 J/m^4", closest[adaptive], settled[adaptive],
+		       iterations[adaptive]);
+	}
+	// The adaptive barrier holds the impact well inside the reach, far from contact, and rests
+	// with the gap of a weight held at about d-hat / 2 by its pairs.
+	assert_true(settled[1] > 0.25 * dhat && settled[1] < dhat);
+	assert_true(closest[1] > 0.25 * dhat && closest[1] > 3 * closest[0]);
+}
+
+/// The adaptive stiffness of a pair: the barrier's push at d-hat / 2, |d b(d^2) / dd| computed
+/// here by central differences of plume_barrier, times kappa, holds the pair's heaviest shell
+/// vertex at the (sub)step's acceleration (gravity at rest, standard gravity without).
+static void test_adaptive_stiffness_formula(void **state)
+{
+	(void)state;
+	double dhat = 1.2e-4;
+	sheet sheets[2] = {{plume_v3(0, 0, 0), 0.01, 0.01, 4}, {plume_v3(0.0011, 0.6 * dhat, 0.0013), 0.01, 0.01, 4}};
+	plume_mesh *mesh = make_sheets(sheets, 2);
+	plume_sim_def def = plume_sim_default_def();
+	def.contact.enabled = true;
+	for (int g = 0; g < 2; ++g) {
+		def.gravity = g == 0 ? plume_v3(0, 0, 0) : plume_v3(0, -30, 0);
+		plume_sim *sim = NULL;
+		plume_error err = {0};
+		assert_int_equal(plume_sim_create(mesh, &def, &sim, &err), PLUME_OK);
+		static const sim_problem statics = {.dynamic = false};
+		assert_true(isfinite(plume_sim_potential(sim, &statics, sim->x, NULL, false, false)));
+		assert_true(sim->contact.active_count > 0);
+		double d = 0.5 * dhat, step = 1e-9, dummy;
+		double push = fabs(plume_barrier((d + step) * (d + step), dhat * dhat, &dummy, NULL) -
+		                   plume_barrier((d - step) * (d - step), dhat * dhat, &dummy, NULL)) /
+		              (2 * step);
+		double acceleration = g == 0 ? 9.80665 : 30;
+		for (int k = 0; k < sim->contact.active_count; ++k) {
+			const sim_contact_pair *pair = sim->contact.pairs + sim->contact.active[k];
+			double heaviest = 0;
+			for (int j = 0; j < 4; ++j)
+				heaviest = fmax(heaviest, sim->mass[pair->vertices[j]]);
+			double force = plume_contact_pair_stiffness(sim, pair) * push;
+			assert_true(fabs(force - heaviest * acceleration) <= 1e-6 * heaviest * acceleration);
+		}
+		plume_sim_destroy(sim);
+	}
+	plume_mesh_destroy(mesh);
+}
+
+/// A sheet meshed finer than d-hat (0.1 mm cells): every primitive is within d-hat of non-adjacent
+/// ones at rest. Those pairs, a few edges apart on the mesh, repel only within half their rest
+/// distance, so the rest shape feels no barrier: without gravity it moves exactly as without
+/// contact. A
+/// second sheet 0.6 d-hat above (another component) keeps the full reach and is pushed away.
+static void test_rest_close_pairs(void **state)
+{
+	(void)state;
+	double dhat = 1.2e-4;
+	sheet sheets[2] = {{plume_v3(0, 0, 0), 6e-4, 6e-4, 7}, {plume_v3(0, 0.6 * dhat, 0), 6e-4, 6e-4, 7}};
+	for (int count = 1; count <= 2; ++count) {
+		plume_mesh *mesh = make_sheets(sheets, count);
+		plume_sim_def def = plume_sim_default_def();
+		def.contact.enabled = true;
+		def.gravity = plume_v3(0, 0, 0);
+		def.time_step = 0.005;
+		plume_sim *sim = NULL;
+		plume_error err = {0};
+		assert_int_equal(plume_sim_create(mesh, &def, &sim, &err), PLUME_OK);
+		// Brute force: the pairs closer than d-hat at rest and at most 3 edges apart.
+		int close = 0, per_sheet = sim->vertex_count / count;
+		surface s = shell_surface(sim);
+		for (int v = 0; v < s.vertex_count; ++v)
+			for (int f = 0; f < s.face_count; ++f) {
+				const int *t = s.faces + 3 * f;
+				if (v == t[0] || v == t[1] || v == t[2])
+					continue;
+				double d2 = plume_point_triangle_distance2(sim->rest[v], sim->rest[t[0]], sim->rest[t[1]],
+				                                           sim->rest[t[2]], NULL);
+				close += d2 < dhat * dhat && (v < per_sheet) == (t[0] < per_sheet);
+			}
+		printf("rest-close: %d sheet(s), %d pairs reduced (%d point-triangle pairs within d-hat in one sheet)\n", count,
+		       sim->contact.rest_close_count, close);
+		assert_true(close > 0 && sim->contact.rest_close_count >= close);
+		plume_sim *free_sim = NULL;
+		def.contact.enabled = false;
+		assert_int_equal(plume_sim_create(mesh, &def, &free_sim, &err), PLUME_OK);
+		plume_solve_report report, free_report;
+		for (int step = 0; step < 3; ++step) {
+			assert_int_equal(plume_sim_step(sim, &report, &err), PLUME_OK);
+			assert_int_equal(plume_sim_step(free_sim, &free_report, &err), PLUME_OK);
+		}
+		double moved = 0;
+		for (int i = 0; i < sim->vertex_count; ++i)
+			moved = fmax(moved, plume_v3_distance(sim->x[i], free_sim->x[i]));
+		if (count == 1) {
+			// The same as without contact, to the bit.
+			assert_true(moved == 0);
+			assert_int_equal(report.contact_pairs, 0);
+		} else {
+			assert_true(moved > 0.1 * dhat); // pushed apart, out of reach
+		}
+		plume_sim_destroy(free_sim);
+		plume_sim_destroy(sim);
+		plume_mesh_destroy(mesh);
+	}
+}
+
+/// plume_sim_energy's contact term is the barrier over every pair within reach (brute force over
+/// all pairs with the pair energy), and a static solve's reported potential is the state's
+/// elastic + gravity + contact energy.
+static void test_energy_includes_contact(void **state)
+{
+	(void)state;
+	sheet sheets[1] = {{plume_v3(-0.01, 6e-5, -0.01), 0.02, 0.02, 5}};
+	plume_mesh *mesh = make_sheets(sheets, 1);
+	plume_sim_def def = contact_def(1e6);
+	plume_sim *sim = NULL;
+	plume_error err = {0};
+	assert_int_equal(plume_sim_create(mesh, &def, &sim, &err), PLUME_OK);
+	assert_true(plume_sim_add_handle(sim, "clamp0", &err) >= 0); // statics needs the sheet held
+	add_ground(sim, 0, 0.05);
+	plume_solve_report report;
+	assert_int_equal(plume_sim_solve_static(sim, &report, &err), PLUME_OK);
+	plume_sim_energies e = plume_sim_energy(sim);
+	double expected = 0, dhat = def.contact.distance;
+	surface shell = shell_surface(sim), body = body_surface(sim);
+	for (int v = 0; v < shell.vertex_count; ++v)
+		for (int f = 0; f < body.face_count && !sim->fixed[3 * v]; ++f) {
+			plume_vec3 points[4] = {shell.x[v], body.x[body.faces[3 * f]], body.x[body.faces[3 * f + 1]],
+			                        body.x[body.faces[3 * f + 2]]};
+			expected +=
+			    plume_contact_pair_energy(PLUME_CONTACT_POINT_TRIANGLE, points, points, dhat, 1e6, false, NULL, NULL);
+		}
+	// Shell edges against the ground's edges (its diagonal lies under the sheet), with the
+	// mollifier's rest positions.
+	int *edges = malloc(sizeof(int) * 6 * (size_t)shell.face_count), edge_count = 0;
+	for (int f = 0; f < shell.face_count; ++f)
+		for (int k = 0; k < 3; ++k) {
+			int a = shell.faces[3 * f + k], b = shell.faces[3 * f + (k + 1) % 3];
+			int low = a < b ? a : b, high = a < b ? b : a;
+			bool seen = sim->fixed[3 * low] || sim->fixed[3 * high];
+			for (int j = 0; j < edge_count && !seen; ++j)
+				seen = edges[2 * j] == low && edges[2 * j + 1] == high;
+			if (!seen)
+				edges[2 * edge_count] = low, edges[2 * edge_count + 1] = high, ++edge_count;
+		}
+	static const int ground_edges[5][2] = {{0, 1}, {1, 2}, {0, 2}, {2, 3}, {0, 3}};
+	for (int j = 0; j < edge_count; ++j)
+		for (int k = 0; k < 5; ++k) {
+			int a = edges[2 * j], b = edges[2 * j + 1], c = ground_edges[k][0], d = ground_edges[k][1];
+			plume_vec3 points[4] = {shell.x[a], shell.x[b], body.x[c], body.x[d]};
+			plume_vec3 rest[4] = {sim->rest[a], sim->rest[b], sim->contact.body_rest[c], sim->contact.body_rest[d]};
+			expected += plume_contact_pair_energy(PLUME_CONTACT_EDGE_EDGE, points, rest, dhat, 1e6, false, NULL, NULL);
+		}
+	free(edges);
+	double state_energy = e.membrane + e.bending + e.compression + e.gravity + e.contact;
+	printf("energy: contact %.6g J (brute force %.6g), friction %g, solve's potential %.9g J, state's %.9g J\n",
+	       e.contact, expected, e.friction, report.energy, state_energy);
+	// The ground's vertices are far away: no ground point against a shell face is in reach.
+	assert_true(expected > 0 && fabs(e.contact - expected) <= 1e-12 * expected);
+	assert_true(e.friction == 0);
+	// The solve reports the potential of its last assembly (its final step is below tolerance);
+	// the contact term is a tenth of it.
+	assert_true(fabs(report.energy - state_energy) <= 1e-6 * fabs(state_energy));
+	plume_sim_destroy(sim);
+	plume_mesh_destroy(mesh);
+}
+
+/// Two sheets stacked on the ground within reach of each other from the start, stepped with one
+/// and with two threads: bit-identical positions (pairs are sorted; no reduction depends on the
+/// thread count).
+static void run_stack(int threads, plume_vec3 *out, int *vertex_count, int *most_pairs)
+{
+	double dhat = 1.2e-4;
+	sheet sheets[2] = {{plume_v3(-0.02, 0.7 * dhat, -0.02), 0.04, 0.04, 21},
+	                   {plume_v3(-0.019, 1.5 * dhat, -0.019), 0.04, 0.04, 21}};
+	plume_mesh *mesh = make_sheets(sheets, 2);
+	plume_sim_def def = plume_sim_default_def();
+	def.contact.enabled = true;
+	def.contact.friction = 0.2;
+	def.time_step = 0.005;
+	int saved = omp_get_max_threads();
+	omp_set_num_threads(threads);
+	plume_sim *sim = NULL;
+	plume_error err = {0};
+	assert_int_equal(plume_sim_create(mesh, &def, &sim, &err), PLUME_OK);
+	add_ground(sim, 0, 0.1);
+	*most_pairs = 0;
+	for (int step = 0; step < 2; ++step) {
+		plume_solve_report report;
+		if (plume_sim_step(sim, &report, &err) != PLUME_OK)
+			fail_msg("step %d: %s", step, err.message);
+		*most_pairs = report.contact_pairs > *most_pairs ? report.contact_pairs : *most_pairs;
+	}
+	*vertex_count = sim->vertex_count;
+	memcpy(out, sim->x, sizeof(plume_vec3) * (size_t)sim->vertex_count);
+	omp_set_num_threads(saved);
+	plume_sim_destroy(sim);
+	plume_mesh_destroy(mesh);
+}
+
+static void test_threads_identical(void **state)
+{
+	(void)state;
+	plume_vec3 *one = malloc(sizeof(plume_vec3) * 4096), *two = malloc(sizeof(plume_vec3) * 4096);
+	int n1 = 0, n2 = 0, pairs1 = 0, pairs2 = 0;
+	run_stack(1, one, &n1, &pairs1);
+	run_stack(2, two, &n2, &pairs2);
+	printf("threads: %d vertices, up to %d pairs in reach (parallel pair loops from 4096)\n", n1, pairs1);
+	assert_int_equal(n1, n2);
+	assert_int_equal(pairs1, pairs2);
+	assert_true(pairs1 >= 4096);
+	assert_memory_equal(one, two, sizeof(plume_vec3) * (size_t)n1);
+	free(one), free(two);
+}
+
 int main(void)
 {
 	static double fast_ground = 0.2; // m/s: 1 mm a step against a gap of 6e-5 m
@@ -975,6 +1232,11 @@ int main(void)
 	    cmocka_unit_test(test_friction_on_slope),
 	    cmocka_unit_test(test_friction_derivatives),
 	    cmocka_unit_test(test_held_end_on_ground),
+	    cmocka_unit_test(test_impact_stiffness),
+	    cmocka_unit_test(test_adaptive_stiffness_formula),
+	    cmocka_unit_test(test_rest_close_pairs),
+	    cmocka_unit_test(test_energy_includes_contact),
+	    cmocka_unit_test(test_threads_identical),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

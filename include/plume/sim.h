@@ -125,11 +125,20 @@ typedef struct plume_contact_def {
 	/// 1.2e-4, the vane's thickness (thesis Table 3.1 and Table 6.1), so two vanes at rest lie
 	/// about a thickness apart.
 	double distance;
-	/// Barrier stiffness kappa, J/m^4, > 0: a pair's energy is kappa b(d^2) with IPC's
-	/// b(d^2) = -(d^2 - dhat^2)^2 ln(d^2 / dhat^2) (m^4). Default 1e6: a point over a plane at
-	/// d = dhat / 2 is then pushed with 4.33 kappa dhat^3 = 7.5e-6 N, about the weight of a vane
-	/// vertex at the default 5 mm mesh (0.026 kg/m^2 x 2.2e-5 m^2 x 9.81 m/s^2), so vanes at rest
-	/// lie about half the contact distance apart (docs/contact.md).
+	/// Adapt the barrier's stiffness to the shell's mass and motion (docs/contact.md "Stiffness";
+	/// after IPC's adaptive stiffness, Li et al. 2020 section 4.3 and supplement): a pair's kappa is
+	/// a * m / (4.33 d-hat^3), m the mean mass of its shell vertices (kg), so the barrier at
+	/// d-hat / 2 holds m at acceleration a; a (m/s^2), fixed at each (sub)step's start, is the
+	/// largest of gravity, the largest load per vertex mass, the fastest shell vertex's or
+	/// obstacle vertex's speed over the (sub)step's length (what stops it within one step), and
+	/// a floor that doubles after a step whose pairs came closer than d-hat / 10. Default true;
+	/// false uses `stiffness` for every pair (a scene's "stiffness" key sets it false).
+	bool adaptive_stiffness;
+	/// Barrier stiffness kappa, J/m^4, > 0, when adaptive_stiffness is false: a pair's energy is
+	/// kappa b(d^2) with IPC's b(d^2) = -(d^2 - dhat^2)^2 ln(d^2 / dhat^2) (m^4). Default 1e6: a
+	/// point over a plane at d = dhat / 2 is then pushed with 4.33 kappa dhat^3 = 7.5e-6 N, about
+	/// the weight of a vane vertex at the default 5 mm mesh (0.026 kg/m^2 x 2.2e-5 m^2 x
+	/// 9.81 m/s^2).
 	double stiffness;
 	/// A feather against itself and against other feathers of the same mesh. Default true;
 	/// false keeps contact with obstacles only.
@@ -203,7 +212,8 @@ typedef struct plume_solve_report {
 	int substeps;
 	/// Free-DOF gradient norm at the end, N.
 	double gradient_norm;
-	/// Potential at the end, J (elastic + gravity, plus inertia for a step).
+	/// Potential at the end, J (elastic + gravity, plus inertia for a step; with contact the
+	/// barrier, and in a step with friction the friction dissipation potential).
 	double energy;
 	/// Largest |l - L| / L over barb-aligned edges.
 	double max_barb_strain;
@@ -259,6 +269,14 @@ typedef struct plume_sim_energies {
 	double compression;
 	double gravity;
 	double kinetic;
+	/// Contact (def.contact.enabled; 0 otherwise): IPC's barrier over the pairs within reach
+	/// (Li et al. 2020, eq. 6; +inf would mean two surfaces touch, which no accepted state has)
+	/// and the friction dissipation potential D(x) of the last (sub)step (section 5.3: mu lambda
+	/// f0(|T^T u|) over its lagged pairs, u the sliding since the (sub)step's start; 0 without
+	/// friction and after a static solve). Both are terms of the incremental potential that the
+	/// last solve minimised (plume_solve_report.energy includes them).
+	double contact;
+	double friction;
 } plume_sim_energies;
 plume_sim_energies plume_sim_energy(plume_sim *sim);
 

@@ -186,7 +186,8 @@ class Simulation(Closable):
     def energies(self) -> dict:
         e = lib.plume_sim_energy(self._live())
         return {"membrane": e.membrane, "bending": e.bending, "compression": e.compression,
-                "gravity": e.gravity, "kinetic": e.kinetic}
+                "gravity": e.gravity, "kinetic": e.kinetic,
+                "contact": e.contact, "friction": e.friction}
 
     def reaction(self, group: str) -> tuple[float, float, float]:
         """Force, N, a handle must apply to hold the group where it is."""

@@ -172,7 +172,9 @@ static void read_contact(plume_spec_reader *reader, const json_t *root, plume_si
 	def->contact.enabled = true;
 	plume_spec_bool(reader, contact, "$.contact", "enabled", &def->contact.enabled);
 	plume_spec_number(reader, contact, "$.contact", "distance", &def->contact.distance);
-	plume_spec_number(reader, contact, "$.contact", "stiffness", &def->contact.stiffness);
+	// A stiffness given is an explicit override of the adaptive one (docs/contact.md).
+	if (plume_spec_number(reader, contact, "$.contact", "stiffness", &def->contact.stiffness))
+		def->contact.adaptive_stiffness = false;
 	plume_spec_bool(reader, contact, "$.contact", "self_contact", &def->contact.self_contact);
 	plume_spec_number(reader, contact, "$.contact", "ccd_separation", &def->contact.ccd_separation);
 	plume_spec_number(reader, contact, "$.contact", "friction", &def->contact.friction);

@@ -28,6 +28,18 @@
 #include "sim/ccd.h"
 #include "sim/sim_internal.h"
 
+/// m/s^2: the adaptive stiffness's least acceleration without (or with weaker) gravity.
+static const double STANDARD_GRAVITY = 9.80665;
+/// A pair of one surface closer than d-hat at rest, whose primitives are at most REST_RINGS
+/// edges apart on the mesh, repels within REST_REACH of its rest distance.
+static const double REST_REACH = 0.5;
+enum { REST_RINGS = 3 };
+/// The adaptive stiffness's floor doubles after a step whose pairs came closer than this
+/// fraction of d-hat (IPC's "the barrier has difficulty pushing the bodies apart").
+static const double DOUBLING_DISTANCE = 0.1;
+/// The floor's ceiling, relative to the least acceleration (a bound on the doubling).
+static const double MAX_ACCELERATION_RATIO = 1e6;
+
 static int compare_edges(const void *a, const void *b)
 {
 	const int *p = a, *q = b;
@@ -60,26 +72,212 @@ static int collect_edges(const int *faces, int face_count, int **out)
 	return unique;
 }
 
+/// |d b(d^2) / dd| at d = d-hat / 2, over d-hat^3: 2 d |b'(d^2)| with b'(s) = -2 (s - s^) ln(s / s^)
+/// - (s - s^)^2 / s, at s = s^ / 4: 3 ln 2 + 9 / 4 = 4.3294.
+static double barrier_push_at_half(void) { return 3 * log(2.0) + 2.25; }
+
+/// The adaptive stiffness's least acceleration, m/s^2: gravity, and at least standard gravity
+/// (a shell without gravity still needs a barrier that holds a weight-like push).
+static double minimum_acceleration(const plume_sim *sim)
+{
+	return fmax(STANDARD_GRAVITY, plume_v3_length(sim->def.gravity));
+}
+
+static bool find_candidates(plume_sim *sim, const plume_vec3 *x0, const plume_vec3 *x1, const plume_vec3 *body0,
+                            const plume_vec3 *body1, double inflate);
+static double pair_distance2(const sim_contact_pair *pair, const plume_vec3 p[4]);
+
+static int compare_pairs(const void *a, const void *b)
+{
+	const sim_contact_pair *p = a, *q = b;
+	if (p->type != q->type)
+		return p->type < q->type ? -1 : 1;
+	for (int k = 0; k < 4; ++k)
+		if (p->vertices[k] != q->vertices[k])
+			return p->vertices[k] < q->vertices[k] ? -1 : 1;
+	return 0;
+}
+
+/// Vertex adjacency of the shell's edges (CSR: neighbours of v in list[start[v] .. start[v + 1])).
+typedef struct adjacency {
+	int *start, *list;
+} adjacency;
+
+static bool build_adjacency(const plume_sim *sim, adjacency *out)
+{
+	const sim_contact *contact = &sim->contact;
+	int n = sim->vertex_count, m = contact->edge_count;
+	out->start = plume_alloc(sizeof(int) * (size_t)(n + 1));
+	out->list = plume_alloc(sizeof(int) * 2 * (size_t)(m > 0 ? m : 1));
+	if (out->start == NULL || out->list == NULL)
+		return false;
+	memset(out->start, 0, sizeof(int) * (size_t)(n + 1));
+	for (int e = 0; e < m; ++e)
+		++out->start[contact->edges[2 * e] + 1], ++out->start[contact->edges[2 * e + 1] + 1];
+	for (int v = 0; v < n; ++v)
+		out->start[v + 1] += out->start[v];
+	int *fill = plume_alloc(sizeof(int) * (size_t)(n > 0 ? n : 1));
+	if (fill == NULL)
+		return false;
+	memcpy(fill, out->start, sizeof(int) * (size_t)n);
+	for (int e = 0; e < m; ++e) {
+		int a = contact->edges[2 * e], b = contact->edges[2 * e + 1];
+		out->list[fill[a]++] = b;
+		out->list[fill[b]++] = a;
+	}
+	plume_free(fill);
+	return true;
+}
+
+/// The primitives of a pair (the first `split` vertices against the rest) are joined by a path
+/// of at most REST_RINGS mesh edges. depth[] (vertex_count entries, -1) and queue are scratch,
+/// left as given.
+static bool topologically_near(const adjacency *graph, const sim_contact_pair *pair, int *depth, int *queue)
+{
+	int split = pair->type == PLUME_CONTACT_POINT_TRIANGLE ? 1 : 2, head = 0, tail = 0;
+	for (int k = 0; k < split; ++k)
+		if (depth[pair->vertices[k]] < 0)
+			depth[pair->vertices[k]] = 0, queue[tail++] = pair->vertices[k];
+	while (head < tail) {
+		int v = queue[head++];
+		if (depth[v] == REST_RINGS)
+			continue;
+		for (int j = graph->start[v]; j < graph->start[v + 1]; ++j)
+			if (depth[graph->list[j]] < 0)
+				depth[graph->list[j]] = depth[v] + 1, queue[tail++] = graph->list[j];
+	}
+	bool near = false;
+	for (int k = split; k < 4; ++k)
+		near = near || depth[pair->vertices[k]] >= 0;
+	for (int i = 0; i < tail; ++i)
+		depth[queue[i]] = -1;
+	return near;
+}
+
+/// Self-contact pairs closer than d-hat in the rest shape (sim->rest) whose primitives are at
+/// most REST_RINGS edges apart, with their reach set to REST_REACH of their rest distance: a
+/// barrier of full reach would push on the rest shape from the first step (docs/contact.md
+/// "Pairs close at rest"). Pairs touching at rest keep d-hat (their evaluation reports them), and
+/// so do pairs farther apart on the mesh (two feathers of one mesh, a vane folded at rest): the
+/// barrier pushes those apart. False when out of memory.
+static bool find_rest_close(plume_sim *sim)
+{
+	sim_contact *contact = &sim->contact;
+	const plume_contact_def *def = &sim->def.contact;
+	if (!def->enabled || !def->self_contact || sim->face_count == 0)
+		return true;
+	double dhat = def->distance;
+	if (!find_candidates(sim, sim->rest, sim->rest, NULL, NULL, 0.5 * dhat))
+		return false;
+	adjacency graph = {NULL, NULL};
+	int *depth = NULL, *queue = NULL;
+	bool ok = true;
+	for (int p = 0; p < contact->pair_count && ok; ++p) {
+		sim_contact_pair pair = contact->pairs[p];
+		plume_vec3 points[4];
+		for (int k = 0; k < 4; ++k)
+			points[k] = sim->rest[pair.vertices[k]];
+		double d2 = pair_distance2(&pair, points);
+		if (!(d2 < dhat * dhat && d2 > 0))
+			continue;
+		if (depth == NULL) {
+			size_t n = (size_t)sim->vertex_count;
+			depth = plume_alloc(sizeof(int) * n);
+			queue = plume_alloc(sizeof(int) * n);
+			ok = depth != NULL && queue != NULL && build_adjacency(sim, &graph);
+			for (size_t v = 0; ok && v < n; ++v)
+				depth[v] = -1;
+			if (!ok)
+				break;
+		}
+		if (!topologically_near(&graph, &pair, depth, queue))
+			continue;
+		if (PLUME_GROW(contact->rest_close, contact->rest_close_capacity, contact->rest_close_count + 1) != 0) {
+			ok = false;
+			break;
+		}
+		pair.distance2 = d2;
+		pair.dhat = REST_REACH * sqrt(d2);
+		contact->rest_close[contact->rest_close_count++] = pair;
+	}
+	plume_free(graph.start), plume_free(graph.list), plume_free(depth), plume_free(queue);
+	// Sorted by key for the lookups.
+	if (ok)
+		qsort(contact->rest_close, (size_t)contact->rest_close_count, sizeof(sim_contact_pair), compare_pairs);
+	contact->pair_count = 0;
+	return ok;
+}
+
+/// A candidate's reach: d-hat, or the reduced reach of a pair close at rest.
+static double lookup_reach(const sim_contact *contact, const sim_contact_pair *pair, int vertex_count, double dhat)
+{
+	if (contact->rest_close_count == 0)
+		return dhat;
+	for (int k = 0; k < 4; ++k)
+		if (pair->vertices[k] >= vertex_count)
+			return dhat; // shell-obstacle
+	const sim_contact_pair *found =
+	    bsearch(pair, contact->rest_close, (size_t)contact->rest_close_count, sizeof(sim_contact_pair), compare_pairs);
+	return found != NULL ? found->dhat : dhat;
+}
+
+double plume_contact_pair_reach(const plume_sim *sim, const sim_contact_pair *pair)
+{
+	return lookup_reach(&sim->contact, pair, sim->vertex_count, sim->def.contact.distance);
+}
+
+double plume_contact_pair_stiffness(const plume_sim *sim, const sim_contact_pair *pair)
+{
+	const plume_contact_def *def = &sim->def.contact;
+	if (!def->adaptive_stiffness)
+		return def->stiffness;
+	// kappa |db/dd| at d = d-hat / 2 is 4.33 kappa d-hat^3 (b on squared distances): that force
+	// holds the pair's heaviest shell vertex at the (sub)step's acceleration.
+	double mass = 0;
+	for (int k = 0; k < 4; ++k)
+		if (pair->vertices[k] < sim->vertex_count)
+			mass = fmax(mass, sim->mass[pair->vertices[k]]);
+	if (!(mass > 0))
+		return def->stiffness; // massless vertices (no density): nothing to scale by
+	double dhat = def->distance;
+	return sim->contact.acceleration * mass / (barrier_push_at_half() * dhat * dhat * dhat);
+}
+
 bool plume_contact_init(plume_sim *sim)
 {
 	sim_contact *contact = &sim->contact;
 	memset(contact, 0, sizeof *contact);
 	contact->min_distance = INFINITY;
+	contact->step_min_distance = INFINITY;
+	contact->acceleration = contact->acceleration_floor = minimum_acceleration(sim);
 	contact->edge_count = collect_edges(sim->faces, sim->face_count, &contact->edges);
-	return contact->edge_count >= 0;
+	return contact->edge_count >= 0 && find_rest_close(sim);
 }
 
 void plume_contact_free(sim_contact *contact)
 {
 	for (int t = 0; t < SIM_TREE_COUNT; ++t)
 		plume_bvh_destroy(contact->trees[t]);
-	void *arrays[] = {contact->edges,           contact->obstacles,  contact->body_rest,
-	                  contact->body_start,      contact->body_end,   contact->body_x,
-	                  contact->body_from,       contact->body_faces, contact->body_edges,
-	                  contact->boxes,           contact->pairs,      contact->active,
-	                  contact->energy,          contact->gradient,   contact->hessian,
-	                  contact->body_lag,        contact->friction,   contact->friction_gradient,
-	                  contact->friction_hessian};
+	void *arrays[] = {contact->edges,
+	                  contact->obstacles,
+	                  contact->body_rest,
+	                  contact->body_start,
+	                  contact->body_end,
+	                  contact->body_x,
+	                  contact->body_from,
+	                  contact->body_faces,
+	                  contact->body_edges,
+	                  contact->boxes,
+	                  contact->pairs,
+	                  contact->active,
+	                  contact->energy,
+	                  contact->gradient,
+	                  contact->hessian,
+	                  contact->body_lag,
+	                  contact->friction,
+	                  contact->friction_gradient,
+	                  contact->friction_hessian,
+	                  contact->rest_close};
 	for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i)
 		plume_free(arrays[i]);
 	plume_pair_list_free(&contact->overlaps);
@@ -142,7 +340,7 @@ static bool reserve_pairs(sim_contact *contact)
 
 static void push_pair(sim_contact *contact, plume_contact_pair_type type, int a, int b, int c, int d)
 {
-	contact->pairs[contact->pair_count++] = (sim_contact_pair){type, {a, b, c, d}, INFINITY};
+	contact->pairs[contact->pair_count++] = (sim_contact_pair){type, {a, b, c, d}, INFINITY, 0};
 }
 
 /// Point-triangle candidates: points of tree `points` (indices `point_index`, offset into
@@ -307,7 +505,7 @@ static bool friction_pattern_holds(const plume_sim *sim);
 static bool find_active(plume_sim *sim, const plume_vec3 *x)
 {
 	sim_contact *contact = &sim->contact;
-	double dhat = sim->def.contact.distance, dhat2 = dhat * dhat, closest = INFINITY;
+	double dhat = sim->def.contact.distance, closest = INFINITY;
 	// Boxes inflated by d-hat / 2 overlap whenever the primitives are closer than d-hat.
 	if (!contact->reuse_candidates && !find_candidates(sim, x, x, contact->body_x, contact->body_x, 0.5 * dhat))
 		return false;
@@ -316,7 +514,10 @@ static bool find_active(plume_sim *sim, const plume_vec3 *x)
 		plume_vec3 points[4];
 		gather_pair(sim, pair, x, contact->body_x, points);
 		pair->distance2 = pair_distance2(pair, points);
-		if (pair->distance2 >= dhat2)
+		if (pair->distance2 >= dhat * dhat)
+			continue;
+		pair->dhat = lookup_reach(contact, pair, sim->vertex_count, dhat);
+		if (pair->distance2 >= pair->dhat * pair->dhat)
 			continue;
 		if (PLUME_GROW(contact->active, contact->active_capacity, contact->active_count + 1) != 0)
 			return false;
@@ -381,7 +582,6 @@ double plume_contact_evaluate(plume_sim *sim, const plume_vec3 *x, bool gradient
 		if (!holds && !rebuild_pattern(sim))
 			return fail(contact, PLUME_ERROR_MEMORY, "out of memory rebuilding the solver's pattern");
 	}
-	double dhat = def->distance;
 	plume_vec3 *rest = sim->rest;
 #pragma omp parallel for schedule(static) if (count >= 4096)
 	for (int k = 0; k < count; ++k) {
@@ -389,7 +589,8 @@ double plume_contact_evaluate(plume_sim *sim, const plume_vec3 *x, bool gradient
 		plume_vec3 points[4], reference[4];
 		gather_pair(sim, pair, x, contact->body_x, points);
 		gather_pair(sim, pair, rest, contact->body_rest, reference);
-		contact->energy[k] = plume_contact_pair_energy(pair->type, points, reference, dhat, def->stiffness, true,
+		contact->energy[k] = plume_contact_pair_energy(pair->type, points, reference, pair->dhat,
+		                                               plume_contact_pair_stiffness(sim, pair), true,
 		                                               gradient || hessian ? contact->gradient + 12 * (size_t)k : NULL,
 		                                               hessian ? contact->hessian + 144 * (size_t)k : NULL);
 	}
@@ -430,6 +631,16 @@ static void scatter_pair(plume_sim *sim, const int *vertices, const double *g, c
 			values[slot] += h[12 * a + b];
 		}
 	}
+}
+
+void plume_contact_energies(plume_sim *sim, const plume_vec3 *x, double *barrier, double *friction)
+{
+	*barrier = *friction = 0;
+	if (!plume_contact_on(sim))
+		return;
+	*barrier = plume_contact_evaluate(sim, x, false, false, false);
+	if (sim->def.contact.friction > 0 && sim->contact.friction_count > 0)
+		*friction = evaluate_friction(sim, x, false);
 }
 
 bool plume_contact_any(const plume_sim *sim) { return sim->contact.active_count > 0 || sim->contact.friction_used; }
@@ -487,7 +698,7 @@ static const double FRICTION_SPEED = 1e-4;
 static bool friction_pattern_holds(const plume_sim *sim)
 {
 	for (int k = 0; k < sim->contact.friction_count; ++k) {
-		sim_contact_pair pair = {PLUME_CONTACT_POINT_TRIANGLE, {0, 0, 0, 0}, 0};
+		sim_contact_pair pair = {PLUME_CONTACT_POINT_TRIANGLE, {0, 0, 0, 0}, 0, 0};
 		memcpy(pair.vertices, sim->contact.friction[k].vertices, sizeof pair.vertices);
 		if (!pattern_holds(sim, &pair))
 			return false;
@@ -548,11 +759,54 @@ static void closest_weights(const sim_contact_pair *pair, const plume_vec3 p[4],
 	w[0] = 1 - s, w[1] = s, w[2] = -(1 - t), w[3] = -t;
 }
 
+/// The adaptive stiffness's acceleration for a (sub)step of length h (0: statics), m/s^2: what
+/// the barrier must hold at d-hat / 2. Gravity and loads (the pushes of resting contact); in
+/// dynamics the fastest shell or obstacle vertex's speed over h, the deceleration that stops
+/// it within the step (a vertex hitting at v is stopped by m v / h, implicit Euler's inertia
+/// m (x~ - x) / h^2 for a prediction x~ a step v h past the contact); at least the floor.
+static double step_acceleration(const plume_sim *sim, double h)
+{
+	const sim_contact *contact = &sim->contact;
+	double a = fmax(contact->acceleration_floor, minimum_acceleration(sim)), speed = 0;
+	for (int i = 0; i < sim->vertex_count; ++i) {
+		if (sim->mass[i] > 0)
+			a = fmax(a, plume_v3_length(sim->load[i]) / sim->mass[i]);
+		speed = fmax(speed, plume_v3_length(sim->v[i]));
+	}
+	if (h > 0 && sim->def.time_step > 0)
+		for (int i = 0; i < contact->body_vertex_count; ++i)
+			speed = fmax(speed, plume_v3_distance(contact->body_start[i], contact->body_end[i]) / sim->def.time_step);
+	return h > 0 ? fmax(a, speed / h) : a;
+}
+
+static bool lag_friction(plume_sim *sim, double s0, double h);
+
+bool plume_contact_stiffen(plume_sim *sim, double previous, double closest)
+{
+	sim_contact *contact = &sim->contact;
+	double limit = DOUBLING_DISTANCE * sim->def.contact.distance;
+	double ceiling = MAX_ACCELERATION_RATIO * minimum_acceleration(sim);
+	if (!(closest < limit && closest < previous && contact->acceleration < ceiling))
+		return false;
+	contact->acceleration = fmin(2 * contact->acceleration, ceiling);
+	return true;
+}
+
 bool plume_contact_lag_friction(plume_sim *sim, double s0, double h)
 {
 	sim_contact *contact = &sim->contact;
-	const plume_contact_def *def = &sim->def.contact;
 	contact->friction_count = 0;
+	// The friction's normal forces are the barrier's pushes at the end of the last solve, with
+	// its stiffness: the (sub)step's own is fixed after them.
+	bool ok = lag_friction(sim, s0, h);
+	contact->acceleration = step_acceleration(sim, h);
+	return ok;
+}
+
+static bool lag_friction(plume_sim *sim, double s0, double h)
+{
+	sim_contact *contact = &sim->contact;
+	const plume_contact_def *def = &sim->def.contact;
 	if (!plume_contact_on(sim) || !(def->friction > 0) || !(h > 0))
 		return true;
 	contact->friction_epsilon = FRICTION_SPEED * h;
@@ -567,7 +821,10 @@ bool plume_contact_lag_friction(plume_sim *sim, double s0, double h)
 		double d2 = pair_distance2(pair, points), db;
 		if (!(d2 < dhat2 && d2 > 0))
 			continue;
-		plume_barrier(d2, dhat2, &db, NULL);
+		double reach = plume_contact_pair_reach(sim, pair);
+		if (!(d2 < reach * reach))
+			continue;
+		plume_barrier(d2, reach * reach, &db, NULL);
 		if (PLUME_GROW(contact->friction, contact->friction_capacity, contact->friction_count + 1) != 0)
 			return false;
 		sim_friction_pair *f = contact->friction + contact->friction_count;
@@ -585,7 +842,7 @@ bool plume_contact_lag_friction(plume_sim *sim, double s0, double h)
 		f->tangent[0] = plume_v3_normalize(plume_v3_cross(n, axis));
 		f->tangent[1] = plume_v3_cross(n, f->tangent[0]);
 		// -dE/dd = -kappa b'(d^2) 2 d: the barrier's push (b' < 0 within reach).
-		f->normal_force = -def->stiffness * db * 2 * sqrt(d2);
+		f->normal_force = -plume_contact_pair_stiffness(sim, pair) * db * 2 * sqrt(d2);
 		++contact->friction_count;
 	}
 	int count = contact->friction_count > 0 ? contact->friction_count : 1;
@@ -770,6 +1027,13 @@ plume_status plume_contact_begin(plume_sim *sim, double s0, double s1, double *r
 void plume_contact_finish(plume_sim *sim)
 {
 	sim_contact *contact = &sim->contact;
+	// IPC's doubling (Li et al. 2020, supplement "Adaptive barrier stiffness"): pairs that came
+	// far inside the reach say the barrier is soft for this motion; later steps start stiffer.
+	if (sim->def.contact.adaptive_stiffness &&
+	    contact->step_min_distance < DOUBLING_DISTANCE * sim->def.contact.distance)
+		contact->acceleration_floor =
+		    fmin(2 * contact->acceleration_floor, MAX_ACCELERATION_RATIO * minimum_acceleration(sim));
+	contact->step_min_distance = INFINITY;
 	if (contact->body_vertex_count > 0) // no obstacles: no arrays (memcpy wants pointers even for 0 bytes)
 		memcpy(contact->body_start, contact->body_end, sizeof(plume_vec3) * (size_t)contact->body_vertex_count);
 }

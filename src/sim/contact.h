@@ -17,6 +17,8 @@ typedef struct sim_contact_pair {
 	plume_contact_pair_type type;
 	int vertices[4];
 	double distance2;
+	/// The barrier's reach for this pair, m: d-hat, or less for a pair close at rest.
+	double dhat;
 } sim_contact_pair;
 
 /// A pair of IPC's lagged friction (Li et al. 2020, section 5.3), fixed at a step's start:
@@ -91,6 +93,20 @@ typedef struct sim_contact {
 	/// (newton.c sets it after a step's CCD, for the points of that step's segment): the
 	/// evaluations skip the broad phase.
 	bool reuse_candidates;
+	/// The barrier's stiffness (docs/contact.md "Stiffness"): with def.contact.adaptive_stiffness,
+	/// a pair's kappa is acceleration * (its shell vertices' mean mass) / (4.33 d-hat^3), so
+	/// the barrier at d-hat / 2 holds that mass at that acceleration; `acceleration` (m/s^2) is
+	/// fixed at each (sub)step's start (plume_contact_lag_friction) and `acceleration_floor`
+	/// (m/s^2) is raised after a step whose pairs came closer than d-hat / 10 (IPC's doubling).
+	double acceleration, acceleration_floor;
+	/// Self-contact pairs closer than d-hat at rest (sorted by type and vertices) and their
+	/// reach: half their rest distance, so the barrier does not push on the rest shape and still
+	/// keeps them apart (docs/contact.md "Pairs close at rest").
+	int rest_close_count, rest_close_capacity;
+	sim_contact_pair *rest_close;
+	/// The smallest pair distance over the accepted iterates since the last
+	/// plume_contact_finish, m (drives the floor's doubling).
+	double step_min_distance;
 	/// Why the last evaluation failed (out of memory: PLUME_ERROR_MEMORY; primitives touching:
 	/// PLUME_ERROR_NUMERIC), for the caller's error; PLUME_OK when it did not.
 	plume_status failure;
@@ -111,10 +127,15 @@ bool plume_contact_on(const struct plume_sim *sim);
 /// lagged friction of plume_contact_lag_friction.
 double plume_contact_evaluate(struct plume_sim *sim, const plume_vec3 *x, bool gradient, bool hessian, bool friction);
 
-/// Fixes the friction pairs of a (sub)step from fraction s0 of the step: the pairs within reach
-/// at its start (sim->previous, obstacles at s0), for a step of length h. None in statics
-/// (h = 0) or without friction. False when out of memory.
+/// Fixes what a (sub)step from fraction s0 of the step, of length h (0 in statics), keeps
+/// constant: the barrier's stiffness (adaptive: from the shell's speeds, loads and gravity at
+/// its start) and the friction pairs, those within reach at its start (sim->previous, obstacles
+/// at s0; none in statics or without friction). False when out of memory.
 bool plume_contact_lag_friction(struct plume_sim *sim, double s0, double h);
+/// The contact energies at shell positions x (obstacles at body_x), J: the barrier's (+inf when a
+/// pair touches) and the friction dissipation potential of the last (sub)step's lagged pairs
+/// (0 without friction, in statics and before the first step).
+void plume_contact_energies(struct plume_sim *sim, const plume_vec3 *x, double *barrier, double *friction);
 /// The last evaluation found pairs in reach or used friction (something to scatter).
 bool plume_contact_any(const struct plume_sim *sim);
 /// Adds the last evaluation's gradient (when gradient != NULL) and Hessian blocks (when
@@ -139,8 +160,19 @@ double plume_contact_step_bound(struct plume_sim *sim, const plume_vec3 *x0, con
 /// of the handles and obstacles. PLUME_ERROR_NUMERIC when the motion cannot advance (the
 /// caller subdivides the step).
 plume_status plume_contact_begin(struct plume_sim *sim, double s0, double s1, double *reached, plume_error *err);
-/// After a successful step or solve: the obstacles' end positions become their start.
+/// After a successful step or solve: the obstacles' end positions become their start, and the
+/// adaptive stiffness's floor doubles when the step's pairs came closer than d-hat / 10.
 void plume_contact_finish(struct plume_sim *sim);
+
+/// IPC's doubling within a solve: when the closest pair distance at an accepted iterate,
+/// `closest` (m), is below d-hat / 10 and below `previous`, the one at the accepted iterate
+/// before (+inf for the first), doubles the adaptive stiffness (up to its ceiling). True when it
+/// changed.
+bool plume_contact_stiffen(struct plume_sim *sim, double previous, double closest);
+
+/// The barrier stiffness kappa of a pair (J/m^4) and its reach d-hat (m).
+double plume_contact_pair_stiffness(const struct plume_sim *sim, const sim_contact_pair *pair);
+double plume_contact_pair_reach(const struct plume_sim *sim, const sim_contact_pair *pair);
 
 /// Force the shell exerts on an obstacle through the barrier at shell positions x, N: minus the
 /// barrier's gradient with respect to the obstacle's vertices (which the solver never uses).

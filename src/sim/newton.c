@@ -225,6 +225,7 @@ static plume_status newton_system(plume_sim *sim, const sim_problem *problem, bo
 	if (plume_contact_on(sim)) {
 		report->contact_pairs = sim->contact.active_count;
 		report->min_distance = fmin(report->min_distance, sim->contact.min_distance);
+		sim->contact.step_min_distance = fmin(sim->contact.step_min_distance, sim->contact.min_distance);
 	}
 	for (int i = 0; i < n3; ++i)
 		if (sim->fixed[i])
@@ -285,6 +286,7 @@ static plume_status newton(plume_sim *sim, const sim_problem *problem, plume_sol
 	// stiffness makes force residuals a poor test; a step below CONTACT_VELOCITY_TOLERANCE
 	// of the shell's size per second (times the step length h) means the iterate has stopped.
 	double h = problem->dynamic ? problem->h : 1;
+	double previous_closest = INFINITY;
 
 	for (int iteration = 0;; ++iteration) {
 		double phi, residual;
@@ -420,6 +422,16 @@ static plume_status newton(plume_sim *sim, const sim_problem *problem, plume_sol
 		for (int k = 0; k < m; ++k)
 			sim->lambda[k] += alpha * (step[n3 + k] - sim->lambda[k]);
 		exact = alpha == 1;
+		// IPC's adaptive stiffness within a solve (Li et al. 2020, supplement): an accepted
+		// iterate far inside the barrier's reach and closer than the one before says the barrier
+		// is too soft to stop this motion: double it. The potential changes, so the merit's trace
+		// (which must decrease) starts again. The last evaluation was at the accepted iterate.
+		if (contact && sim->def.contact.adaptive_stiffness) {
+			double closest = sim->contact.min_distance;
+			if (plume_contact_stiffen(sim, previous_closest, closest))
+				sim->trace_count = 0;
+			previous_closest = closest;
+		}
 	}
 	report->max_barb_strain = plume_sim_max_barb_strain(sim, x);
 	return plume_error_set(err, PLUME_ERROR_NUMERIC,

@@ -35,6 +35,7 @@ plume_sim_def plume_sim_default_def(void)
 	def.contact.enabled = false;
 	def.contact.distance = 1.2e-4;
 	def.contact.stiffness = 1e6;
+	def.contact.adaptive_stiffness = true;
 	def.contact.self_contact = true;
 	def.contact.ccd_separation = 0.1;
 	def.contact.friction = 0;
@@ -927,5 +928,6 @@ plume_sim_energies plume_sim_energy(plume_sim *sim)
 		out.gravity -= sim->mass[i] * plume_v3_dot(sim->def.gravity, sim->x[i]) + plume_v3_dot(sim->load[i], sim->x[i]);
 		out.kinetic += 0.5 * sim->mass[i] * plume_v3_dot(sim->v[i], sim->v[i]);
 	}
+	plume_contact_energies(sim, sim->x, &out.contact, &out.friction);
 	return out;
 }
