@@ -454,24 +454,6 @@ static plume_status load_feather(const char *file, const json_t *value, const ch
 // ---------------------------------------------------------------------------
 // Many feathers (docs/scene.md "Many feathers")
 
-/// Moves a feather (and its afterfeather) rigidly: every point p goes to rotation p + translation.
-static void move_feather(plume_feather *feather, plume_mat3 rotation, plume_vec3 translation)
-{
-	for (int i = 0; i < feather->shaft_count; ++i) {
-		plume_shaft_sample *s = feather->shaft + i;
-		s->position = plume_v3_add(plume_m3_apply(rotation, s->position), translation);
-		s->tangent = plume_m3_apply(rotation, s->tangent);
-		s->normal = plume_m3_apply(rotation, s->normal);
-		s->binormal = plume_m3_apply(rotation, s->binormal);
-	}
-	for (int i = 0; i < feather->point_count; ++i) {
-		feather->points[i] = plume_v3_add(plume_m3_apply(rotation, feather->points[i]), translation);
-		feather->normals[i] = plume_m3_apply(rotation, feather->normals[i]);
-	}
-	if (feather->afterfeather != NULL)
-		move_feather(feather->afterfeather, rotation, translation);
-}
-
 /// A feather of "feathers" while the scene is read: in its own frame until it is meshed.
 typedef struct pending_feather {
 	plume_feather *feather;
@@ -659,7 +641,7 @@ static plume_status expand_coat(const char *file, const char *name, const char *
 		plume_vec3 origin;
 		plume_coat_feather_frame(coat, k, &rotation, &origin);
 		plume_mat3 inverse = plume_m3_transpose(rotation);
-		move_feather(feather, inverse, plume_v3_scale(plume_m3_apply(inverse, origin), -1));
+		plume_feather_move(feather, inverse, plume_v3_scale(plume_m3_apply(inverse, origin), -1));
 		item->rotation = plume_m3_mul(entry->rotation, rotation);
 		item->translation = plume_v3_add(plume_m3_apply(entry->rotation, origin), entry->translation);
 		if (entry->named) {
@@ -976,7 +958,7 @@ static plume_status build_many(const char *file, const json_t *array, const plum
 			plume_error_prefix(err, prefix);
 			break;
 		}
-		move_feather(item->feather, item->rotation, item->translation);
+		plume_feather_move(item->feather, item->rotation, item->translation);
 		if (options != NULL && options->progress != NULL)
 			options->progress(options->progress_user, i + 1, list.count);
 		plume_mesh_report report = item->report;
