@@ -381,6 +381,7 @@ static plume_status write_summary(cli_output *output, const plume_scene *scene, 
 	json_object_set_new(root, "seconds_assembly", json_real(summary->seconds_assembly));
 	json_object_set_new(root, "seconds_factorization", json_real(summary->seconds_factor));
 	json_object_set_new(root, "seconds_solve", json_real(summary->seconds_solve));
+	json_object_set_new(root, "seconds_contact", json_real(summary->seconds_contact));
 	json_object_set_new(root, "max_barb_strain", json_real(summary->max_barb_strain));
 	json_object_set_new(root, "rachis_tip_deflection", json_real(summary->rachis_tip_deflection));
 	json_object_set_new(root, "vertices", json_integer(summary->vertex_count));

@@ -145,6 +145,7 @@ typedef struct plume_scene_summary {
 	double seconds_assembly;
 	double seconds_factor;
 	double seconds_solve;
+	double seconds_contact;
 	double max_barb_strain;
 	/// Mean displacement of the rachis_tip group from rest at the end, m (0 without that group).
 	double rachis_tip_deflection;

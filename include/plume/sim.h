@@ -221,6 +221,9 @@ typedef struct plume_solve_report {
 	double seconds_assembly;
 	double seconds_factor;
 	double seconds_solve;
+	/// Seconds in contact detection: the broad phase and CCD bounding the steps and the
+	/// prescribed motion (the barrier's own terms count as assembly). 0 without contact.
+	double seconds_contact;
 	/// Contact (with def.contact.enabled): pairs of primitives within the barrier's reach at the
 	/// end, and the smallest pair distance seen at accepted iterates, m (+inf when none was
 	/// within reach).

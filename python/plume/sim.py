@@ -27,6 +27,7 @@ def _solve_report(r: Any) -> dict:
         "seconds_assembly": r.seconds_assembly,
         "seconds_factor": r.seconds_factor,
         "seconds_solve": r.seconds_solve,
+        "seconds_contact": r.seconds_contact,
     }
 
 

@@ -344,7 +344,9 @@ static plume_status newton(plume_sim *sim, const sim_problem *problem, plume_sol
 		double bound = 1;
 		if (contact) {
 			apply_step(sim, x, step, 1, sim->trial);
+			double t0 = omp_get_wtime();
 			bound = plume_contact_step_bound(sim, x, sim->trial, sim->contact.body_x, sim->contact.body_x);
+			report->seconds_contact += omp_get_wtime() - t0;
 			if (isnan(bound))
 				return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory finding contact pairs");
 			// Those candidates hold every pair in reach anywhere on the segment x -> x + step:
@@ -394,8 +396,13 @@ static plume_status newton(plume_sim *sim, const sim_problem *problem, plume_sol
 					// The corrected point must be reached without passing through anything, too;
 					// it leaves the segment, so the evaluations from here on query again.
 					sim->contact.reuse_candidates = false;
-					if (contact && !(plume_contact_step_bound(sim, x, sim->scratch, sim->contact.body_x,
-					                                          sim->contact.body_x) >= 1)) {
+					double t0 = omp_get_wtime();
+					double corrected_bound =
+					    contact
+					        ? plume_contact_step_bound(sim, x, sim->scratch, sim->contact.body_x, sim->contact.body_x)
+					        : 1;
+					report->seconds_contact += omp_get_wtime() - t0;
+					if (!(corrected_bound >= 1)) {
 						alpha *= 0.5;
 						continue;
 					}

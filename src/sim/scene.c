@@ -231,6 +231,7 @@ plume_status plume_scene_run(const plume_scene *scene, plume_scene_step_fn *on_s
 		summary->seconds_assembly += report.seconds_assembly;
 		summary->seconds_factor += report.seconds_factor;
 		summary->seconds_solve += report.seconds_solve;
+		summary->seconds_contact += report.seconds_contact;
 		summary->max_barb_strain = fmax(summary->max_barb_strain, report.max_barb_strain);
 		summary->retried_steps += report.substeps > 1;
 		if (scene->sim.contact.enabled) {

@@ -5,6 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <omp.h>
+
 #include "../core/asserts.h"
 #include "core/alloc.h"
 #include "sim/sim_internal.h"
@@ -716,6 +718,7 @@ static void add_report(plume_solve_report *total, const plume_solve_report *part
 	total->seconds_assembly += part->seconds_assembly;
 	total->seconds_factor += part->seconds_factor;
 	total->seconds_solve += part->seconds_solve;
+	total->seconds_contact += part->seconds_contact;
 	total->gradient_norm = part->gradient_norm;
 	total->energy = part->energy;
 	total->converged = part->converged;
@@ -736,7 +739,9 @@ static plume_status solve_substep(plume_sim *sim, const sim_problem *problem, do
 	if (!plume_contact_lag_friction(sim, s0, problem->dynamic ? problem->h : 0))
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory finding friction pairs");
 	for (int round = 0; round < MAX_CONTACT_ROUNDS; ++round) {
+		double t0 = omp_get_wtime();
 		plume_status status = plume_contact_begin(sim, s0, s1, &reached, err);
+		total->seconds_contact += omp_get_wtime() - t0;
 		if (status != PLUME_OK)
 			return status;
 		plume_solve_report part = {0};
