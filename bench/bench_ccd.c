@@ -1,3 +1,4 @@
+#define _POSIX_C_SOURCE 200809L // clock_gettime (bench_support.h)
 // Benchmark: contact detection (issue 14). Prints
 //  - additive CCD queries per second (point-triangle and edge-edge, separation 0.1) over a
 //    seeded random sweep like test_ccd's: generic motions and motions forced to collide,

@@ -1,3 +1,4 @@
+#define _POSIX_C_SOURCE 200809L // clock_gettime (bench_support.h)
 // Benchmark: feather coats (Streit & Heidrich 4.4). The paper's Figure 15 (64
 // feathers, "computed in real time" on a 2002 PC) and a 10,000-feather coat,
 // built with OpenMP over the follicles. Prints medians; the 64-feather coat

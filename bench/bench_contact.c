@@ -1,3 +1,4 @@
+#define _POSIX_C_SOURCE 200809L // clock_gettime
 // Benchmark: contact in the simulator on a real feather. The hawk of
 // examples/scenes/swing.json (e = 5 mm), released flat 1 mm above a ground (two triangles)
 // with self-contact on, falls and settles under gravity. Prints, per run: steps, Newton

@@ -1,3 +1,4 @@
+#define _POSIX_C_SOURCE 200809L // clock_gettime (bench_support.h)
 // Benchmark: the hawk preset (2 vanes x 2200 barbs x 30 samples) — generation,
 // export and a 2000 x 2000 PNG render. Prints medians over repeated runs.
 //

@@ -1,3 +1,4 @@
+#define _POSIX_C_SOURCE 200809L // clock_gettime (bench_support.h)
 // Benchmark: the intersection check (plume_find_intersections, docs/contact.md) on sheets of
 // n x n quads: flat in z = 0 (the floating-point filter or the zero-column shortcut decides
 // every pair), flat but rotated (its neighbours are coplanar within rounding, so the exact GMP

@@ -1,3 +1,4 @@
+#define _POSIX_C_SOURCE 200809L // clock_gettime (bench_support.h)
 // Benchmark: barb-aligned mesh quality of every example feather (Franco-Walter,
 // Streit-Heidrich, Zhang-Kanai) at e = 5 mm and 2.5 mm: vane faces, the smallest
 // vane angle, the faces under 20 degrees and where they lie (touching the rachis,

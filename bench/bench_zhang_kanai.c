@@ -1,3 +1,4 @@
+#define _POSIX_C_SOURCE 200809L // clock_gettime (bench_support.h)
 // Benchmark: the Zhang–Kanai generator (issue 4). Prints the time to generate
 // a feather of 2 x 400 barbs with expansion (median of repeated runs, one
 // thread) and the time per frame of a 100-frame growth sequence of it. The
