@@ -202,7 +202,7 @@ static bool find_rest_close(plume_sim *sim)
 	}
 	plume_free(graph.start), plume_free(graph.list), plume_free(depth), plume_free(queue);
 	// Sorted by key for the lookups.
-	if (ok)
+	if (ok && contact->rest_close_count > 0) // (qsort of an empty, never allocated list is undefined)
 		qsort(contact->rest_close, (size_t)contact->rest_close_count, sizeof(sim_contact_pair), compare_pairs);
 	contact->pair_count = 0;
 	return ok;
