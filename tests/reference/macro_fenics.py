@@ -104,48 +104,10 @@ def macro_traction(W, H, theta, E_vv, E_ww, E_vw, strain_max, steps, h):
     e_vw = df.dot(v, Egl * n)
     # Eq. 4.1: S_vv = E_vv e_vv, S_ww = E_ww e_ww, S_vw = E_vw (2 e_vw); energy (b / 2) S : eps.
     energy = 0.5 * THICKNESS * (E_vv * e_vv ** 2 + E_ww * e_ww ** 2 + E_vw * (2.0 * e_vw) ** 2) * df.dx
-    residual = df.derivative(energy, u, df.TestFunction(V))
-    jacobian = df.derivative(residual, u, df.TrialFunction(V))
-
-    def bottom(x, on_boundary):
-        return on_boundary and x[1] < 1e-9 * H
-
-    def top(x, on_boundary):
-        return on_boundary and x[1] > H * (1.0 - 1e-9)
-
-    lift = df.Constant((0.0, 0.0))
-    bcs = [df.DirichletBC(V, df.Constant((0.0, 0.0)), bottom), df.DirichletBC(V, lift, top)]
-    # The clamp force: the residual tested with a field that is (0, 1) on the top edge.
-    probe = df.Function(V)
-    df.DirichletBC(V, df.Constant((0.0, 1.0)), top).apply(probe.vector())
-    force_form = df.derivative(energy, u, probe)
-
-    problem = df.NonlinearVariationalProblem(residual, u, bcs, jacobian)
-    solver = df.NonlinearVariationalSolver(problem)
-    prm = solver.parameters["newton_solver"]
-    prm["report"] = bool(os.environ.get("LAB_FENICS_VERBOSE"))
-    prm["linear_solver"] = "mumps"
-    prm["absolute_tolerance"] = 1e-13 * E_vv * THICKNESS * W
-    prm["relative_tolerance"] = 1e-10
-    prm["maximum_iterations"] = 30
-
-    strains, stresses = [0.0], [0.0]
-    d_prev = 0.0
-    for i in range(1, steps + 1):
-        strain = strain_max * i / steps
-        d = H * (math.sqrt(1.0 + 2.0 * strain) - 1.0)
-        if d_prev > 0.0:
-            u.vector()[:] = u.vector().get_local() * (d / d_prev)
-        else:
-            # First step: start from the uniform stretch rather than from the clamp's
-            # displacement on the top row of nodes alone.
-            u.assign(df.interpolate(df.Expression(("0.0", "d * x[1] / H"), d=d, H=H, degree=1), V))
-        lift.assign(df.Constant((0.0, d)))
-        solver.solve()
-        f = df.assemble(force_form)
-        strains.append(strain)
-        stresses.append(H * f / (THICKNESS * W * (H + d)))
-        d_prev = d
+    # First step from the uniform stretch rather than from the clamp's displacement on the
+    # top row of nodes alone.
+    strains, stresses = meso.clamped_traction(V, u, energy, W, H, strain_max, steps,
+                                              1e-13 * E_vv * THICKNESS * W, 1e-10, uniform_start=True)
     return meso.fitted_slope(strains, stresses), mesh.num_cells()
 
 
