@@ -4,7 +4,7 @@
 set -euo pipefail
 
 packages=(build-essential cmake pkg-config libcairo2-dev libjansson-dev libstb-dev libcmocka-dev
-	libsuitesparse-dev libembree-dev libqhull-dev libplplot-dev libgmp-dev)
+	libsuitesparse-dev libopenblas0-serial libembree-dev libqhull-dev libplplot-dev libgmp-dev)
 # The Python binding (python/) and its tests.
 packages+=(python3-cffi python3-numpy python3-pytest)
 # PNG decoding in the .glb texture check (tests/glb_check.py) and the plots of python/examples.

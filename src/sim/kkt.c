@@ -1,6 +1,6 @@
 // The Newton systems' sparse matrix: a pattern built once per mesh, values
-// scattered into precomputed slots, CHOLMOD factorisation (see kkt.h for why
-// simplicial LDL' with constraints and simplicial LL' without).
+// scattered into precomputed slots, the constraints' multipliers eliminated into a
+// positive definite matrix that CHOLMOD factors (kkt.h says why).
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -72,23 +72,28 @@ static plume_status build(plume_kkt *kkt, int vertex_count, int face_count, cons
 		failed = push_block(&list, extra + 4 * k, 4);
 	for (int k = 0; k < constraint_count && !failed; ++k) {
 		int column = kkt->dof_count + k;
-		if (PLUME_GROW(list.items, list.capacity, list.count + 7) != 0) {
+		if (PLUME_GROW(list.items, list.capacity, list.count + 6) != 0) {
 			failed = 1;
 			break;
 		}
 		for (int e = 0; e < 2; ++e)
 			for (int d = 0; d < 3; ++d)
 				list.items[list.count++] = (plume_sparse_entry){column, 3 * constraint_vertices[2 * k + e] + d};
-		list.items[list.count++] = (plume_sparse_entry){column, column};
 	}
 	if (failed) {
 		plume_free(list.items);
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory building the solver's sparse pattern");
 	}
-	// LL' without constraints, so that an indefinite H reports itself; the KKT matrix is
-	// quasi-definite, never positive definite: LDL'.
-	plume_status status = plume_sparse_init(&kkt->system, size, list.items, (size_t)list.count, constraint_count == 0,
-	                                        "the solver's matrix", err);
+	// K stored in the natural order, sorted by column: its position block (columns below
+	// dof_count) comes first, and those entries, still sorted and unique in the list, are
+	// the pattern of the factored matrix (C^T R C couples a constraint's two vertices,
+	// whose block is already there).
+	plume_status status =
+	    plume_sparse_init(&kkt->system, size, list.items, (size_t)list.count, false, "the solver's matrix", err);
+	int position_entries = status == PLUME_OK ? ((const int *)kkt->system.matrix->p)[kkt->dof_count] : 0;
+	if (status == PLUME_OK)
+		status = plume_sparse_init(&kkt->positions, kkt->dof_count, list.items, (size_t)position_entries, true,
+		                           "the solver's matrix", err);
 	plume_free(list.items);
 	if (status != PLUME_OK) {
 		plume_kkt_free(kkt);
@@ -101,9 +106,14 @@ static plume_status build(plume_kkt *kkt, int vertex_count, int face_count, cons
 	int block = 9 * bending_size * bending_size;
 	kkt->bending_size = bending_size;
 	kkt->bending_slots = plume_alloc(sizeof(int) * (size_t)block * (size_t)(bending_count > 0 ? bending_count : 1));
-	kkt->constraint_slots = plume_alloc(sizeof(int) * 7 * (size_t)(constraint_count > 0 ? constraint_count : 1));
-	kkt->pair_slots = plume_alloc(sizeof(int) * 36 * (size_t)(constraint_count > 0 ? constraint_count : 1));
-	if (!kkt->vertex_slots || !kkt->face_slots || !kkt->bending_slots || !kkt->constraint_slots || !kkt->pair_slots) {
+	size_t constraints = (size_t)(constraint_count > 0 ? constraint_count : 1);
+	kkt->constraint_slots = plume_alloc(sizeof(int) * 6 * constraints);
+	kkt->pair_slots = plume_alloc(sizeof(int) * 36 * constraints);
+	kkt->augment_slots = plume_alloc(sizeof(int) * 36 * constraints);
+	kkt->rho = plume_alloc(sizeof(double) * constraints);
+	kkt->position_slots = plume_alloc(sizeof(int) * (size_t)(position_entries > 0 ? position_entries : 1));
+	if (!kkt->vertex_slots || !kkt->face_slots || !kkt->bending_slots || !kkt->constraint_slots || !kkt->pair_slots ||
+	    !kkt->augment_slots || !kkt->rho || !kkt->position_slots) {
 		plume_kkt_free(kkt);
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory allocating the solver's slot maps");
 	}
@@ -117,11 +127,15 @@ static plume_status build(plume_kkt *kkt, int vertex_count, int face_count, cons
 	for (int k = 0; k < constraint_count; ++k) {
 		int column = kkt->dof_count + k;
 		fill_block_slots(matrix, constraint_vertices + 2 * k, 2, kkt->pair_slots + 36 * k);
+		fill_block_slots(&kkt->positions, constraint_vertices + 2 * k, 2, kkt->augment_slots + 36 * k);
 		for (int a = 0; a < 6; ++a)
-			kkt->constraint_slots[7 * k + a] =
+			kkt->constraint_slots[6 * k + a] =
 			    plume_sparse_find(matrix, 3 * constraint_vertices[2 * k + a / 3] + a % 3, column);
-		kkt->constraint_slots[7 * k + 6] = plume_sparse_find(matrix, column, column);
 	}
+	const int *p = matrix->matrix->p, *rows = matrix->matrix->i;
+	for (int column = 0; column < kkt->dof_count; ++column)
+		for (int e = p[column]; e < p[column + 1]; ++e)
+			kkt->position_slots[e] = plume_sparse_find(&kkt->positions, rows[e], column);
 
 	return PLUME_OK;
 }
@@ -150,6 +164,10 @@ plume_status plume_kkt_set_extra_blocks(plume_kkt *kkt, int count, const int *ve
 void plume_kkt_free(plume_kkt *kkt)
 {
 	plume_sparse_free(&kkt->system);
+	plume_sparse_free(&kkt->positions);
+	plume_free(kkt->position_slots);
+	plume_free(kkt->augment_slots);
+	plume_free(kkt->rho);
 	plume_free(kkt->vertex_slots);
 	plume_free(kkt->face_slots);
 	plume_free(kkt->bending_slots);
@@ -187,18 +205,51 @@ static void shift_positions(plume_kkt *kkt, double amount)
 			values[kkt->vertex_slots[9 * v + 4 * d]] += amount;
 }
 
+/// rho_k over the largest diagonal entry of H at the constraint's free unknowns: large
+/// enough that H + C^T R C is positive definite whenever H is on the constraints' tangent
+/// space and that refinement converges in a few steps, small enough that the factored
+/// matrix stays well conditioned. Measured on Figure 1 (docs/simulation.md, "Linear
+/// algebra"): 1e3 refuses exact Hessians the LDL' inertia accepted and a step fails;
+/// 1e4 converges to positions 1.9e-9 m from the LDL' solver's; 1e6 to 6e-17 m with 4.4
+/// solves an iteration; 1e8 to 1e-16 m with 5.4.
+static const double AUGMENTATION = 1e6;
+
+/// The factored matrix from K: H's entries, then C^T R C with rho_k from H's diagonal.
+static void load_positions(plume_kkt *kkt)
+{
+	const double *stored = kkt->system.matrix->x;
+	double *values = kkt->positions.matrix->x;
+	int position_entries = ((const int *)kkt->system.matrix->p)[kkt->dof_count];
+	for (int e = 0; e < position_entries; ++e)
+		values[kkt->position_slots[e]] = stored[e];
+	for (int k = 0; k < kkt->constraint_count; ++k) {
+		const int *vertices = kkt->constraint_vertices + 2 * k;
+		double c[6], diagonal = 0;
+		for (int a = 0; a < 6; ++a) {
+			c[a] = stored[kkt->constraint_slots[6 * k + a]];
+			if (c[a] != 0)
+				diagonal = fmax(diagonal, fabs(stored[kkt->vertex_slots[9 * vertices[a / 3] + 4 * (a % 3)]]));
+		}
+		double rho = kkt->rho[k] = AUGMENTATION * (diagonal > 0 ? diagonal : 1);
+		const int *slots = kkt->augment_slots + 36 * k;
+		for (int a = 0; a < 6; ++a)
+			for (int b = 0; b < 6; ++b)
+				if (slots[6 * a + b] >= 0)
+					values[slots[6 * a + b]] += rho * c[a] * c[b];
+	}
+}
+
 plume_status plume_kkt_factor(plume_kkt *kkt, bool allow_shift, double *shift, plume_error *err)
 {
 	*shift = 0;
-	bool factored = plume_sparse_factor(&kkt->system);
-	if (factored && !allow_shift && kkt->constraint_count > 0 &&
-	    plume_sparse_negative_pivots(&kkt->system) != kkt->constraint_count)
-		return plume_error_set(err, PLUME_ERROR_NUMERIC,
-		                       "the Newton matrix is not positive definite on the constraints' tangent space");
-	if (factored)
+	load_positions(kkt);
+	if (plume_sparse_factor(&kkt->positions))
 		return PLUME_OK;
 	if (!allow_shift)
-		return plume_error_set(err, PLUME_ERROR_NUMERIC, "the Newton matrix is not positive definite");
+		return plume_error_set(err, PLUME_ERROR_NUMERIC,
+		                       kkt->constraint_count > 0
+		                           ? "the Newton matrix is not positive definite on the constraints' tangent space"
+		                           : "the Newton matrix is not positive definite");
 	// Not positive definite on the positions (a free rigid motion in statics, or an
 	// indefinite constraint curvature term): Levenberg-style shifts, growing tenfold.
 	double base = mean_position_diagonal(kkt);
@@ -209,49 +260,66 @@ plume_status plume_kkt_factor(plume_kkt *kkt, bool allow_shift, double *shift, p
 		double wanted = factor * base;
 		shift_positions(kkt, wanted - applied);
 		applied = wanted;
-		if (plume_sparse_factor(&kkt->system)) {
+		load_positions(kkt);
+		if (plume_sparse_factor(&kkt->positions)) {
 			*shift = applied;
 			return PLUME_OK;
 		}
 	}
 	return plume_error_set(err, PLUME_ERROR_NUMERIC,
 	                       "the Newton system could not be factored (CHOLMOD status %d) even after regularisation",
-	                       kkt->system.common.status);
+	                       kkt->positions.common.status);
 }
 
-static plume_status solve_once(plume_kkt *kkt, const double *rhs, double *solution, plume_error *err)
+/// [dx; lambda] = M^-1 [r1; r2] for the regularised matrix M = [H C^T; C -R^-1]:
+/// (H + C^T R C) dx = r1 + C^T R r2, lambda = R (C dx - r2).
+static plume_status solve_regularised(plume_kkt *kkt, const double *rhs, double *solution, plume_error *err)
 {
-	plume_sparse *system = &kkt->system;
-	memcpy(system->rhs->x, rhs, sizeof(double) * system->rhs->nrow);
-	if (!plume_sparse_solve(system))
-		return plume_error_set(err, PLUME_ERROR_NUMERIC, "CHOLMOD solve failed (status %d)", system->common.status);
-	memcpy(solution, system->solution->x, sizeof(double) * system->rhs->nrow);
+	plume_sparse *positions = &kkt->positions;
+	const double *stored = kkt->system.matrix->x;
+	int n = kkt->dof_count;
+	double *b = positions->rhs->x;
+	memcpy(b, rhs, sizeof(double) * (size_t)n);
+	for (int k = 0; k < kkt->constraint_count; ++k) {
+		double weight = kkt->rho[k] * rhs[n + k];
+		for (int a = 0; a < 6; ++a)
+			b[3 * kkt->constraint_vertices[2 * k + a / 3] + a % 3] += weight * stored[kkt->constraint_slots[6 * k + a]];
+	}
+	if (!plume_sparse_solve(positions))
+		return plume_error_set(err, PLUME_ERROR_NUMERIC, "CHOLMOD solve failed (status %d)", positions->common.status);
+	const double *dx = positions->solution->x;
+	memcpy(solution, dx, sizeof(double) * (size_t)n);
+	for (int k = 0; k < kkt->constraint_count; ++k) {
+		double cdx = 0;
+		for (int a = 0; a < 6; ++a)
+			cdx += stored[kkt->constraint_slots[6 * k + a]] * dx[3 * kkt->constraint_vertices[2 * k + a / 3] + a % 3];
+		solution[n + k] = kkt->rho[k] * (cdx - rhs[n + k]);
+	}
 	return PLUME_OK;
 }
 
 /// At most this many refinement steps (each one solve); refinement stops earlier once
 /// the backward error is below REFINEMENT_TOLERANCE or stops falling.
-enum { REFINEMENT_STEPS = 3 };
+enum { REFINEMENT_STEPS = 8 };
 static const double REFINEMENT_TOLERANCE = 1e-14;
 
-/// residual = rhs - K0 x with K0 the matrix without the -d diagonal of the constraint rows,
-/// and the componentwise backward error max_i |residual_i| / (|K0| |x| + |rhs|)_i
-/// (Arioli, Demmel & Duff 1989): the relative change of K0's entries and of rhs that makes
-/// x exact. Rows whose denominator is zero (held unknowns, zero rows) do not count.
+/// residual = rhs - K x and the componentwise backward error
+/// max_i |residual_i| / (|K| |x| + |rhs|)_i (Arioli, Demmel & Duff 1989): the relative
+/// change of K's entries and of rhs that makes x exact. Rows whose denominator is zero
+/// (held unknowns, zero rows) do not count.
 static double backward_error(const plume_kkt *kkt, const double *rhs, const double *x, double *residual, double *scale)
 {
-	const int *p = kkt->system.matrix->p, *rows = kkt->system.matrix->i, *unknown = kkt->system.permutation;
-	const double *values = kkt->system.matrix->x;
-	size_t size = kkt->system.matrix->ncol;
+	const cholmod_sparse *stored = kkt->system.matrix;
+	const int *p = stored->p, *rows = stored->i;
+	const double *values = stored->x;
+	size_t size = stored->ncol;
 	for (size_t i = 0; i < size; ++i) {
 		residual[i] = rhs[i];
 		scale[i] = fabs(rhs[i]);
 	}
-	for (size_t column = 0; column < size; ++column)
-		for (int e = p[column]; e < p[column + 1]; ++e) {
-			size_t i = (size_t)unknown[rows[e]], j = (size_t)unknown[column];
-			if (i == j && (int)j >= kkt->dof_count)
-				continue; // the regularisation: K0 has 0 there
+	for (size_t j = 0; j < size; ++j)
+		for (int e = p[j]; e < p[j + 1]; ++e) {
+			size_t i = (size_t)rows[e];
 			residual[i] -= values[e] * x[j];
 			scale[i] += fabs(values[e] * x[j]);
 			if (i != j) {
@@ -268,10 +336,10 @@ static double backward_error(const plume_kkt *kkt, const double *rhs, const doub
 
 plume_status plume_kkt_solve(plume_kkt *kkt, const double *rhs, double *solution, plume_error *err)
 {
-	plume_status status = solve_once(kkt, rhs, solution, err);
+	plume_status status = solve_regularised(kkt, rhs, solution, err);
 	if (status != PLUME_OK || kkt->constraint_count == 0)
 		return status;
-	size_t size = kkt->system.rhs->nrow;
+	size_t size = kkt->system.matrix->ncol;
 	if (kkt->refine == NULL && (kkt->refine = plume_alloc(3 * sizeof(double) * size)) == NULL)
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory refining the Newton step");
 	double *residual = kkt->refine, *correction = kkt->refine + size, *scale = kkt->refine + 2 * size;
@@ -281,7 +349,7 @@ plume_status plume_kkt_solve(plume_kkt *kkt, const double *rhs, double *solution
 		if (step == REFINEMENT_STEPS || error <= REFINEMENT_TOLERANCE || !(error < 0.5 * previous))
 			break;
 		previous = error;
-		if ((status = solve_once(kkt, residual, correction, err)) != PLUME_OK)
+		if ((status = solve_regularised(kkt, residual, correction, err)) != PLUME_OK)
 			return status;
 		for (size_t i = 0; i < size; ++i)
 			solution[i] += correction[i];
@@ -291,13 +359,5 @@ plume_status plume_kkt_solve(plume_kkt *kkt, const double *rhs, double *solution
 
 void plume_kkt_multiply_add(const plume_kkt *kkt, const double *x, double *y)
 {
-	const int *p = kkt->system.matrix->p, *rows = kkt->system.matrix->i, *unknown = kkt->system.permutation;
-	const double *values = kkt->system.matrix->x;
-	for (size_t column = 0; column < kkt->system.matrix->ncol; ++column)
-		for (int e = p[column]; e < p[column + 1]; ++e) {
-			size_t i = (size_t)unknown[rows[e]], j = (size_t)unknown[column];
-			y[i] += values[e] * x[j];
-			if (i != j)
-				y[j] += values[e] * x[i];
-		}
+	plume_sparse_multiply_add(&kkt->system, x, y);
 }

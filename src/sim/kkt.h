@@ -1,14 +1,23 @@
 // Private: the sparse symmetric systems of the Newton iteration, factored by CHOLMOD.
 //
 //   [ H   C^T ] [ dx     ]   [ -g ]
-//   [ C  -dI  ] [ lambda ] = [ -c ]
+//   [ C   0   ] [ lambda ] = [ -c ]
 //
 // H is the (projected) Hessian over 3 n position unknowns, C the Jacobian of the
-// barb-length constraints, d a tiny regularisation that makes the matrix
-// quasi-definite. A quasi-definite matrix has an LDL' factorisation for every
-// symmetric ordering (Vanderbei 1995), so CHOLMOD's simplicial LDL' factors it
-// without pivoting; its supernodal mode computes LL' only and cannot. Without
-// constraints the matrix is H alone, factored by Cholesky (LL', sim/sparse.h).
+// barb-length constraints. The callers assemble this matrix, K. It is solved through
+// the regularised matrix [H C^T; C -R^-1], R = diag(rho_k), whose Schur complement
+// eliminates the multipliers:
+//
+//   (H + C^T R C) dx = -g - C^T R c,    lambda = R (C dx + c),
+//
+// positive definite exactly when H is positive definite on the tangent space of the
+// constraints, for rho large enough (Debreu's lemma; Nocedal & Wright, Numerical
+// Optimization, 2nd ed., theorem 17.5), and then factored by Cholesky, supernodal where
+// it pays (sim/sparse.h). Iterative refinement against K itself removes the
+// regularisation's error (each step shrinks it by about 1/(1 + rho_k s_k), s_k the
+// constraint's compliance). This replaced a simplicial LDL' of the quasi-definite K
+// (Vanderbei 1995), which CHOLMOD cannot factor supernodally: docs/simulation.md,
+// "Linear algebra", measures both. Without constraints the matrix is H alone.
 // The pattern is fixed per mesh, the symbolic analysis runs once, except when contact
 // (sim/contact.c) couples vertices the mesh does not: plume_kkt_set_extra_blocks.
 #ifndef PLUME_SIM_KKT_H
@@ -20,8 +29,14 @@
 #include "sim/sparse.h"
 
 typedef struct plume_kkt {
-	/// The matrix (upper triangle, values rewritten every iteration) and its factorisation.
+	/// K, stored (upper triangle, natural order, values rewritten every iteration): the
+	/// callers add into its slots.
 	plume_sparse system;
+	/// H + C^T R C over the position unknowns, factored.
+	plume_sparse positions;
+	int *position_slots; ///< per stored entry of K's position block (they come first), its slot in positions
+	int *augment_slots;  ///< 36 per constraint: positions' slots of its two vertices' 6x6 block
+	double *rho;         ///< per constraint, the regularisation's rho_k of the last factorisation
 	int dof_count;
 	int constraint_count;
 	/// Slot of the entry for each element block pair (upper part), -1 for the lower part.
@@ -29,7 +44,7 @@ typedef struct plume_kkt {
 	int *bending_slots;    ///< (3 k)^2 per bending element of k vertices
 	int bending_size;      ///< k: 4 (hinge) or 6 (fundamental-form face)
 	int *vertex_slots;     ///< 9 per vertex
-	int *constraint_slots; ///< 7 per constraint: 6 Jacobian entries and the diagonal
+	int *constraint_slots; ///< 6 per constraint: its row of C
 	int *pair_slots;       ///< 36 per constraint: the 6x6 position block of its two vertices
 	double *refine;        ///< scratch for iterative refinement (3 x size)
 	/// plume_kkt_init's arguments (the caller keeps the arrays alive), for plume_kkt_set_extra_blocks.
@@ -59,18 +74,17 @@ void plume_kkt_zero(plume_kkt *kkt);
 /// Factors the current values. With allow_shift, a Hessian that is not positive
 /// definite on the free unknowns is shifted by growing multiples of its mean
 /// diagonal until it factors; *shift reports the shift used (0 normally). Without,
-/// such a matrix returns PLUME_ERROR_NUMERIC; with constraints that is decided by the
-/// inertia of the LDL' factors: the KKT matrix has exactly constraint_count negative
-/// pivots iff H + C^T C / d is positive definite (Sylvester's law of inertia), that is,
-/// with d tiny, iff H is positive definite on the tangent space of the constraints,
-/// which is what makes the step a descent direction of the l1 merit (Nocedal & Wright,
-/// Numerical Optimization, 2nd ed., sections 16.2 and 18.3).
+/// such a matrix returns PLUME_ERROR_NUMERIC: with constraints, when H + C^T R C is
+/// not positive definite, which (rho_k being 1e4 times the diagonal of H at the
+/// constraint's ends) says that H is not positive definite on the tangent space of the
+/// constraints, the condition for a descent direction of the l1 merit (Nocedal &
+/// Wright, sections 16.2 and 18.3).
 plume_status plume_kkt_factor(plume_kkt *kkt, bool allow_shift, double *shift, plume_error *err);
 
-/// Solves with the last factorisation: rhs and solution have dof_count + constraint_count entries.
-/// With constraints, iterative refinement against the unregularised matrix (d = 0) removes
-/// the regularisation's error, so the linearised constraints hold to rounding: a step
-/// only while the componentwise backward error is above 1e-14 and falling, at most 3.
+/// Solves K [dx; lambda] = rhs with the last factorisation: rhs and solution have
+/// dof_count + constraint_count entries. With constraints, iterative refinement against
+/// K: a step only while the componentwise backward error is above 1e-14 and falling, at
+/// most 8, so the linearised constraints hold to rounding.
 plume_status plume_kkt_solve(plume_kkt *kkt, const double *rhs, double *solution, plume_error *err);
 
 /// y += K x for the assembled (symmetric) matrix.

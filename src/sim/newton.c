@@ -32,10 +32,6 @@
 #include "sim/sim_internal.h"
 
 enum { MAX_BACKTRACKS = 30 };
-/// Constraint rows' regularisation, relative to the mean Hessian diagonal: small enough
-/// that the linearised constraint is met to ~1e-12 of the step, large enough to make the
-/// matrix quasi-definite.
-static const double KKT_REGULARISATION = 1e-15;
 /// A solve also requires every constrained barb edge's strain below this.
 static const double STRAIN_TOLERANCE = 1e-10;
 /// IPC's Newton tolerance on the step per unit time, relative to the shell's size (1/s).
@@ -81,19 +77,6 @@ static double max_constraint_strain(const plume_sim *sim, const plume_vec3 *x)
 	return worst;
 }
 
-static double mean_diagonal(const plume_sim *sim)
-{
-	const double *values = sim->kkt.system.matrix->x;
-	double sum = 0;
-	int count = 0;
-	for (int i = 0; i < 3 * sim->vertex_count; ++i)
-		if (!sim->fixed[i]) {
-			sum += values[sim->kkt.vertex_slots[9 * (i / 3) + 4 * (i % 3)]];
-			++count;
-		}
-	return count > 0 && sum > 0 ? sum / count : 1;
-}
-
 /// Adds the constraint rows to the assembled matrix, puts the Lagrangian gradient
 /// g + C^T lambda in sim->residual and the right-hand side [-g; -c] in rhs. Returns
 /// the residual's infinity norm over free unknowns (with the current multipliers).
@@ -101,7 +84,6 @@ static double add_constraints(plume_sim *sim, const plume_vec3 *x, double *gradi
 {
 	int n3 = 3 * sim->vertex_count;
 	double *values = plume_kkt_values(&sim->kkt);
-	double regularisation = KKT_REGULARISATION * mean_diagonal(sim);
 	double *residual = sim->residual;
 	memcpy(residual, gradient, sizeof(double) * (size_t)n3);
 	plume_sim_add_constraint_forces(sim, x, residual);
@@ -111,8 +93,7 @@ static double add_constraints(plume_sim *sim, const plume_vec3 *x, double *gradi
 		double c = constraint_value(sim, x, k, &t, &l);
 		const int *vertices = sim->constraint_vertices + 2 * k;
 		const double tv[3] = {t.x, t.y, t.z};
-		const int *slots = sim->kkt.constraint_slots + 7 * k;
-		values[slots[6]] = -regularisation;
+		const int *slots = sim->kkt.constraint_slots + 6 * k;
 		if (constraint_held(sim, k)) {
 			// Both ends held by handles: a rigid handle keeps the length, nothing to solve.
 			rhs[n3 + k] = 0;

@@ -1,10 +1,16 @@
-// The CHOLMOD side of plume's sparse symmetric systems: why simplicial, in sparse.h.
+// The CHOLMOD side of plume's sparse symmetric systems: the design, in sparse.h.
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "core/alloc.h"
 #include "sim/sparse.h"
+
+// OpenBLAS's thread count, when the BLAS that CHOLMOD loaded is OpenBLAS (a weak
+// reference: NULL with any other BLAS). Its multithreaded kernels split dense blocks
+// by the thread count, which would make the factors' bits depend on it.
+extern void openblas_set_num_threads(int threads) __attribute__((weak));
 
 static int compare_entries(const void *a, const void *b)
 {
@@ -14,28 +20,14 @@ static int compare_entries(const void *a, const void *b)
 	return (p->row > q->row) - (p->row < q->row);
 }
 
-plume_status plume_sparse_init(plume_sparse *s, int n, plume_sparse_entry *entries, size_t count, bool ll,
-                               const char *what, plume_error *err)
+/// Allocates s->matrix with the sorted, unique entries' pattern, each (row, column) mapped
+/// through position (NULL: the identity).
+static bool allocate_pattern(plume_sparse *s, int n, const plume_sparse_entry *entries, size_t unique)
 {
-	memset(s, 0, sizeof *s);
-	qsort(entries, count, sizeof *entries, compare_entries);
-	size_t unique = 0;
-	for (size_t e = 0; e < count; ++e)
-		if (unique == 0 || compare_entries(entries + unique - 1, entries + e) != 0)
-			entries[unique++] = entries[e];
-
-	cholmod_start(&s->common);
-	s->started = true;
-	s->common.print = 0; // failures come back through the status (DESIGN.md)
-	s->common.nmethods = 1;
-	s->common.postorder = 1;
-	s->common.supernodal = CHOLMOD_SIMPLICIAL;
-	s->common.final_ll = ll;
-	// First the ordering, on the pattern as given.
-	cholmod_sparse *given = cholmod_allocate_sparse((size_t)n, (size_t)n, unique, 1, 1, 1, CHOLMOD_PATTERN, &s->common);
-	if (given == NULL)
-		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory allocating %s", what);
-	int *p = given->p, *rows = given->i;
+	s->matrix = cholmod_allocate_sparse((size_t)n, (size_t)n, unique, 1, 1, 1, CHOLMOD_REAL, &s->common);
+	if (s->matrix == NULL)
+		return false;
+	int *p = s->matrix->p, *rows = s->matrix->i;
 	size_t e = 0;
 	for (int column = 0; column < n; ++column) {
 		p[column] = (int)e;
@@ -43,18 +35,25 @@ plume_status plume_sparse_init(plume_sparse *s, int n, plume_sparse_entry *entri
 			rows[e] = entries[e].row;
 	}
 	p[n] = (int)unique;
-	// AMD and CHOLMOD's two nested dissections (METIS, and METIS with constrained AMD on
-	// the separators); the one whose factors cost the fewest flops (CHOLMOD's own count,
-	// a property of the pattern, so the choice is deterministic) is kept. Measured on
-	// Figure 1's KKT matrices: AMD is best at e = 5 mm (3.9 against 5.1 and 5.3 MFlop),
-	// nested dissection from e = 2.5 mm (10 % fewer at 2.5 and 1.75 mm, see
-	// docs/simulation.md).
+	return true;
+}
+
+/// The fill-reducing order of the pattern: AMD and CHOLMOD's two nested dissections
+/// (METIS, and METIS with constrained AMD on the separators); the one whose factors cost
+/// the fewest flops (CHOLMOD's own count, a property of the pattern, so the choice is
+/// deterministic) is kept, postordered. Measured on Figure 1's matrices: AMD is best at
+/// e = 5 mm, nested dissection from e = 2.5 mm on (docs/simulation.md).
+static bool choose_ordering(plume_sparse *s)
+{
 	static const int orderings[] = {CHOLMOD_AMD, CHOLMOD_NESDIS, CHOLMOD_METIS};
 	cholmod_factor *ordering = NULL;
 	double best = INFINITY;
+	s->common.nmethods = 1;
+	s->common.postorder = 1;
+	s->common.supernodal = CHOLMOD_SIMPLICIAL; // the flop count is the same, the analysis cheaper
 	for (size_t k = 0; k < sizeof orderings / sizeof *orderings; ++k) {
 		s->common.method[0].ordering = orderings[k];
-		cholmod_factor *candidate = cholmod_analyze(given, &s->common);
+		cholmod_factor *candidate = cholmod_analyze(s->matrix, &s->common);
 		if (candidate != NULL && s->common.fl < best) {
 			best = s->common.fl;
 			cholmod_free_factor(&ordering, &s->common);
@@ -63,20 +62,44 @@ plume_status plume_sparse_init(plume_sparse *s, int n, plume_sparse_entry *entri
 			cholmod_free_factor(&candidate, &s->common);
 		}
 	}
-	cholmod_free_sparse(&given, &s->common);
-	s->permutation = plume_alloc(sizeof(int) * (size_t)(n > 0 ? n : 1));
-	s->inverse = plume_alloc(sizeof(int) * (size_t)(n > 0 ? n : 1));
-	if (ordering == NULL || s->permutation == NULL || s->inverse == NULL) {
-		cholmod_free_factor(&ordering, &s->common);
-		return plume_error_set(err, PLUME_ERROR_MEMORY, "CHOLMOD could not order %s (status %d)", what,
-		                       s->common.status);
-	}
+	if (ordering == NULL)
+		return false;
+	size_t n = s->matrix->nrow;
 	const int *perm = ordering->Perm;
-	for (int k = 0; k < n; ++k) {
+	for (size_t k = 0; k < n; ++k) {
 		s->permutation[k] = perm[k];
-		s->inverse[perm[k]] = k;
+		s->inverse[perm[k]] = (int)k;
 	}
 	cholmod_free_factor(&ordering, &s->common);
+	return true;
+}
+
+plume_status plume_sparse_init(plume_sparse *s, int n, plume_sparse_entry *entries, size_t count, bool factored,
+                               const char *what, plume_error *err)
+{
+	memset(s, 0, sizeof *s);
+	if (count > 0)
+		qsort(entries, count, sizeof *entries, compare_entries);
+	size_t unique = 0;
+	for (size_t e = 0; e < count; ++e)
+		if (unique == 0 || compare_entries(entries + unique - 1, entries + e) != 0)
+			entries[unique++] = entries[e];
+
+	cholmod_start(&s->common);
+	s->started = true;
+	s->common.print = 0; // failures come back through the status (DESIGN.md)
+	s->permutation = plume_alloc(sizeof(int) * (size_t)(n > 0 ? n : 1));
+	s->inverse = plume_alloc(sizeof(int) * (size_t)(n > 0 ? n : 1));
+	if (s->permutation == NULL || s->inverse == NULL || !allocate_pattern(s, n, entries, unique))
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory allocating %s", what);
+	for (int k = 0; k < n; ++k)
+		s->permutation[k] = s->inverse[k] = k;
+	if (!factored)
+		return PLUME_OK;
+
+	if (!choose_ordering(s))
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "CHOLMOD could not order %s (status %d)", what,
+		                       s->common.status);
 	// Then the matrix itself in that order, P A P^T (upper triangle), analysed in its
 	// natural order: the same factors, with nothing to permute per factorisation.
 	for (size_t k = 0; k < unique; ++k) {
@@ -84,20 +107,15 @@ plume_status plume_sparse_init(plume_sparse *s, int n, plume_sparse_entry *entri
 		entries[k] = (plume_sparse_entry){i > j ? i : j, i > j ? j : i};
 	}
 	qsort(entries, unique, sizeof *entries, compare_entries);
-	s->matrix = cholmod_allocate_sparse((size_t)n, (size_t)n, unique, 1, 1, 1, CHOLMOD_REAL, &s->common);
-	if (s->matrix == NULL)
+	cholmod_free_sparse(&s->matrix, &s->common);
+	if (!allocate_pattern(s, n, entries, unique))
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory allocating %s", what);
-	p = s->matrix->p;
-	rows = s->matrix->i;
-	e = 0;
-	for (int column = 0; column < n; ++column) {
-		p[column] = (int)e;
-		for (; e < unique && entries[e].column == column; ++e)
-			rows[e] = entries[e].row;
-	}
-	p[n] = (int)unique;
+	if (openblas_set_num_threads != NULL)
+		openblas_set_num_threads(1);
 	s->common.method[0].ordering = CHOLMOD_NATURAL;
 	s->common.postorder = 0;
+	s->common.supernodal = CHOLMOD_AUTO;
+	s->common.final_ll = true;
 	s->factor = cholmod_analyze(s->matrix, &s->common);
 	s->rhs = cholmod_zeros((size_t)n, 1, CHOLMOD_REAL, &s->common);
 	s->solution = cholmod_zeros((size_t)n, 1, CHOLMOD_REAL, &s->common);
@@ -148,19 +166,42 @@ int plume_sparse_find(const plume_sparse *s, int row, int column)
 	return -1;
 }
 
-bool plume_sparse_factor(plume_sparse *s)
+/// Every pivot (the factor's diagonal) finite and positive.
+static bool pivots_usable(const cholmod_factor *L)
 {
-	cholmod_factorize(s->matrix, s->factor, &s->common);
-	if (s->common.status != CHOLMOD_OK || s->factor->minor != s->factor->n)
-		return false;
-	const int *p = s->factor->p;
-	const double *x = s->factor->x;
-	for (size_t j = 0; j < s->factor->n; ++j) {
-		double d = x[p[j]]; // the diagonal leads each column of a simplicial factor
-		if (!isfinite(d) || d == 0)
-			return false;
+	const double *x = L->x;
+	if (!L->is_super) {
+		const int *p = L->p;
+		for (size_t j = 0; j < L->n; ++j)
+			if (!(isfinite(x[p[j]]) && x[p[j]] > 0)) // the diagonal leads each column
+				return false;
+		return true;
+	}
+	// A supernode holds columns super[s] .. super[s+1]-1 as a dense block of
+	// pi[s+1] - pi[s] rows, column-major from px[s], its diagonal on top.
+	const int *super = L->super, *pi = L->pi, *px = L->px;
+	for (size_t s = 0; s < L->nsuper; ++s) {
+		int rows = pi[s + 1] - pi[s];
+		for (int j = 0; j < super[s + 1] - super[s]; ++j) {
+			double d = x[px[s] + (size_t)j * rows + j];
+			if (!(isfinite(d) && d > 0))
+				return false;
+		}
 	}
 	return true;
+}
+
+bool plume_sparse_factor(plume_sparse *s)
+{
+	// CHOLMOD's supernodal factorisation zeroes and scatters each large supernode in
+	// OpenMP regions of four threads: on two cores their wake-ups and spinning cost more
+	// than the loops (measured: a third of Figure 1's run at e = 2.5 mm), so it runs
+	// with no parallel region active. The dense work is in the (one-thread) BLAS.
+	int levels = omp_get_max_active_levels();
+	omp_set_max_active_levels(0);
+	cholmod_factorize(s->matrix, s->factor, &s->common);
+	omp_set_max_active_levels(levels);
+	return s->common.status == CHOLMOD_OK && s->factor->minor == s->factor->n && pivots_usable(s->factor);
 }
 
 bool plume_sparse_solve(plume_sparse *s)
@@ -180,14 +221,15 @@ bool plume_sparse_solve(plume_sparse *s)
 	return true;
 }
 
-int plume_sparse_negative_pivots(const plume_sparse *s)
+void plume_sparse_multiply_add(const plume_sparse *s, const double *x, double *y)
 {
-	if (s->factor->is_ll)
-		return 0;
-	const int *p = s->factor->p;
-	const double *x = s->factor->x;
-	int count = 0;
-	for (size_t j = 0; j < s->factor->n; ++j)
-		count += x[p[j]] < 0;
-	return count;
+	const int *p = s->matrix->p, *rows = s->matrix->i, *unknown = s->permutation;
+	const double *values = s->matrix->x;
+	for (size_t column = 0; column < s->matrix->ncol; ++column)
+		for (int e = p[column]; e < p[column + 1]; ++e) {
+			size_t i = (size_t)unknown[rows[e]], j = (size_t)unknown[column];
+			y[i] += values[e] * x[j];
+			if (i != j)
+				y[j] += values[e] * x[i];
+		}
 }

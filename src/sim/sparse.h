@@ -1,13 +1,15 @@
 // Private: a symmetric sparse matrix with a fixed pattern, factored and solved by
-// CHOLMOD. The simulator's Newton systems (sim/kkt) and the lab's band model
-// (lab/quadratic) are both built on it.
+// CHOLMOD's Cholesky factorisation LL'. The simulator's Newton systems (sim/kkt) and
+// the lab's band model (lab/quadratic) are both built on it; a matrix can also be only
+// stored (its values assembled, multiplied, never factored).
 //
-// The factorisation is always simplicial: with Debian's reference BLAS the supernodal
-// method was slower on every plume system measured (Figure 1's isotropic vane: 3.7 s
-// against 0.73 s of factorisation; the 8000-element band model: 18 s against 13 s),
-// and without BLAS the bits do not depend on the thread count. The fill-reducing
-// ordering (the cheapest of AMD and two nested dissections, chosen once per pattern) is
-// applied to the pattern itself, so that every factorisation reads the matrix in place.
+// Simplicial or supernodal is CHOLMOD's choice per pattern (CHOLMOD_AUTO: supernodal
+// when the factor's flops per entry make dense kernels pay, from about e = 2.5 mm on
+// Figure 1's meshes); the supernodal kernels run in the BLAS, OpenBLAS on Debian
+// (scripts/deps.sh), held to one thread so that the bits never depend on the thread
+// count (docs/simulation.md, "Linear algebra"). The fill-reducing ordering (the
+// cheapest of AMD and two nested dissections, chosen once per pattern) is applied to
+// the pattern itself, so that every factorisation reads the matrix in place.
 // The library never prints.
 #ifndef PLUME_SIM_SPARSE_H
 #define PLUME_SIM_SPARSE_H
@@ -28,8 +30,9 @@ typedef struct plume_sparse_entry {
 typedef struct plume_sparse {
 	cholmod_common common;
 	bool started;
-	/// The fill-reducing order (AMD, postordered), applied once to the pattern:
-	/// permutation[k] is the unknown at position k, inverse[i] the position of unknown i.
+	/// The fill-reducing order (postordered), applied once to the pattern (the identity
+	/// for a stored-only matrix): permutation[k] is the unknown at position k, inverse[i]
+	/// the position of unknown i.
 	int *permutation;
 	int *inverse;
 	/// P A P^T, upper triangle (stype 1), CSC with sorted rows, factored in its natural
@@ -38,7 +41,7 @@ typedef struct plume_sparse {
 	/// reads in place. The caller writes the values, at plume_sparse_find's slots; row
 	/// and column k are unknown permutation[k].
 	cholmod_sparse *matrix;
-	cholmod_factor *factor;
+	cholmod_factor *factor; ///< NULL for a stored-only matrix
 	/// Right-hand side (the caller writes it) and solution, in the caller's order; the
 	/// same permuted, and CHOLMOD's workspace, kept between solves.
 	cholmod_dense *rhs;
@@ -49,11 +52,12 @@ typedef struct plume_sparse {
 	cholmod_dense *work_e;
 } plume_sparse;
 
-/// Builds the n x n pattern of the entries (sorted and deduplicated in place) and runs the
-/// symbolic analysis for LL' (ll: the matrix is meant to be positive definite, and a matrix
-/// that is not reports itself) or LDL' (quasi-definite matrices). `what` names the matrix
-/// in error messages ("the solver's matrix"). On failure, free with plume_sparse_free.
-plume_status plume_sparse_init(plume_sparse *s, int n, plume_sparse_entry *entries, size_t count, bool ll,
+/// Builds the n x n pattern of the entries (sorted and deduplicated in place) and, with
+/// factored, orders it and runs the symbolic analysis for LL' (the matrix is meant to be
+/// positive definite; one that is not reports itself). Without, the matrix is only
+/// stored, in the natural order. `what` names the matrix in error messages ("the
+/// solver's matrix"). On failure, free with plume_sparse_free.
+plume_status plume_sparse_init(plume_sparse *s, int n, plume_sparse_entry *entries, size_t count, bool factored,
                                const char *what, plume_error *err);
 void plume_sparse_free(plume_sparse *s);
 
@@ -61,14 +65,13 @@ void plume_sparse_free(plume_sparse *s);
 /// symmetric), or -1 when it is not in the pattern.
 int plume_sparse_find(const plume_sparse *s, int row, int column);
 
-/// Factors the current values. False when CHOLMOD fails, when LL' meets a pivot that is not
-/// positive, or when a pivot is zero or not finite (LDL' does not pivot; a NaN passes LL''s
-/// positivity test): the matrix then has no usable factorisation.
+/// Factors the current values. False when CHOLMOD fails, when a pivot is not positive, or
+/// when one is not finite (a NaN passes the simplicial positivity test and OpenBLAS's):
+/// the matrix then has no usable factorisation.
 bool plume_sparse_factor(plume_sparse *s);
 
-/// Number of negative pivots of the last LDL' factorisation (0 for LL'): by Sylvester's law
-/// of inertia, the number of negative eigenvalues of the factored matrix.
-int plume_sparse_negative_pivots(const plume_sparse *s);
+/// y += A x for the stored (symmetric) matrix; x and y in the caller's order.
+void plume_sparse_multiply_add(const plume_sparse *s, const double *x, double *y);
 
 /// Solves with the last factorisation: s->rhs into s->solution. False on failure.
 bool plume_sparse_solve(plume_sparse *s);
