@@ -393,6 +393,91 @@ static void test_kkt_factor_inertia(void **state)
 	plume_kkt_free(&kkt);
 }
 
+static void test_shared_edge_bending_matches_finite_differences(void **state)
+{
+	(void)state;
+	// The fundamental-form faces take their dihedral angles from the shared-edge pass
+	// (fundamental_form.h, Shared edges). On a bent strip with one face wound the other
+	// way (so that some faces see their edge's angle with the opposite sign), the
+	// assembled energy, gradient and exact Hessian must be those of the faces evaluated
+	// on their own, and the gradient and Hessian those of central differences.
+	plume_mesh *mesh = make_strip(0.1, 0.02, 4);
+	int *flipped = mesh->faces + 3 * 7, t = flipped[1];
+	flipped[1] = flipped[2];
+	flipped[2] = t;
+	plume_sim_def def = plume_sim_default_def();
+	def.gravity = plume_v3(0, 0, 0);
+	def.materials[0].barb_constraint = false;
+	plume_sim *sim = NULL;
+	plume_error err = {0};
+	assert_int_equal(plume_sim_create(mesh, &def, &sim, &err), PLUME_OK);
+	int n = sim->vertex_count, n3 = 3 * n, size = n3 + sim->constraint_count;
+	for (int i = 0; i < n; ++i)
+		sim->x[i].z += 0.004 * sin(40 * sim->x[i].x) + 0.002 * cos(90 * sim->x[i].y + 0.3 * i);
+	static const sim_problem statics = {.dynamic = false};
+	double *g = calloc((size_t)size, sizeof(double)), *gp = calloc((size_t)size, sizeof(double));
+	double *gm = calloc((size_t)size, sizeof(double)), *v = calloc((size_t)size, sizeof(double));
+	double *kv = calloc((size_t)size, sizeof(double));
+	plume_vec3 *x = malloc(sizeof(plume_vec3) * (size_t)n);
+	plume_sim_potential(sim, &statics, sim->x, g, true, false);
+	for (int i = 0; i < n3; ++i)
+		v[i] = sim->fixed[i] ? 0 : cos(0.37 * i);
+	plume_kkt_multiply_add(&sim->kkt, v, kv);
+
+	double energy_difference = 0, energy_largest = 0;
+	int negative = 0;
+	for (int e = 0; e < sim->ff_count; ++e) {
+		const plume_ff_face *face = sim->ff_faces + e;
+		plume_vec3 local[6];
+		for (int k = 0; k < 6; ++k)
+			local[k] = face->vertices[k] >= 0 ? sim->x[face->vertices[k]] : plume_v3(0, 0, 0);
+		double direct = plume_ff_face_energy(face, local, NULL, NULL);
+		energy_difference = fmax(energy_difference, fabs(direct - sim->hinge_energy[e]));
+		energy_largest = fmax(energy_largest, fabs(direct));
+		for (int i = 0; i < 3; ++i)
+			negative += face->edge[i] >= 0 && face->edge_sign[i] < 0;
+	}
+	assert_true(negative > 0);
+	assert_true(energy_largest > 0 && energy_difference <= 1e-12 * energy_largest);
+
+	double worst = 0, largest = 0, step = 1e-7;
+	for (int i = 0; i < n3; ++i)
+		largest = fmax(largest, fabs(g[i]));
+	for (int i = 0; i < n3; ++i) {
+		if (sim->fixed[i])
+			continue;
+		memcpy(x, sim->x, sizeof(plume_vec3) * (size_t)n);
+		double *c = &x[i / 3].x + i % 3, saved = *c;
+		*c = saved + step;
+		double plus = plume_sim_potential(sim, &statics, x, NULL, false, false);
+		*c = saved - step;
+		double minus = plume_sim_potential(sim, &statics, x, NULL, false, false);
+		worst = fmax(worst, fabs((plus - minus) / (2 * step) - g[i]));
+	}
+	double hworst = 0, hlargest = 0;
+	for (int sign = -1; sign <= 1; sign += 2) {
+		for (int i = 0; i < n; ++i)
+			x[i] = plume_v3(sim->x[i].x + sign * step * v[3 * i], sim->x[i].y + sign * step * v[3 * i + 1],
+			                sim->x[i].z + sign * step * v[3 * i + 2]);
+		plume_sim_potential(sim, &statics, x, sign > 0 ? gp : gm, false, false);
+	}
+	for (int i = 0; i < n3; ++i) {
+		if (sim->fixed[i])
+			continue;
+		double fd = (gp[i] - gm[i]) / (2 * step);
+		hworst = fmax(hworst, fabs(fd - kv[i]));
+		hlargest = fmax(hlargest, fabs(fd));
+	}
+	printf("shared-edge bending (%d faces see their edge's angle negated): energy %.3g of %.3g, gradient error %.3g of "
+	       "%.3g, Hessian error %.3g of %.3g\n",
+	       negative, energy_difference, energy_largest, worst, largest, hworst, hlargest);
+	assert_true(largest > 0 && worst <= 1e-6 * largest);
+	assert_true(hlargest > 0 && hworst <= 1e-6 * hlargest);
+	free(g), free(gp), free(gm), free(v), free(kv), free(x);
+	plume_sim_destroy(sim);
+	plume_mesh_destroy(mesh);
+}
+
 static void test_bad_definitions(void **state)
 {
 	(void)state;
@@ -432,6 +517,7 @@ int main(void)
 	    cmocka_unit_test(test_reaction_balances_load),
 	    cmocka_unit_test(test_steps_are_deterministic),
 	    cmocka_unit_test(test_kkt_factor_reports_indefinite),
+	    cmocka_unit_test(test_shared_edge_bending_matches_finite_differences),
 	    cmocka_unit_test(test_kkt_factor_inertia),
 	    cmocka_unit_test(test_bad_definitions),
 	};

@@ -88,6 +88,7 @@ bool plume_ff_face_init(plume_ff_face *face, const int vertices[6], const plume_
 	for (int i = 0; i < 3; ++i) {
 		face->rest_angle[i] = 0;
 		face->edge_scale[i] = face->border_scale[i] = 1;
+		face->edge[i] = -1;
 		if (vertices[3 + i] < 0) {
 			condense(face->stiffness, i);
 			continue;
@@ -122,56 +123,31 @@ void plume_ff_face_clamp(plume_ff_face *face, const bool held[6])
 	}
 }
 
+/// One edge's angle and derivatives as a face sees them: chi in the face's sign,
+/// gradient (12) and Hessian (144, NULL when not needed) in some stencil order, slot
+/// order[k] holding the face's hinge vertex k, each derivative times sign.
+typedef struct edge_view {
+	double chi;
+	const double *gradient;
+	const double *hessian;
+	const unsigned char *order;
+	double sign;
+} edge_view;
+
+static const unsigned char IDENTITY_ORDER[4] = {0, 1, 2, 3};
+
 // The change of edge i's angle from its rest value, the short way round, times the edge's
-// clamp scale; its gradient (12) and Hessian (144) when asked for. Zero for a boundary edge.
-static double angle_change(const plume_ff_face *face, const plume_vec3 x[6], int i, double gradient[12],
-                           double hessian[144])
+// clamp scale. Zero for a boundary edge.
+static double angle_change(const plume_ff_face *face, int i, double chi)
 {
-	if (face->vertices[3 + i] < 0) {
-		if (gradient)
-			memset(gradient, 0, 12 * sizeof(double));
-		if (hessian)
-			memset(hessian, 0, 144 * sizeof(double));
+	if (face->vertices[3 + i] < 0)
 		return 0;
-	}
-	int h[4];
-	hinge_indices(i, h);
-	plume_vec3 local[4] = {x[h[0]], x[h[1]], x[h[2]], x[h[3]]};
-	double delta = plume_dihedral_angle_derivatives(local, gradient, hessian) - face->rest_angle[i];
+	double delta = chi - face->rest_angle[i];
 	if (delta > PI)
 		delta -= 2 * PI;
 	else if (delta <= -PI)
 		delta += 2 * PI;
-	double s = face->edge_scale[i];
-	if (s != 1) {
-		for (int k = 0; gradient != NULL && k < 12; ++k)
-			gradient[k] *= s;
-		for (int k = 0; hessian != NULL && k < 144; ++k)
-			hessian[k] *= s;
-	}
-	return s * delta;
-}
-
-// Spreads a hinge's 12-gradient into the face stencil's 18.
-static void spread_gradient(int i, const double local[12], double out[18])
-{
-	int h[4];
-	hinge_indices(i, h);
-	memset(out, 0, 18 * sizeof(double));
-	for (int k = 0; k < 4; ++k)
-		for (int a = 0; a < 3; ++a)
-			out[3 * h[k] + a] = local[3 * k + a];
-}
-
-// The three angle changes and their stencil gradients J (3 x 18).
-static void angle_changes(const plume_ff_face *face, const plume_vec3 x[6], double delta[3], double J[54])
-{
-	for (int i = 0; i < 3; ++i) {
-		double local[12];
-		delta[i] = angle_change(face, x, i, J ? local : NULL, NULL);
-		if (J)
-			spread_gradient(i, local, J + 18 * i);
-	}
+	return face->edge_scale[i] * delta;
 }
 
 // J^T M J, symmetric exactly (the solver stores one triangle).
@@ -189,49 +165,119 @@ static void gauss_newton(const double M[9], const double J[54], double hessian[3
 			hessian[18 * c + r] = hessian[18 * r + c] = 0.5 * (hessian[18 * r + c] + hessian[18 * c + r]);
 }
 
-// Energy, gradient (M dchi)^T J and the Gauss-Newton Hessian J^T M J from one pass over
-// the angles; force receives M dchi.
-static double energy_and_gauss_newton(const plume_ff_face *face, const plume_vec3 x[6], double gradient[18],
-                                      double hessian[324], double force[3])
+// Energy 1/2 dchi^T M dchi, gradient (M dchi)^T J, and the Gauss-Newton Hessian J^T M J
+// plus, when exact, sum_i (M dchi)_i Hess chi_i, from the three edges' views (J: the
+// stencil gradients of the scaled angle changes, 3 x 18).
+static double combine(const plume_ff_face *face, const edge_view view[3], bool exact, double gradient[18],
+                      double hessian[324])
 {
 	double delta[3], J[54];
 	bool derivatives = gradient != NULL || hessian != NULL;
-	angle_changes(face, x, delta, derivatives ? J : NULL);
+	if (derivatives)
+		memset(J, 0, sizeof J);
+	for (int i = 0; i < 3; ++i) {
+		delta[i] = angle_change(face, i, view[i].chi);
+		if (!derivatives || face->vertices[3 + i] < 0)
+			continue;
+		int h[4];
+		hinge_indices(i, h);
+		double scale = face->edge_scale[i] * view[i].sign;
+		for (int k = 0; k < 4; ++k)
+			for (int a = 0; a < 3; ++a)
+				J[18 * i + 3 * h[k] + a] = scale * view[i].gradient[3 * view[i].order[k] + a];
+	}
 	const double *M = face->stiffness;
+	double force[3];
 	for (int i = 0; i < 3; ++i)
 		force[i] = M[3 * i] * delta[0] + M[3 * i + 1] * delta[1] + M[3 * i + 2] * delta[2];
 	if (gradient)
 		for (int r = 0; r < 18; ++r)
 			gradient[r] = force[0] * J[r] + force[1] * J[18 + r] + force[2] * J[36 + r];
-	if (hessian)
+	if (hessian) {
 		gauss_newton(M, J, hessian);
+		for (int i = 0; exact && i < 3; ++i) {
+			if (force[i] == 0 || face->vertices[3 + i] < 0)
+				continue;
+			int h[4];
+			hinge_indices(i, h);
+			double scale = force[i] * face->edge_scale[i] * view[i].sign;
+			const unsigned char *order = view[i].order;
+			for (int a = 0; a < 12; ++a)
+				for (int b = 0; b < 12; ++b)
+					hessian[18 * (3 * h[a / 3] + a % 3) + 3 * h[b / 3] + b % 3] +=
+					    scale * view[i].hessian[12 * (3 * order[a / 3] + a % 3) + 3 * order[b / 3] + b % 3];
+		}
+	}
 	return 0.5 * (force[0] * delta[0] + force[1] * delta[1] + force[2] * delta[2]);
+}
+
+// The face's three angles with their derivatives (hinge order) from the positions.
+static double evaluate(const plume_ff_face *face, const plume_vec3 x[6], bool exact, double gradient[18],
+                       double hessian[324])
+{
+	double local_gradient[3][12], local_hessian[3][144];
+	bool want_hessian = exact && hessian != NULL, derivatives = gradient != NULL || hessian != NULL;
+	edge_view view[3];
+	for (int i = 0; i < 3; ++i) {
+		view[i] = (edge_view){0, local_gradient[i], local_hessian[i], IDENTITY_ORDER, 1};
+		if (face->vertices[3 + i] < 0)
+			continue;
+		int h[4];
+		hinge_indices(i, h);
+		plume_vec3 local[4] = {x[h[0]], x[h[1]], x[h[2]], x[h[3]]};
+		view[i].chi = plume_dihedral_angle_derivatives(local, derivatives ? local_gradient[i] : NULL,
+		                                               want_hessian ? local_hessian[i] : NULL);
+	}
+	return combine(face, view, exact, gradient, hessian);
 }
 
 double plume_ff_face_energy_gauss_newton(const plume_ff_face *face, const plume_vec3 x[6], double gradient[18],
                                          double hessian[324])
 {
-	double force[3];
-	return energy_and_gauss_newton(face, x, gradient, hessian, force);
+	return evaluate(face, x, false, gradient, hessian);
 }
 
 double plume_ff_face_energy(const plume_ff_face *face, const plume_vec3 x[6], double gradient[18], double hessian[324])
 {
-	double force[3];
-	double energy = energy_and_gauss_newton(face, x, gradient, hessian, force);
-	if (hessian) {
-		// J^T M J + sum_i (M dchi)_i Hess chi_i.
-		for (int i = 0; i < 3; ++i) {
-			if (force[i] == 0 || face->vertices[3 + i] < 0)
-				continue;
-			double local[144];
-			angle_change(face, x, i, NULL, local);
-			int h[4];
-			hinge_indices(i, h);
-			for (int a = 0; a < 12; ++a)
-				for (int b = 0; b < 12; ++b)
-					hessian[18 * (3 * h[a / 3] + a % 3) + 3 * h[b / 3] + b % 3] += force[i] * local[12 * a + b];
+	return evaluate(face, x, true, gradient, hessian);
+}
+
+void plume_ff_hinge_vertices(const plume_ff_face *face, int i, int out[4])
+{
+	int h[4];
+	hinge_indices(i, h);
+	for (int k = 0; k < 4; ++k)
+		out[k] = face->vertices[h[k]];
+}
+
+void plume_ff_face_link(plume_ff_face *face, int i, int edge, const int stencil[4])
+{
+	int own[4];
+	plume_ff_hinge_vertices(face, i, own);
+	for (int k = 0; k < 4; ++k)
+		for (int slot = 0; slot < 4; ++slot)
+			if (stencil[slot] == own[k])
+				face->edge_order[i][k] = (unsigned char)slot;
+	face->edge[i] = edge;
+	// plume_dihedral_angle is unchanged when the edge's direction and the wings are both
+	// swapped (n_A and n_B trade places), and changes sign when only one of them is.
+	bool edge_swapped = face->edge_order[i][0] != 0, wings_swapped = face->edge_order[i][2] != 2;
+	face->edge_sign[i] = edge_swapped == wings_swapped ? 1 : -1;
+}
+
+double plume_ff_face_energy_from_edges(const plume_ff_face *face, const double *chi, const double *gradients,
+                                       const double *hessians, bool exact, double gradient[18], double hessian[324])
+{
+	edge_view view[3];
+	for (int i = 0; i < 3; ++i) {
+		int e = face->edge[i];
+		if (face->vertices[3 + i] < 0 || e < 0) {
+			view[i] = (edge_view){0, NULL, NULL, IDENTITY_ORDER, 1};
+			continue;
 		}
+		double sign = face->edge_sign[i];
+		view[i] = (edge_view){sign * chi[e], gradients + 12 * (size_t)e,
+		                      hessians != NULL ? hessians + 144 * (size_t)e : NULL, face->edge_order[i], sign};
 	}
-	return energy;
+	return combine(face, view, exact, gradient, hessian);
 }

@@ -61,6 +61,13 @@ typedef struct plume_ff_face {
 	double edge_scale[3];
 	/// 2 D_g / (D_f + D_g) of the material border rule above; 1 inside one material.
 	double border_scale[3];
+	/// Shared edges (plume_ff_face_link): edge i's index among the mesh's interior edges
+	/// (-1 on the boundary or when unlinked), the slot in that edge's stencil of each of
+	/// the four vertices of this face's hinge, and +1 or -1: this face's angle is sign
+	/// times the edge's.
+	int edge[3];
+	unsigned char edge_order[3][4];
+	signed char edge_sign[3];
 } plume_ff_face;
 
 /// The bilinear form of the bending tensor on two symmetric 2 x 2 curvatures given as
@@ -94,5 +101,26 @@ double plume_ff_face_energy(const plume_ff_face *face, const plume_vec3 x[6], do
 /// what the Newton solver assembles. One pass over the angles.
 double plume_ff_face_energy_gauss_newton(const plume_ff_face *face, const plume_vec3 x[6], double gradient[18],
                                          double hessian[324]);
+
+// Shared edges. An interior edge's dihedral angle belongs to both of its faces, and its
+// Hessian is most of the cost of a fundamental-form Hessian (Figure 1: a fifth of the
+// run), so the solver computes each edge's angle and derivatives once, with
+// plume_dihedral_angle_derivatives on the edge's stencil, and each face combines its
+// three edges' (plume_ff_face_energy_from_edges).
+
+/// The vertices of face's hinge across edge i, in plume_dihedral_angle's order: the edge
+/// v_{i+1} -> v_{i+2}, v_i, the vertex across (-1 on the boundary).
+void plume_ff_hinge_vertices(const plume_ff_face *face, int i, int out[4]);
+
+/// Links the face's edge i to interior edge `edge`, whose stencil is `stencil` (the same
+/// four vertices in some plume_dihedral_angle order: the edge's two, then its two wings).
+void plume_ff_face_link(plume_ff_face *face, int i, int edge, const int stencil[4]);
+
+/// plume_ff_face_energy (exact) or plume_ff_face_energy_gauss_newton (not exact) from the
+/// interior edges' angles (chi, one per edge), gradients (12 per edge, the edge's stencil
+/// order) and, when exact and a Hessian is asked for, Hessians (144 per edge). Every
+/// interior edge of the face must be linked.
+double plume_ff_face_energy_from_edges(const plume_ff_face *face, const double *chi, const double *gradients,
+                                       const double *hessians, bool exact, double gradient[18], double hessian[324]);
 
 #endif // PLUME_SIM_FUNDAMENTAL_FORM_H

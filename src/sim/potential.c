@@ -92,17 +92,27 @@ static void evaluate_hinges(plume_sim *sim, const plume_vec3 *x, bool gradient, 
 
 static void evaluate_ff_faces(plume_sim *sim, const plume_vec3 *x, bool gradient, bool hessian, bool project)
 {
+	// Each shared edge's angle and derivatives once (fundamental_form.h, Shared edges): the
+	// exact Hessian needs its angle's Hessian, the projected one (Gauss-Newton J^T M J,
+	// for the reason given for the hinges) only gradients.
+	bool derivatives = gradient || hessian, angle_hessians = hessian && !project;
+	int edges = sim->ff_edge_count;
+#pragma omp parallel for schedule(static) if (edges >= 4096)
+	for (int e = 0; e < edges; ++e) {
+		plume_vec3 local[4];
+		gather(x, sim->ff_edge_vertices + 4 * e, 4, local);
+		sim->ff_edge_chi[e] = plume_dihedral_angle_derivatives(
+		    local, derivatives ? sim->ff_edge_gradient + 12 * (size_t)e : NULL,
+		    angle_hessians ? sim->ff_edge_hessian + 144 * (size_t)e : NULL);
+	}
 	int count = sim->ff_count;
-#pragma omp parallel for schedule(static) if (count >= 2048)
+#pragma omp parallel for schedule(static) if (count >= 4096)
 	for (int e = 0; e < count; ++e) {
-		const plume_ff_face *face = sim->ff_faces + e;
-		plume_vec3 local[6];
-		gather(x, face->vertices, 6, local);
 		double *g = gradient ? sim->hinge_gradient + 18 * e : NULL;
 		double *h = hessian ? sim->hinge_hessian + 324 * e : NULL;
-		// Projected: the Gauss-Newton part J^T M J, for the reason given for the hinges.
 		sim->hinge_energy[e] =
-		    project ? plume_ff_face_energy_gauss_newton(face, local, g, h) : plume_ff_face_energy(face, local, g, h);
+		    plume_ff_face_energy_from_edges(sim->ff_faces + e, sim->ff_edge_chi, sim->ff_edge_gradient,
+		                                    angle_hessians ? sim->ff_edge_hessian : NULL, !project, g, h);
 	}
 }
 

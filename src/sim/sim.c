@@ -325,6 +325,24 @@ static plume_status build_ff_faces(plume_sim *sim, const plume_mesh *mesh, const
 		}
 	}
 	sim->ff_count = faces;
+	// Each interior edge once, in its first side's hinge order; both sides linked to it.
+	sim->ff_edge_count = pair_count;
+	size_t edges = (size_t)(pair_count > 0 ? pair_count : 1);
+	sim->ff_edge_vertices = plume_alloc(sizeof(int) * 4 * edges);
+	sim->ff_edge_chi = plume_alloc(sizeof(double) * edges);
+	sim->ff_edge_gradient = plume_alloc(sizeof(double) * 12 * edges);
+	sim->ff_edge_hessian = plume_alloc(sizeof(double) * 144 * edges);
+	if (!sim->ff_edge_vertices || !sim->ff_edge_chi || !sim->ff_edge_gradient || !sim->ff_edge_hessian) {
+		plume_free(across);
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory building the bending elements");
+	}
+	for (int e = 0; e < pair_count; ++e) {
+		int *stencil = sim->ff_edge_vertices + 4 * e;
+		int side[2] = {pairs[2 * e], pairs[2 * e + 1]};
+		plume_ff_hinge_vertices(sim->ff_faces + side[0] / 3, (side[0] % 3 + 2) % 3, stencil);
+		for (int k = 0; k < 2; ++k)
+			plume_ff_face_link(sim->ff_faces + side[k] / 3, (side[k] % 3 + 2) % 3, e, stencil);
+	}
 	// Material borders (fundamental_form.h): each face's share of the edge's angle.
 	for (int e = 0; e < pair_count; ++e) {
 		int side[2] = {pairs[2 * e], pairs[2 * e + 1]};
@@ -553,6 +571,10 @@ void plume_sim_destroy(plume_sim *sim)
 	                  sim->membranes,
 	                  sim->hinges,
 	                  sim->ff_faces,
+	                  sim->ff_edge_vertices,
+	                  sim->ff_edge_chi,
+	                  sim->ff_edge_gradient,
+	                  sim->ff_edge_hessian,
 	                  sim->constraint_vertices,
 	                  sim->constraint_length,
 	                  sim->lambda,

@@ -66,6 +66,14 @@ struct plume_sim {
 	plume_hinge *hinges;
 	int ff_count;
 	plume_ff_face *ff_faces;
+	/// The interior edges the fundamental-form faces share (fundamental_form.h, Shared
+	/// edges): a hinge stencil each (4 vertices), and per evaluation its angle, gradient (12)
+	/// and Hessian (144).
+	int ff_edge_count;
+	int *ff_edge_vertices;
+	double *ff_edge_chi;
+	double *ff_edge_gradient;
+	double *ff_edge_hessian;
 
 	/// Barb-aligned edges held at their reference length (constraint rows).
 	int constraint_count;
