@@ -150,19 +150,17 @@ static double angle_change(const plume_ff_face *face, int i, double chi)
 	return face->edge_scale[i] * delta;
 }
 
-// J^T M J, symmetric exactly (the solver stores one triangle).
+// J^T M J, symmetric exactly (the solver stores one triangle): the upper triangle,
+// mirrored.
 static void gauss_newton(const double M[9], const double J[54], double hessian[324])
 {
 	for (int r = 0; r < 18; ++r) {
 		double MJ[3]; // (M J)_{:, r}
 		for (int i = 0; i < 3; ++i)
 			MJ[i] = M[3 * i] * J[r] + M[3 * i + 1] * J[18 + r] + M[3 * i + 2] * J[36 + r];
-		for (int c = 0; c < 18; ++c)
-			hessian[18 * r + c] = J[c] * MJ[0] + J[18 + c] * MJ[1] + J[36 + c] * MJ[2];
+		for (int c = r; c < 18; ++c)
+			hessian[18 * c + r] = hessian[18 * r + c] = J[c] * MJ[0] + J[18 + c] * MJ[1] + J[36 + c] * MJ[2];
 	}
-	for (int r = 0; r < 18; ++r)
-		for (int c = r + 1; c < 18; ++c)
-			hessian[18 * c + r] = hessian[18 * r + c] = 0.5 * (hessian[18 * r + c] + hessian[18 * c + r]);
 }
 
 // Energy 1/2 dchi^T M dchi, gradient (M dchi)^T J, and the Gauss-Newton Hessian J^T M J
@@ -198,14 +196,19 @@ static double combine(const plume_ff_face *face, const edge_view view[3], bool e
 		for (int i = 0; exact && i < 3; ++i) {
 			if (force[i] == 0 || face->vertices[3 + i] < 0)
 				continue;
-			int h[4];
+			int h[4], face_row[12], edge_row[12];
 			hinge_indices(i, h);
+			for (int a = 0; a < 12; ++a) {
+				face_row[a] = 3 * h[a / 3] + a % 3;
+				edge_row[a] = 3 * view[i].order[a / 3] + a % 3;
+			}
 			double scale = force[i] * face->edge_scale[i] * view[i].sign;
-			const unsigned char *order = view[i].order;
-			for (int a = 0; a < 12; ++a)
+			for (int a = 0; a < 12; ++a) {
+				double *out = hessian + 18 * face_row[a];
+				const double *in = view[i].hessian + 12 * edge_row[a];
 				for (int b = 0; b < 12; ++b)
-					hessian[18 * (3 * h[a / 3] + a % 3) + 3 * h[b / 3] + b % 3] +=
-					    scale * view[i].hessian[12 * (3 * order[a / 3] + a % 3) + 3 * order[b / 3] + b % 3];
+					out[face_row[b]] += scale * in[edge_row[b]];
+			}
 		}
 	}
 	return 0.5 * (force[0] * delta[0] + force[1] * delta[1] + force[2] * delta[2]);
