@@ -300,14 +300,15 @@ static plume_status on_step(void *user, int step, double time, const plume_sim *
 	run_state *run = user;
 	if (report != NULL) {
 		// The energies of the state (docs/simulation.md): kinetic, elastic (membrane, compression,
-		// bending) and gravitational (with the scene's constant forces). Like the reactions, they
-		// re-evaluate the const simulator's state and change nothing it reports.
+		// bending), gravitational (with the scene's constant forces), and contact's barrier and
+		// friction potential. Like the reactions, they re-evaluate the const simulator's state and
+		// change nothing it reports.
 		plume_sim_energies e = plume_sim_energy((plume_sim *)sim);
 		double elastic = e.membrane + e.compression + e.bending;
 		plume_sim_vane_shape vane = plume_sim_vane_shape_measure(sim, run->vane_base);
-		fprintf(run->stats, "%.9g,%d,%.6e,%.12e,%.6e,%.6f,%.9e,%.9e,%.9e,%.9g,%.9e", time, report->newton_iterations,
-		        report->gradient_norm, report->energy, report->max_barb_strain, wall_seconds, e.kinetic, elastic,
-		        e.gravity, vane.min_principal_stretch, vane.max_out_of_plane);
+		fprintf(run->stats, "%.9g,%d,%.6e,%.12e,%.6e,%.6f,%.9e,%.9e,%.9e,%.9e,%.9e,%.9g,%.9e", time,
+		        report->newton_iterations, report->gradient_norm, report->energy, report->max_barb_strain, wall_seconds,
+		        e.kinetic, elastic, e.gravity, e.contact, e.friction, vane.min_principal_stretch, vane.max_out_of_plane);
 		// fmin/fmax skip NaN: a measure that is never defined stays NaN (null in summary.json).
 		run->min_stretch = fmin(run->min_stretch, vane.min_principal_stretch);
 		run->max_out_of_plane = fmax(run->max_out_of_plane, vane.max_out_of_plane);
@@ -594,7 +595,8 @@ static plume_status simulate(const plume_scene *scene, cli_output *output, run_s
 	if (run->stats == NULL)
 		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write", path);
 	fprintf(run->stats, "time,newton_iterations,gradient_norm,energy,max_barb_strain,wall_seconds,kinetic_energy,"
-	                    "elastic_energy,gravitational_energy,vane_min_principal_stretch,vane_max_out_of_plane");
+	                    "elastic_energy,gravitational_energy,contact_energy,friction_potential,vane_min_principal_stretch,"
+	                    "vane_max_out_of_plane");
 	for (int h = 0; h < scene->handle_count; ++h)
 		fprintf(run->stats, ",handle%d_fx,handle%d_fy,handle%d_fz,handle%d_dx,handle%d_dy,handle%d_dz", h, h, h, h, h,
 		        h);

@@ -65,6 +65,12 @@ assert s["frames_checked"] == s["steps"] + 1, s
 assert s["contact_pairs_max"] > 0 and 0 < s["min_distance"] < 1.2e-4, s
 assert s["max_barb_strain"] < 1e-8, s
 ' "$scratch/$scene-true/summary.json"
+	check "$scene: stats.csv has the barrier energy with contact, none without" /usr/bin/python3 -c '
+import csv, sys
+on = [float(r["contact_energy"]) for r in csv.DictReader(open(sys.argv[1]))]
+off = [float(r["contact_energy"]) for r in csv.DictReader(open(sys.argv[2]))]
+assert min(on) >= 0 and max(on) > 0 and set(off) == {0.0}, (on, off)
+' "$scratch/$scene-true/stats.csv" "$scratch/$scene-false/stats.csv"
 done
 
 # The two examples of issue 14, shortened: the flapping bird's first 30 ms (its feathers

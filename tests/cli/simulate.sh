@@ -33,7 +33,7 @@ check "summary has rachis_tip_deflection" grep -q '"rachis_tip_deflection"' "$ou
 # The vane's shape and the handle's reaction per step, their extremes in the summary:
 # a feather held at its clamp sags under gravity (its vane leaves the plane by a little,
 # well under its length) and stretches by next to nothing; the clamp carries its weight (+z).
-check "stats has the vane's shape" grep -q "^time,.*,gravitational_energy,vane_min_principal_stretch,vane_max_out_of_plane,handle0_fx," "$out/stats.csv"
+check "stats has the vane's shape" grep -q "^time,.*,gravitational_energy,contact_energy,friction_potential,vane_min_principal_stretch,vane_max_out_of_plane,handle0_fx," "$out/stats.csv"
 check "vane shape and reactions: plausible, summary gives their extremes" /usr/bin/python3 -c '
 import csv, json, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
