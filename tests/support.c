@@ -2,6 +2,7 @@
 #include "support.h"
 
 #include <dirent.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -91,4 +92,29 @@ int test_count_entries(const char *path)
 			count++;
 	closedir(dir);
 	return count;
+}
+
+double test_coordinate(const plume_vec3 *x, int k)
+{
+	const plume_vec3 *p = x + k / 3;
+	return k % 3 == 0 ? p->x : k % 3 == 1 ? p->y : p->z;
+}
+
+void test_set_coordinate(plume_vec3 *x, int k, double value)
+{
+	plume_vec3 *p = x + k / 3;
+	if (k % 3 == 0)
+		p->x = value;
+	else if (k % 3 == 1)
+		p->y = value;
+	else
+		p->z = value;
+}
+
+double test_norm(const double *v, int n)
+{
+	double sum = 0.0;
+	for (int i = 0; i < n; ++i)
+		sum += v[i] * v[i];
+	return sqrt(sum);
 }

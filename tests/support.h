@@ -27,6 +27,13 @@ int test_file_exists(const char *path);
 /// Number of entries in a folder (hidden ones included), -1 when it does not exist.
 int test_count_entries(const char *path);
 
+/// Coordinate k of a vertex array seen as 3 n numbers (x0 y0 z0 x1 ...), for the finite
+/// differences of energies over vertex positions; and its setter.
+double test_coordinate(const plume_vec3 *x, int k);
+void test_set_coordinate(plume_vec3 *x, int k, double value);
+/// Euclidean norm of n numbers.
+double test_norm(const double *v, int n);
+
 /// Asserts that |a - b| <= tolerance, printing both on failure.
 #define assert_close(a, b, tolerance)                                                                                  \
 	do {                                                                                                               \

@@ -23,31 +23,6 @@ enum { REGION_COUNT = PLUME_EE_LINES + 1 };
 // ---------------------------------------------------------------------------
 // Helpers
 
-static double coordinate(const plume_vec3 *x, int k)
-{
-	const plume_vec3 *p = x + k / 3;
-	return k % 3 == 0 ? p->x : k % 3 == 1 ? p->y : p->z;
-}
-
-static void set_coordinate(plume_vec3 *x, int k, double value)
-{
-	plume_vec3 *p = x + k / 3;
-	if (k % 3 == 0)
-		p->x = value;
-	else if (k % 3 == 1)
-		p->y = value;
-	else
-		p->z = value;
-}
-
-static double norm(const double *v, int n)
-{
-	double sum = 0.0;
-	for (int i = 0; i < n; ++i)
-		sum += v[i] * v[i];
-	return sqrt(sum);
-}
-
 static plume_vec3 random_vec3(plume_rng *rng, double size)
 {
 	return plume_v3(plume_rng_range(rng, -size, size), plume_rng_range(rng, -size, size),
@@ -416,12 +391,12 @@ static double finite_difference_error(pair_fn *fn, const void *context, const pl
 			assert_true(hessian[r * 12 + c] == hessian[c * 12 + r]);
 	double fd_gradient[12], fd_hessian[144];
 	for (int k = 0; k < 12; ++k) {
-		double at = coordinate(x0, k), gp[12], gm[12];
-		set_coordinate(x, k, at + h);
+		double at = test_coordinate(x0, k), gp[12], gm[12];
+		test_set_coordinate(x, k, at + h);
 		double ep = fn(context, x, gp, NULL);
-		set_coordinate(x, k, at - h);
+		test_set_coordinate(x, k, at - h);
 		double em = fn(context, x, gm, NULL);
-		set_coordinate(x, k, at);
+		test_set_coordinate(x, k, at);
 		fd_gradient[k] = (ep - em) / (2 * h);
 		for (int r = 0; r < 12; ++r)
 			fd_hessian[r * 12 + k] = (gp[r] - gm[r]) / (2 * h);
@@ -431,8 +406,8 @@ static double finite_difference_error(pair_fn *fn, const void *context, const pl
 		diff_g[k] = fd_gradient[k] - gradient[k];
 	for (int k = 0; k < 144; ++k)
 		diff_h[k] = fd_hessian[k] - hessian[k];
-	assert_true(norm(gradient, 12) > 0);
-	return fmax(norm(diff_g, 12) / norm(gradient, 12), norm(diff_h, 144) / norm(hessian, 144));
+	assert_true(test_norm(gradient, 12) > 0);
+	return fmax(test_norm(diff_g, 12) / test_norm(gradient, 12), test_norm(diff_h, 144) / test_norm(hessian, 144));
 }
 
 /// A configuration well inside region `kind`, moved rigidly at random. Point-triangle:
@@ -784,11 +759,11 @@ static void test_projected_hessian(void **state)
 			// the points vanish.
 			for (int c = 0; c < 3; ++c) {
 				assert_close(g_exact[c] + g_exact[3 + c] + g_exact[6 + c] + g_exact[9 + c], 0.0,
-				             1e-12 * norm(g_exact, 12));
+				             1e-12 * test_norm(g_exact, 12));
 				for (int row = 0; row < 12; ++row)
 					assert_close(exact[row * 12 + c] + exact[row * 12 + 3 + c] + exact[row * 12 + 6 + c] +
 					                 exact[row * 12 + 9 + c],
-					             0.0, 1e-12 * norm(exact, 144));
+					             0.0, 1e-12 * test_norm(exact, 144));
 			}
 			// P is the Frobenius-nearest PSD matrix to H iff P >= 0, P - H >= 0 and
 			// P (P - H) = 0 (the two parts of H's spectral split are orthogonal).
@@ -871,9 +846,9 @@ static int check_boundaries(plume_contact_pair_type type, const plume_vec3 start
 				fail_msg("regions %d | %d: %.17g | %.17g", (int)kind_lo, (int)kind_hi, v_lo, v_hi);
 			for (int i = 0; i < 12; ++i)
 				diff[i] = g_lo[i] - g_hi[i];
-			if (!(norm(diff, 12) <= 1e-7 * norm(g_lo, 12)))
+			if (!(test_norm(diff, 12) <= 1e-7 * test_norm(g_lo, 12)))
 				fail_msg("regions %d | %d: gradients differ by %.3g of %.3g", (int)kind_lo, (int)kind_hi,
-				         norm(diff, 12), norm(g_lo, 12));
+				         test_norm(diff, 12), test_norm(g_lo, 12));
 			checked++;
 		}
 		previous = kind;

@@ -46,31 +46,6 @@ static double ff_fn(const void *element, const plume_vec3 *x, double *gradient, 
 	return plume_ff_face_energy(element, x, gradient, hessian);
 }
 
-static double coordinate(const plume_vec3 *x, int k)
-{
-	const plume_vec3 *p = x + k / 3;
-	return k % 3 == 0 ? p->x : k % 3 == 1 ? p->y : p->z;
-}
-
-static void set_coordinate(plume_vec3 *x, int k, double value)
-{
-	plume_vec3 *p = x + k / 3;
-	if (k % 3 == 0)
-		p->x = value;
-	else if (k % 3 == 1)
-		p->y = value;
-	else
-		p->z = value;
-}
-
-static double norm(const double *v, int n)
-{
-	double sum = 0.0;
-	for (int i = 0; i < n; ++i)
-		sum += v[i] * v[i];
-	return sqrt(sum);
-}
-
 /// Central differences of the energy (for the gradient) and of the gradient (for the
 /// Hessian) at x, with step h; returns the larger relative error, in the Frobenius /
 /// Euclidean norm.
@@ -92,13 +67,13 @@ static double finite_difference_error(energy_fn *fn, const void *element, const 
 	assert_memory_equal(only_gradient, gradient, (size_t)n * sizeof(double));
 	double fd_gradient[MAX], fd_hessian[MAX * MAX];
 	for (int k = 0; k < n; ++k) {
-		double value = coordinate(x0, k);
+		double value = test_coordinate(x0, k);
 		double gp[MAX], gm[MAX];
-		set_coordinate(x, k, value + h);
+		test_set_coordinate(x, k, value + h);
 		double ep = fn(element, x, gp, NULL);
-		set_coordinate(x, k, value - h);
+		test_set_coordinate(x, k, value - h);
 		double em = fn(element, x, gm, NULL);
-		set_coordinate(x, k, value);
+		test_set_coordinate(x, k, value);
 		fd_gradient[k] = (ep - em) / (2.0 * h);
 		for (int r = 0; r < n; ++r)
 			fd_hessian[r * n + k] = (gp[r] - gm[r]) / (2.0 * h);
@@ -108,8 +83,8 @@ static double finite_difference_error(energy_fn *fn, const void *element, const 
 		diff_g[k] = fd_gradient[k] - gradient[k];
 	for (int k = 0; k < n * n; ++k)
 		diff_h[k] = fd_hessian[k] - hessian[k];
-	double error_g = norm(diff_g, n) / norm(gradient, n);
-	double error_h = norm(diff_h, n * n) / norm(hessian, n * n);
+	double error_g = test_norm(diff_g, n) / test_norm(gradient, n);
+	double error_h = test_norm(diff_h, n * n) / test_norm(hessian, n * n);
 	// The analytic Hessian must be symmetric.
 	for (int r = 0; r < n; ++r)
 		for (int c = 0; c < n; ++c)
@@ -281,7 +256,7 @@ static void test_patch_stretch_along_and_across_barbs(void **state)
 			assert_close(energy, element.area * 0.5 * thickness * modulus * strain * strain,
 			             1e-12 * element.area * thickness * E_vv * strain * strain);
 			for (int k = 0; k < 9; ++k)
-				assert_close(gradient[k], expect[k], 1e-11 * norm(expect, 9));
+				assert_close(gradient[k], expect[k], 1e-11 * test_norm(expect, 9));
 			// The free lateral strain: d energy / d eps across = 0 at zero lateral strain,
 			// i.e. the membrane does not want to contract sideways. Stretch sideways by a
 			// little and check that the energy grows quadratically from this state, with the
@@ -353,7 +328,7 @@ static void test_patch_general_uniform_deformation(void **state)
 		uniform_stress_gradient(&element, F, S, expect);
 		plume_membrane_energy(&element, x, gradient, NULL);
 		for (int k = 0; k < 9; ++k)
-			assert_close(gradient[k], expect[k], 1e-11 * norm(expect, 9));
+			assert_close(gradient[k], expect[k], 1e-11 * test_norm(expect, 9));
 	}
 }
 
@@ -580,7 +555,7 @@ static void test_fundamental_form_tensor_and_rigid_motion(void **state)
 		double gradient[18];
 		double energy = plume_ff_face_energy(&face, x, gradient, NULL);
 		assert_true(energy <= 1e-26 * across);
-		assert_true(norm(gradient, 18) <= 1e-12 * across);
+		assert_true(test_norm(gradient, 18) <= 1e-12 * across);
 	}
 }
 
@@ -614,10 +589,10 @@ static void test_rigid_motion_stores_nothing(void **state)
 		double force = thickness * E_vv;
 		double energy = plume_membrane_energy(&element, x, gradient, hessian);
 		assert_true(fabs(energy) <= 1e-26 * force);
-		assert_true(norm(gradient, 9) <= 1e-13 * force);
+		assert_true(test_norm(gradient, 9) <= 1e-13 * force);
 		energy = plume_compression_energy(&element, x, gradient, NULL);
 		assert_true(energy <= 1e-30 * element.compression);
-		assert_true(norm(gradient, 9) <= 1e-20 * element.compression);
+		assert_true(test_norm(gradient, 9) <= 1e-20 * element.compression);
 
 		// Bending: a hinge folded at rest, moved rigidly.
 		plume_vec3 rest[4];
@@ -630,7 +605,7 @@ static void test_rigid_motion_stores_nothing(void **state)
 		energy = plume_hinge_energy(&hinge, x, gradient, NULL);
 		double k = hinge.stiffness * hinge.scale * hinge.scale;
 		assert_true(energy <= 1e-26 * k);
-		assert_true(norm(gradient, 12) <= 1e-12 * k);
+		assert_true(test_norm(gradient, 12) <= 1e-12 * k);
 	}
 }
 
@@ -652,7 +627,7 @@ static void test_compression_only_under_compression(void **state)
 		apply_uniform(F, reference, x);
 		double gradient[9], hessian[81];
 		assert_true(plume_compression_energy(&element, x, gradient, hessian) == 0.0);
-		assert_true(norm(gradient, 9) == 0.0 && norm(hessian, 81) == 0.0);
+		assert_true(test_norm(gradient, 9) == 0.0 && test_norm(hessian, 81) == 0.0);
 	}
 	// Disabled when kappa = 0.
 	double voigt[9];
@@ -1007,7 +982,7 @@ static void test_project_psd_translation_free(void **state)
 		plume_project_psd(full, n);
 		plume_project_psd_translation_free(reduced, m);
 		changed += memcmp(full, H, (size_t)(n * n) * sizeof(double)) != 0;
-		double scale = norm(H, n * n);
+		double scale = test_norm(H, n * n);
 		for (int i = 0; i < n * n; ++i)
 			assert_close(reduced[i], full[i], 1e-12 * scale);
 		for (int i = 0; i < n; ++i)
@@ -1052,9 +1027,9 @@ static void test_triangle_energy_and_projection(void **state)
 		double energy = plume_triangle_energy(&element, x, g, H, false);
 		double sum = plume_membrane_energy(&element, x, gm, Hm) + plume_compression_energy(&element, x, gc, Hc);
 		assert_close(energy, sum, 1e-13 * fabs(sum));
-		double scale = norm(Hm, 81) + norm(Hc, 81);
+		double scale = test_norm(Hm, 81) + test_norm(Hc, 81);
 		for (int i = 0; i < 9; ++i)
-			assert_close(g[i], gm[i] + gc[i], 1e-12 * (norm(gm, 9) + norm(gc, 9)));
+			assert_close(g[i], gm[i] + gc[i], 1e-12 * (test_norm(gm, 9) + test_norm(gc, 9)));
 		for (int i = 0; i < 81; ++i)
 			assert_close(H[i], Hm[i] + Hc[i], 1e-12 * scale);
 		assert_true(finite_difference_error(triangle_fn, &element, x, 3, 1e-6) < 1e-6);
@@ -1064,7 +1039,7 @@ static void test_triangle_energy_and_projection(void **state)
 		double values[9];
 		plume_symmetric_eigen(P, 9, values, NULL);
 		for (int k = 0; k < 9; ++k)
-			assert_true(values[k] >= -1e-12 * norm(P, 81));
+			assert_true(values[k] >= -1e-12 * test_norm(P, 81));
 		for (int r = 0; r < 9; ++r)
 			for (int c = 0; c < 9; ++c)
 				assert_true(P[9 * r + c] == P[9 * c + r]);
