@@ -597,6 +597,21 @@ static void test_obj(void **state)
 	assert_memory_equal(back.triangles, fan, sizeof fan);
 	plume_body_mesh_free(&back);
 
+	// CRLF line ends, comments, blank lines; a body reads no texture coordinates, so a
+	// "vt" that is not finite and texture indices past the "vt" lines pass (the shell's
+	// reader, plume_mesh_read_obj, refuses both: test_mesh.c).
+	write_fixture("crlf.obj",
+	              "# exported on Windows\r\n\r\nv 0 0 0\r\nv 1 0 0 # origin's neighbour\r\nv 1 1 0\r\n"
+	              "v 0 1 0\r\nvt nan 0\r\n\tf 1/9/1 2/9/1 -2/9/1 -1/9/1\r\n",
+	              path, sizeof path);
+	assert_int_equal(plume_body_read_obj(path, &back, &err), PLUME_OK);
+	const int quad[] = {0, 1, 2, 0, 2, 3};
+	assert_int_equal(back.vertex_count, 4);
+	assert_int_equal(back.triangle_count, 2);
+	assert_memory_equal(back.triangles, quad, sizeof quad);
+	assert_true(back.vertices[1].x == 1.0 && back.vertices[3].y == 1.0);
+	plume_body_mesh_free(&back);
+
 	// Errors, with file and line.
 	const struct {
 		const char *text, *message;
@@ -611,6 +626,12 @@ static void test_obj(void **state)
 	    {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 2\n", ":4: face 1: degenerate (zero-area) triangle of vertices 1 2 2"},
 	    {"v 0 0 0\nv 1 0 0\nf 1 2\n", ":3: face 1 has 2 corners; a face needs at least 3"},
 	    {"v 0 0 0\nv 1 0 0\nf 1 x 2\n", ":3: face 1: corner \"x\" is not a vertex index"},
+	    {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3/x\n", ":4: face 1: corner \"3/x\" is not a vertex index"},
+	    {"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 4 3\nf 1 2 3 4 5\n",
+	     ":6: face 2: vertex index 5 out of range (4 vertices so far)"},
+	    {"v 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\n# a triangle\r\nf 1 2 3 -4\r\n", ":5: face 1: vertex index -4 out of range"},
+	    {"v 0 0 0\nv 1 0x 0\n", ":2: vertex 2: \"0x\" is not a number"},
+	    {"v 0 0 0\nv 1 0 -inf\n", ":2: vertex 2: coordinate 3 is -inf; allowed finite, within 1e12 m"},
 	    {"v 0 0 0\n# nothing else\n", ":2: end of file without faces"},
 	};
 	for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
@@ -619,6 +640,8 @@ static void test_obj(void **state)
 		if (strstr(err.message, bad[i].message) == NULL || strstr(err.message, "bad.obj:") == NULL)
 			fail_msg("case %zu: \"%s\" lacks \"%s\"", i, err.message, bad[i].message);
 		assert_null(back.vertices);
+		assert_null(back.triangles);
+		assert_int_equal(back.vertex_count + back.triangle_count, 0);
 	}
 	// The error comes through a body file as is, naming the OBJ and its line.
 	write_fixture("bad.json", "{\"mesh\": \"bad.obj\"}", json, sizeof json);

@@ -267,6 +267,56 @@ static void test_mesh_surface(void **state)
 	plume_coat_destroy(coat);
 }
 
+/// The coat surface of a cube written as quads follicle for follicle equals the same cube
+/// written as the triangles a fan from each quad's first corner gives, (c0 c1 c2), (c0 c2 c3).
+static void test_mesh_surface_of_quads(void **state)
+{
+	(void)state;
+	// A cube of half-side 3 cm, faces wound outwards.
+	const char *vertices = "v -0.03 -0.03 -0.03\nv 0.03 -0.03 -0.03\nv 0.03 0.03 -0.03\nv -0.03 0.03 -0.03\n"
+	                       "v -0.03 -0.03 0.03\nv 0.03 -0.03 0.03\nv 0.03 0.03 0.03\nv -0.03 0.03 0.03\n";
+	const int quads[6][4] = {{1, 4, 3, 2}, {5, 6, 7, 8}, {1, 2, 6, 5}, {3, 4, 8, 7}, {1, 5, 8, 4}, {2, 3, 7, 6}};
+	char quad_text[1024], triangle_text[1024];
+	size_t q = (size_t)snprintf(quad_text, sizeof quad_text, "%s", vertices);
+	size_t t = (size_t)snprintf(triangle_text, sizeof triangle_text, "%s", vertices);
+	for (int f = 0; f < 6; ++f) {
+		const int *c = quads[f];
+		q += (size_t)snprintf(quad_text + q, sizeof quad_text - q, "f %d %d %d %d\n", c[0], c[1], c[2], c[3]);
+		t += (size_t)snprintf(triangle_text + t, sizeof triangle_text - t, "f %d %d %d\nf %d %d %d\n", c[0], c[1], c[2],
+		                      c[0], c[2], c[3]);
+	}
+	char obj[512];
+	snprintf(obj, sizeof obj, "%s/cube-quads.obj", scratch);
+	test_write_file(obj, quad_text);
+	snprintf(obj, sizeof obj, "%s/cube-triangles.obj", scratch);
+	test_write_file(obj, triangle_text);
+	const char *rest = "\"follicles\": {\"layout\": \"poisson\", \"spacing\": 0.012},"
+	                   "\"key_feathers\": [{\"at\": [0, 0, 0.03], \"feather\": \"@plume.json\"},"
+	                   "{\"at\": [0.03, 0, 0], \"feather\": \"@contour.json\"}],"
+	                   "\"direction\": {\"towards\": [0, -0.05, 0]}, \"lod\": {\"barb_elevations\": 0}";
+	char body[1024];
+	snprintf(body, sizeof body, "\"surface\": {\"type\": \"mesh\", \"obj\": \"cube-quads.obj\"}, %s", rest);
+	plume_coat *from_quads = build(write_coat("quads.json", body), 2, false);
+	snprintf(body, sizeof body, "\"surface\": {\"type\": \"mesh\", \"obj\": \"cube-triangles.obj\"}, %s", rest);
+	plume_coat *from_triangles = build(write_coat("triangles.json", body), 2, false);
+	assert_int_equal(plume_coat_surface(from_quads)->face_count, 12);
+	assert_memory_equal(plume_coat_surface(from_quads)->faces, plume_coat_surface(from_triangles)->faces,
+	                    36 * sizeof(int));
+	int count = plume_coat_feather_count(from_quads);
+	assert_true(count > 50);
+	assert_int_equal(plume_coat_feather_count(from_triangles), count);
+	for (int i = 0; i < count; ++i) {
+		plume_vec3 p[2], n[2];
+		plume_coat_follicle(from_quads, i, &p[0], &n[0]);
+		plume_coat_follicle(from_triangles, i, &p[1], &n[1]);
+		assert_memory_equal(&p[0], &p[1], sizeof p[0]);
+		assert_memory_equal(&n[0], &n[1], sizeof n[0]);
+	}
+	assert_rooted(from_quads);
+	plume_coat_destroy(from_triangles);
+	plume_coat_destroy(from_quads);
+}
+
 static void test_exports_and_strip_rendering(void **state)
 {
 	(void)state;
@@ -352,12 +402,12 @@ static void test_bad_coats(void **state)
 	                  "\"key_feathers\": [{\"at\": [0, 0], \"feather\": \"@plume.json\"},"
 	                  "{\"at\": [0.001, 0], \"feather\": \"@plume.json\"}]",
 	                  PLUME_ERROR_SPEC, "already holds key feather 0");
-	// An OBJ that is not a triangle mesh.
+	// An OBJ with a face of two corners.
 	char obj[512];
-	snprintf(obj, sizeof obj, "%s/quad.obj", scratch);
-	test_write_file(obj, "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n");
+	snprintf(obj, sizeof obj, "%s/short.obj", scratch);
+	test_write_file(obj, "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nf 1 2\n");
 	snprintf(body, sizeof body,
-	         "\"surface\": {\"type\": \"mesh\", \"obj\": \"quad.obj\"}, \"follicles\": {\"layout\": \"poisson\", "
+	         "\"surface\": {\"type\": \"mesh\", \"obj\": \"short.obj\"}, \"follicles\": {\"layout\": \"poisson\", "
 	         "\"spacing\": 0.1}, %s",
 	         keys);
 	const char *path = write_coat("bad.json", body);
@@ -366,7 +416,7 @@ static void test_bad_coats(void **state)
 	plume_spec_options options = {0};
 	assert_true(plume_coat_spec_generate(path, &options, &coat, &err) != PLUME_OK);
 	assert_null(coat);
-	assert_non_null(strstr(err.message, "quad.obj"));
+	assert_non_null(strstr(err.message, "short.obj:6: face 2 has 2 corners; a face needs at least 3"));
 	assert_non_null(strstr(err.message, "$.surface.obj"));
 	snprintf(body, sizeof body,
 	         "\"surface\": {\"type\": \"mesh\", \"obj\": \"octahedron.obj\"}, \"follicles\": {\"spacing\": 0.1}, %s",
@@ -422,6 +472,7 @@ int main(void)
 	    cmocka_unit_test(test_poisson_keeps_its_distance),
 	    cmocka_unit_test(test_sphere_coat),
 	    cmocka_unit_test(test_mesh_surface),
+	    cmocka_unit_test(test_mesh_surface_of_quads),
 	    cmocka_unit_test(test_exports_and_strip_rendering),
 	    cmocka_unit_test(test_bad_coats),
 	    cmocka_unit_test(test_progress),

@@ -891,17 +891,46 @@ static void test_obj_reader(void **state)
 	assert_true(mesh->uv[0].x == 0.0 && mesh->uv[1].x == 0.0); // not every face vertex has a vt: zero
 	plume_mesh_destroy(mesh);
 
+	// A quad and a pentagon, fanned from their first corner: (c0, c_i, c_i+1), each
+	// triangle with its corners' texture coordinates and its polygon's group; CRLF line
+	// ends, a comment after the data, blank and indented lines.
+	test_write_file(path, "v 0 0 0\r\nv 1 0 0\r\nv 1 1 0\r\nv 0 1 0\r\nv 0.5 1.5 0 # apex\r\n\r\n"
+	                      "vt 0 0\r\nvt 1 0\r\nvt 1 1\r\nvt 0 1\r\nvt 0.5 1.5\r\n"
+	                      "  f 1/1 2/2 3/3 4/4\r\ng rachis\r\nf -5/-5 -4/-4 -3/-3 -1/-1 -2/-2\r\n");
+	assert_int_equal(plume_mesh_read_obj(path, &mesh, &err), PLUME_OK);
+	assert_int_equal(mesh->vertex_count, 5);
+	assert_int_equal(mesh->face_count, 5);
+	const int fan[15] = {0, 1, 2, 0, 2, 3, 0, 1, 2, 0, 2, 4, 0, 4, 3};
+	assert_memory_equal(mesh->faces, fan, sizeof fan);
+	const unsigned char materials[5] = {PLUME_MATERIAL_VANE, PLUME_MATERIAL_VANE, PLUME_MATERIAL_RACHIS,
+	                                    PLUME_MATERIAL_RACHIS, PLUME_MATERIAL_RACHIS};
+	assert_memory_equal(mesh->material, materials, sizeof materials);
+	assert_true(mesh->uv[4].x == 0.5 && mesh->uv[4].y == 1.5 && mesh->uv[2].x == 1.0);
+	assert_true(mesh->rest[4].y == 1.5);
+	plume_mesh_destroy(mesh);
+
+	// Errors name the file, the line and what is wrong, and return no mesh.
 	struct {
 		const char *text, *expected;
 	} cases[] = {
-	    {"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 4 3\n", "in.obj:5: face with more than 3 vertices"},
-	    {"v 0 0 0\nv 1 0 0\nv 0 1 0\n\nf 1 2 7\n", "in.obj:5: vertex index 7 out of range"},
-	    {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -4\n", "in.obj:4: vertex index -4 out of range"},
-	    {"v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/2 3/1\n", "in.obj:5: texture index 2 out of range"},
+	    {"v 0 0 0\nv 1 0 0\nv 0 1 0\n\nf 1 2 7\n", "in.obj:5: face 1: vertex index 7 out of range (3 vertices so far)"},
+	    {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 -4\n", "in.obj:5: face 2: vertex index -4 out of range"},
+	    {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 0\n", "in.obj:4: face 1: vertex index 0 out of range"},
+	    {"v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/2 3/1\n",
+	     "in.obj:5: face 1: texture index 2 out of range (1 texture coordinates so far)"},
+	    {"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3 5\n", "in.obj:5: face 1: vertex index 5 out of range"},
 	    {"v 0 0 0\nv 1 0 0\nv 0 1 0\n", "in.obj:3: end of file without faces"},
-	    {"v 0 0\n", "in.obj:1: \"v\" needs three numbers"},
-	    {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n", "in.obj:4: face with fewer than 3 vertices"},
-	    {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 x 3\n", "in.obj:4: face vertex is not an index"},
+	    {"v 0 0\n", "in.obj:1: \"v\" needs three numbers (x y z); found 2"},
+	    {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n", "in.obj:4: face 1 has 2 corners; a face needs at least 3"},
+	    {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 x 3\n", "in.obj:4: face 1: corner \"x\" is not a vertex index"},
+	    {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2/ 3\n", "in.obj:4: face 1: corner \"2/\" is not a vertex index"},
+	    {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3//x\n", "in.obj:4: face 1: corner \"3//x\" is not a vertex index"},
+	    {"v 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nf 1 2 3 4\r\n", "in.obj:4: face 1: vertex index 4 out of range"},
+	    {"v 0 0 0\nv 1 0,5 0\n", "in.obj:2: vertex 2: \"0,5\" is not a number"},
+	    {"v 0 0 0\nv 1 0 0 one\n", "in.obj:2: vertex 2: \"one\" is not a number"},
+	    {"v 0 0 0\nv 0 inf 0\n", "in.obj:2: vertex 2: coordinate 2 is inf; allowed finite, within 1e12 m"},
+	    {"v 0 0 0\nvt 0 x\n", "in.obj:2: texture coordinate 1: \"x\" is not a number"},
+	    {"vt\n", "in.obj:1: \"vt\" needs one or two numbers (u [v]); found 0"},
 	};
 	int64_t before = plume_bytes_in_use();
 	for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {

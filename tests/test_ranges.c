@@ -181,10 +181,10 @@ static void test_obj_texture_coordinates(void **state)
 	plume_error err = {0};
 	assert_int_equal(plume_mesh_read_obj(path, &mesh, &err), PLUME_ERROR_SYNTAX);
 	assert_null(mesh);
-	expect_message(&err, "vt.obj:5: \"vt\": a coordinate is not finite or is beyond 1e12");
+	expect_message(&err, "vt.obj:5: texture coordinate 2: coordinate 1 is nan; allowed finite, within 1e12");
 	test_write_file(path, "v 0 0 0\nv 1 0 0\nv 0 1e13 0\nf 1 2 3\n");
 	assert_int_equal(plume_mesh_read_obj(path, &mesh, &err), PLUME_ERROR_SYNTAX);
-	expect_message(&err, "vt.obj:3: \"v\": a coordinate is not finite or is beyond 1e12 m");
+	expect_message(&err, "vt.obj:3: vertex 3: coordinate 2 is 1e+13; allowed finite, within 1e12 m");
 	// Normals are not read: a "vn nan" line is ignored, the mesh loads.
 	test_write_file(path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn nan nan nan\nf 1 2 3\n");
 	assert_int_equal(plume_mesh_read_obj(path, &mesh, &err), PLUME_OK);

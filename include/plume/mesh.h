@@ -229,12 +229,20 @@ plume_mesh_report plume_mesh_measure(const plume_mesh *mesh);
 
 void plume_mesh_destroy(plume_mesh *mesh);
 
-/// Reads a triangle mesh from Wavefront OBJ: v, vt and f lines (f with v, v/vt,
-/// v//vn or v/vt/vn; negative indices allowed; other lines ignored). rest holds
-/// the positions, reference their (x, y), uv the texture coordinates when every
-/// face vertex has one (else zero). Faces get material 0, barb_edge -1. A face
-/// that is not a triangle, an index out of range or no faces at all is an error
-/// naming the file and line.
+/// Reads a polygon mesh from Wavefront OBJ (docs/formats.md, "Reading OBJ meshes"):
+/// v, vt, f and g lines; f corners v, v/vt, v//vn or v/vt/vn, 1-based or negative
+/// (counted back from the last one so far); comments, blank lines, CRLF and other
+/// lines (normals, objects, materials) ignored; numbers in the "C" locale. A face of
+/// n >= 3 corners (c0, ..., c_n-1) is fan-triangulated from its first corner into the
+/// n - 2 triangles (c0, c_i, c_i+1), i = 1 .. n-2, in that order (exact for convex
+/// planar polygons). rest holds the positions, reference their (x, y), uv the texture
+/// coordinates when every corner has one (else zero; a vertex with several keeps its
+/// first). Each triangle gets its face's material from the group name the writer gives
+/// it ("rachis", "material_N"; else the vane's, 0) and barb_edge -1.
+/// PLUME_ERROR_SYNTAX "file:line: what" on a token that is not a number, a coordinate
+/// that is not finite or beyond 1e12, a corner that is not an index, an index out of
+/// range, a face of fewer than 3 corners or no faces at all; PLUME_ERROR_IO when the
+/// file cannot be read. On any error *out is NULL.
 plume_status plume_mesh_read_obj(const char *path, plume_mesh **out, plume_error *err);
 
 /// Writes the mesh with the given vertex positions (rest when positions is NULL)

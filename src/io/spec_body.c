@@ -3,153 +3,55 @@
 // the mesh. The checks on the assembled definition are plume_body_create's; this file
 // adds the JSON paths (and the OBJ's file and line) to its messages.
 #define _POSIX_C_SOURCE 200809L
-#include <ctype.h>
-#include <stdarg.h>
-#include <errno.h>
 #include <libgen.h>
-#include <locale.h>
 #include <math.h>
 #include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "../core/alloc.h"
 #include "../sim/body_internal.h"
+#include "obj_reader.h"
 #include "spec.h"
 #include "spec_body.h"
 
 // ---------------------------------------------------------------------------
-// OBJ
+// OBJ (read by obj_reader.c; a body adds its zero-area check, with the file's line)
 
-typedef struct obj_state {
-	const char *path;
-	long line;
-	int face;
-	plume_error *err;
-	plume_body_mesh mesh;
-	int vertex_capacity, triangle_capacity;
-} obj_state;
-
-static plume_status obj_fail(obj_state *state, const char *format, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 2, 3)))
-#endif
-    ;
-
-static plume_status obj_fail(obj_state *state, const char *format, ...)
+/// Fails on the first triangle of zero area, naming its face and line.
+static plume_status check_obj_areas(const plume_obj *obj, const char *path, plume_error *err)
 {
-	char message[768];
-	va_list args;
-	va_start(args, format);
-	vsnprintf(message, sizeof message, format, args);
-	va_end(args);
-	return plume_error_set(state->err, PLUME_ERROR_SYNTAX, "%s:%ld: %s", state->path, state->line, message);
-}
-
-static plume_status obj_vertex(obj_state *state, const char *text)
-{
-	double x[3];
-	for (int i = 0; i < 3; ++i) {
-		char *end;
-		x[i] = strtod(text, &end);
-		if (end == text || !(isspace((unsigned char)*end) || *end == '\0'))
-			return obj_fail(state, "\"v\" needs three numbers");
-		// The bound of every number plume reads (PLUME_SPEC_MAX_MAGNITUDE); nan and inf fail here.
-		if (!(fabs(x[i]) <= PLUME_SPEC_MAX_MAGNITUDE))
-			return obj_fail(state, "vertex %d: coordinate %d is %g; allowed finite, within 1e12 m",
-			                state->mesh.vertex_count + 1, i + 1, x[i]);
-		text = end;
-	}
-	if (PLUME_GROW(state->mesh.vertices, state->vertex_capacity, state->mesh.vertex_count + 1) != 0)
-		return plume_error_set(state->err, PLUME_ERROR_MEMORY, "%s: out of memory", state->path);
-	state->mesh.vertices[state->mesh.vertex_count++] = plume_v3(x[0], x[1], x[2]);
-	return PLUME_OK;
-}
-
-/// One polygon, fanned from its first corner into triangles (c0, c_i, c_i+1).
-static plume_status obj_face(obj_state *state, char *text)
-{
-	++state->face;
-	int first = -1, previous = -1, corners = 0;
-	char *save = NULL;
-	for (char *token = strtok_r(text, " \t\r\n", &save); token != NULL; token = strtok_r(NULL, " \t\r\n", &save)) {
-		char *end;
-		errno = 0;
-		long index = strtol(token, &end, 10);
-		if (end == token || (*end != '\0' && *end != '/') || errno != 0)
-			return obj_fail(state, "face %d: corner \"%s\" is not a vertex index", state->face, token);
-		int count = state->mesh.vertex_count;
-		long resolved = index > 0 ? index - 1 : count + index; // 1-based, or counted back from the last vertex
-		if (index == 0 || resolved < 0 || resolved >= count)
-			return obj_fail(state, "face %d: vertex index %ld out of range (%d vertices so far)", state->face, index,
-			                count);
-		int v = (int)resolved;
-		++corners;
-		if (corners == 1) {
-			first = v;
-		} else if (corners >= 3) {
-			const plume_vec3 *p = state->mesh.vertices;
-			if (plume_body_triangle_degenerate(p[first], p[previous], p[v]))
-				return obj_fail(state,
-				                "face %d: degenerate (zero-area) triangle of vertices %d %d %d (1-based, as in the "
-				                "file); remove the face or move its vertices apart",
-				                state->face, first + 1, previous + 1, v + 1);
-			if (PLUME_GROW(state->mesh.triangles, state->triangle_capacity, 3 * (state->mesh.triangle_count + 1)) != 0)
-				return plume_error_set(state->err, PLUME_ERROR_MEMORY, "%s: out of memory", state->path);
-			int *t = state->mesh.triangles + 3 * state->mesh.triangle_count++;
-			t[0] = first, t[1] = previous, t[2] = v;
+	const plume_vec3 *p = obj->vertices;
+	for (int t = 0; t < obj->triangle_count; ++t) {
+		const int *v = obj->triangles + 3 * t;
+		if (plume_body_triangle_degenerate(p[v[0]], p[v[1]], p[v[2]])) {
+			int face = obj->triangle_face[t];
+			return plume_error_set(err, PLUME_ERROR_SYNTAX,
+			                       "%s:%ld: face %d: degenerate (zero-area) triangle of vertices %d %d %d (1-based, "
+			                       "as in the file); remove the face or move its vertices apart",
+			                       path, obj->face_line[face], face + 1, v[0] + 1, v[1] + 1, v[2] + 1);
 		}
-		previous = v;
 	}
-	if (corners < 3)
-		return obj_fail(state, "face %d has %d corners; a face needs at least 3", state->face, corners);
 	return PLUME_OK;
 }
 
 plume_status plume_body_read_obj(const char *path, plume_body_mesh *mesh, plume_error *err)
 {
 	*mesh = (plume_body_mesh){0};
-	FILE *stream = fopen(path, "r");
-	if (stream == NULL)
-		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot open: %s", path, strerror(errno));
-	// Numbers in the "C" locale whatever the process's (see export.h).
-	locale_t c_locale = newlocale(LC_NUMERIC_MASK, "C", (locale_t)0);
-	if (c_locale == (locale_t)0) {
-		fclose(stream);
-		return plume_error_set(err, PLUME_ERROR_MEMORY, "%s: out of memory", path);
+	plume_obj obj;
+	plume_status status = plume_obj_read(path, PLUME_OBJ_POSITIONS, &obj, err);
+	if (status == PLUME_OK)
+		status = check_obj_areas(&obj, path, err);
+	if (status == PLUME_OK) {
+		// The body takes the reader's arrays as they are.
+		*mesh = (plume_body_mesh){.vertex_count = obj.vertex_count,
+		                          .vertices = obj.vertices,
+		                          .triangle_count = obj.triangle_count,
+		                          .triangles = obj.triangles};
+		obj.vertices = NULL;
+		obj.triangles = NULL;
 	}
-	locale_t saved_locale = uselocale(c_locale);
-	obj_state state = {.path = path, .err = err};
-	plume_status status = PLUME_OK;
-	char *line = NULL;
-	size_t capacity = 0;
-	while (status == PLUME_OK && getline(&line, &capacity, stream) >= 0) {
-		++state.line;
-		char *text = line;
-		while (isspace((unsigned char)*text))
-			++text;
-		if (text[0] == 'v' && isspace((unsigned char)text[1]))
-			status = obj_vertex(&state, text + 2);
-		else if (text[0] == 'f' && isspace((unsigned char)text[1]))
-			status = obj_face(&state, text + 2);
-		// Anything else (comments, normals, texture coordinates, groups, materials) is ignored.
-	}
-	if (status == PLUME_OK && ferror(stream))
-		status = plume_error_set(err, PLUME_ERROR_IO, "%s: read failed: %s", path, strerror(errno));
-	if (status == PLUME_OK && state.mesh.triangle_count == 0)
-		status = plume_error_set(err, PLUME_ERROR_SYNTAX,
-		                         "%s:%ld: end of file without faces (\"f\" lines): a body mesh needs triangles", path,
-		                         state.line);
-	free(line); // getline allocates with malloc
-	fclose(stream);
-	uselocale(saved_locale);
-	freelocale(c_locale);
-	if (status != PLUME_OK) {
-		plume_body_mesh_free(&state.mesh);
-		return status;
-	}
-	*mesh = state.mesh;
-	return PLUME_OK;
+	plume_obj_free(&obj);
+	return status;
 }
 
 // ---------------------------------------------------------------------------

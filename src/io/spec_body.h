@@ -14,11 +14,11 @@
 plume_status plume_spec_body(const char *file, const json_t *object, const char *path, const char *folder,
                              plume_body **out, plume_error *err);
 
-/// Reads a Wavefront OBJ as a body's rest mesh: "v x y z" and "f" lines (a/b/c corner
-/// syntax, 1-based or negative indices, polygons fanned into triangles from their first
-/// corner); other lines are ignored. Errors name file:line: a bad number, a non-finite
-/// vertex, an index out of range, a face of fewer than 3 corners, a degenerate
-/// (zero-area) triangle, no faces at all. mesh is freed with plume_body_mesh_free.
+/// Reads a Wavefront OBJ as a body's rest mesh with plume_obj_read (obj_reader.h), positions
+/// only: "v" and "f" lines (polygons fanned into triangles from their first corner), texture
+/// coordinates not read. Errors name file:line: plume_obj_read's, and a degenerate (zero-area)
+/// triangle, naming its face. On any error mesh is empty; else it is freed with
+/// plume_body_mesh_free.
 plume_status plume_body_read_obj(const char *path, plume_body_mesh *mesh, plume_error *err);
 
 #endif // PLUME_IO_SPEC_BODY_H

@@ -61,11 +61,11 @@ check "coat --max-memory 1G builds the example ($(cat "$scratch/err.txt"))" test
 # --- a coat on an OBJ with a nan vertex: looped forever choosing follicles -----------------------
 printf 'v 0 0 0\nv 0.1 0 0\nv nan 0.1 0\nv 0 0.1 0\nf 1 2 3\nf 1 3 4\n' >"$bad/nan.obj"
 printf '{"model": "coat", "surface": {"type": "mesh", "obj": "nan.obj"}, "follicles": {"layout": "poisson", "spacing": 0.01}, "key_feathers": [{"at": [0, 0, 0], "feather": "key-plume.json"}]}' >"$bad/coat-nan.json"
-expect_no_output "coat on a nan vertex" 3 'nan.obj:3: "v": a coordinate is not finite' "$scratch/o11" \
+expect_no_output "coat on a nan vertex" 3 'nan.obj:3: vertex 3: coordinate 1 is nan; allowed finite' "$scratch/o11" \
 	$T "$plume" coat "$bad/coat-nan.json" -o "$scratch/o11"
 printf 'v 0 0 0\nv 0.1 0 0\nv 1e300 0.1 0\nf 1 2 3\n' >"$bad/huge.obj"
 sed 's/nan.obj/huge.obj/' "$bad/coat-nan.json" >"$bad/coat-huge.json"
-expect_no_output "coat on a 1e300 vertex" 3 'huge.obj:3: "v": a coordinate is not finite or is beyond 1e12 m' \
+expect_no_output "coat on a 1e300 vertex" 3 'huge.obj:3: vertex 3: coordinate 1 is 1e+300; allowed finite, within 1e12 m' \
 	"$scratch/o12" $T "$plume" coat "$bad/coat-huge.json" -o "$scratch/o12"
 
 # --- time_step 1e-9 over duration 1e9: overflowed the step count, exit 0 with 0 steps -----------

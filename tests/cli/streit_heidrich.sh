@@ -109,10 +109,10 @@ expect_no_output "undecodable scan" 3 'empty.png: not an image' "$scratch/o6" \
 	"$plume" generate "$bad/scan2.json" -o "$scratch/o6"
 expect_no_output "grow a bad spec" 3 '$.rachis_length is -0.1' "$scratch/o7" \
 	"$plume" grow "$bad/negative.json" -o "$scratch/o7" --frames 3
-printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n' >"$bad/quad.obj"
-printf '{"model": "coat", "surface": {"type": "mesh", "obj": "quad.obj"}, "follicles": {"layout": "poisson", "spacing": 0.1}, "key_feathers": [{"at": [0, 0, 0], "feather": "%s/key-plume.json"}]}' "$coats" >"$bad/coat-quad.json"
-expect_no_output "coat on a non-triangle OBJ" 3 'quad.obj' "$scratch/o8" \
-	"$plume" coat "$bad/coat-quad.json" -o "$scratch/o8"
+printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nf 1 2\n' >"$bad/short.obj"
+printf '{"model": "coat", "surface": {"type": "mesh", "obj": "short.obj"}, "follicles": {"layout": "poisson", "spacing": 0.1}, "key_feathers": [{"at": [0, 0, 0], "feather": "%s/key-plume.json"}]}' "$coats" >"$bad/coat-short.json"
+expect_no_output "coat on an OBJ face of 2 corners" 3 'short.obj:6: face 2 has 2 corners; a face needs at least 3' \
+	"$scratch/o8" "$plume" coat "$bad/coat-short.json" -o "$scratch/o8"
 printf '{"model": "coat", "surface": {"type": "plane", "size": [0.05, 0.05]}, "follicles": {"spacing": 0}, "key_feathers": [{"at": [0, 0], "feather": "%s/key-plume.json"}]}' "$coats" >"$bad/coat-zero.json"
 expect_no_output "coat with zero spacing" 3 '$.follicles.spacing: is 0' "$scratch/o9" \
 	"$plume" coat "$bad/coat-zero.json" -o "$scratch/o9"
