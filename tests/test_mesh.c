@@ -249,9 +249,10 @@ static void test_examples_are_aligned(void **state)
 /// plume_mesh_report.excepted_count) the
 /// smallest vane angle must reach 20 degrees; the rows below 20 are the measured
 /// floor, pinned so that a change that makes them worse fails (docs/meshing.md
-/// lists what still makes them: fans at guides cut short, the narrow strips of
-/// Streit-Heidrich barbs at a few degrees to the rachis). Junction faces stay
-/// at most 4 % of the vane where it has 100 faces or more.
+/// lists what still makes them: fans at guides cut short that no neighbour
+/// vertex within e takes, the narrow strips of Streit-Heidrich barbs at a few
+/// degrees to the rachis). Junction faces stay at most 4 % of the vane where it
+/// has 100 faces or more.
 typedef struct quality_row {
 	const char *spec;
 	double edge_length;
@@ -262,20 +263,20 @@ typedef struct quality_row {
 static const quality_row quality_rows[] = {
     {"franco-walter/blue.json", 5e-3, 20.0, 0},
     {"franco-walter/blue.json", 2.5e-3, 20.0, 0},
-    {"franco-walter/figure6a.json", 5e-3, 6.79, 4},
-    {"franco-walter/figure6a.json", 2.5e-3, 12.89, 9},
+    {"franco-walter/figure6a.json", 5e-3, 20.0, 2},
+    {"franco-walter/figure6a.json", 2.5e-3, 12.89, 8},
     {"franco-walter/figure6b.json", 5e-3, 20.0, 1},
-    {"franco-walter/figure6b.json", 2.5e-3, 14.46, 1},
+    {"franco-walter/figure6b.json", 2.5e-3, 20.0, 0},
     {"franco-walter/filoplume.json", 5e-3, 20.0, 1},
     {"franco-walter/filoplume.json", 2.5e-3, 16.36, 1},
     {"franco-walter/hawk.json", 5e-3, 20.0, 0},
     {"franco-walter/hawk.json", 2.5e-3, 19.06, 0},
     {"franco-walter/peacock.json", 5e-3, 7.21, 2},
-    {"franco-walter/peacock.json", 2.5e-3, 3.39, 11},
+    {"franco-walter/peacock.json", 2.5e-3, 3.39, 8},
     {"franco-walter/pigeon-primary.json", 5e-3, 20.0, 3},
     {"franco-walter/pigeon-primary.json", 2.5e-3, 10.21, 7},
     {"franco-walter/pigeon-secondary.json", 5e-3, 20.0, 0},
-    {"franco-walter/pigeon-secondary.json", 2.5e-3, 13.96, 3},
+    {"franco-walter/pigeon-secondary.json", 2.5e-3, 18.10, 2},
     {"streit-heidrich/bristle.json", 5e-3, 4.33, 0},
     {"streit-heidrich/bristle.json", 2.5e-3, 15.33, 0},
     {"streit-heidrich/continuum.json", 5e-3, 20.0, 0},
@@ -288,10 +289,10 @@ static const quality_row quality_rows[] = {
     {"streit-heidrich/filoplume.json", 2.5e-3, 5.17, 7},
     {"streit-heidrich/flight.json", 5e-3, 16.59, 19},
     {"streit-heidrich/flight.json", 2.5e-3, 17.91, 44},
-    {"streit-heidrich/peacock.json", 5e-3, 1.03, 56},
-    {"streit-heidrich/peacock.json", 2.5e-3, 0.19, 113},
-    {"streit-heidrich/semiplume.json", 5e-3, 19.41, 4},
-    {"streit-heidrich/semiplume.json", 2.5e-3, 8.31, 7},
+    {"streit-heidrich/peacock.json", 5e-3, 3.57, 53},
+    {"streit-heidrich/peacock.json", 2.5e-3, 0.19, 104},
+    {"streit-heidrich/semiplume.json", 5e-3, 19.60, 4},
+    {"streit-heidrich/semiplume.json", 2.5e-3, 8.31, 6},
     {"zhang-kanai/figure10-asymmetry-020.json", 5e-3, 20.0, 0},
     {"zhang-kanai/figure10-asymmetry-020.json", 2.5e-3, 20.0, 0},
     {"zhang-kanai/figure10-asymmetry-040.json", 5e-3, 20.0, 0},
@@ -354,11 +355,11 @@ static void test_example_quality(void **state)
 	}
 	print_message("%d of %d example meshes reach %.0f degrees outside junction faces\n", meeting,
 	              (int)(sizeof quality_rows / sizeof quality_rows[0]), PLUME_MESH_QUALITY_ANGLE_DEG);
-	// 37 built by GCC, 34 by Clang: the Streit-Heidrich generator's growth turns last-bit
+	// 39 built by GCC, 36 by Clang: the Streit-Heidrich generator's growth turns last-bit
 	// differences between the two compilers into different feathers (different face counts),
 	// and three of its meshes sit near 20 degrees (down and continuum at 2.5 mm, semiplume at
 	// 5 mm). The rows above hold the lower floor of the two builds.
-	assert_true(meeting >= 34);
+	assert_true(meeting >= 36);
 	assert_int_equal(plume_bytes_in_use(), before);
 }
 
@@ -702,6 +703,76 @@ static void test_explicit_guides(void **state)
 	assert_int_equal(plume_bytes_in_use(), before);
 }
 
+/// Distance from p to segment ab.
+static double segment_distance(plume_vec2 p, plume_vec2 a, plume_vec2 b)
+{
+	double dx = b.x - a.x, dy = b.y - a.y;
+	double t = ((p.x - a.x) * dx + (p.y - a.y) * dy) / (dx * dx + dy * dy);
+	t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
+	return hypot(a.x + t * dx - p.x, a.y + t * dy - p.y);
+}
+
+/// A guide that ends well before its neighbours (docs/meshing.md, "Joining
+/// short guides"): straight barbs at 30 degrees to a straight rachis, rows 4 mm
+/// apart (guides 2 mm apart), and a slot 0.6 mm wide cut into the outline
+/// along the guide rooted at y = 48 mm, ending 13.5 mm along it, so that guide
+/// alone ends there. Without the join the strips beside it end in fans from its
+/// tip: 1.24 degrees (measured); joined, the tip moves onto a neighbour's
+/// vertex, no vertex stays on the slot, and the vane's smallest angle is that
+/// of the same feather without the slot.
+static void test_short_guide_joined(void **state)
+{
+	(void)state;
+	int64_t before = plume_bytes_in_use();
+	const double along = 0.0135, half_width = 3e-4;
+	plume_vec2 u = {0.5, sqrt(3.0) / 2.0}, n = {-u.y, u.x}, root = {0.00076, 0.048}; // the row's rachis vertex
+	plume_vec2 cap = {root.x + along * u.x, root.y + along * u.y};
+	plume_vec2 low = {cap.x - half_width * n.x, cap.y - half_width * n.y};
+	plume_vec2 high = {cap.x + half_width * n.x, cap.y + half_width * n.y};
+	plume_vec2 low_out = {0.02, low.y + (0.02 - low.x) * u.y / u.x},
+	           high_out = {0.02, high.y + (0.02 - high.x) * u.y / u.x};
+	plume_vec2 plain[4] = {{-0.001, -0.002}, {0.02, -0.002}, {0.02, 0.13}, {-0.001, 0.13}};
+	plume_vec2 slotted[8] = {{-0.001, -0.002}, {0.02, -0.002}, low_out,       low, high,
+	                         high_out,         {0.02, 0.13},   {-0.001, 0.13}};
+	plume_vec2 rachis[2] = {{0.0, 0.0}, {0.0, 0.1}};
+	plume_vec2 points[4] = {{0.0, 0.01}, {0.06 * u.x, 0.01 + 0.06 * u.y}, {0.0, 0.08}, {0.06 * u.x, 0.08 + 0.06 * u.y}};
+	int offsets[3] = {0, 2, 4};
+	plume_mesh_guides guides = {.boundary_count = 4,
+	                            .boundary = plain,
+	                            .rachis_count = 2,
+	                            .rachis = rachis,
+	                            .guide_count = 2,
+	                            .guide_offsets = offsets,
+	                            .guide_points = points};
+	plume_mesh_def def = plume_mesh_default_def();
+	def.edge_length = 0.004;
+	def.rachis_width_base = 0.002;
+	def.rachis_width_tip = 0.001;
+	plume_mesh *mesh = NULL;
+	plume_mesh_report plain_report, report;
+	plume_error err;
+	if (plume_mesh_from_guides(&guides, &def, &mesh, &plain_report, &err) != PLUME_OK)
+		fail_msg("%s", err.message);
+	plume_mesh_destroy(mesh);
+	guides.boundary_count = 8;
+	guides.boundary = slotted;
+	if (plume_mesh_from_guides(&guides, &def, &mesh, &report, &err) != PLUME_OK)
+		fail_msg("%s", err.message);
+	assert_aligned_mesh(mesh, &report, def.edge_length);
+	print_message("vane min angle %.3f deg, %.3f deg without the slot\n", report.vane_min_angle * 180.0 / pi,
+	              plain_report.vane_min_angle * 180.0 / pi);
+	assert_true(report.vane_min_angle >= plain_report.vane_min_angle);
+	for (int v = 0; v < mesh->vertex_count; ++v) {
+		plume_vec2 p = mesh->reference[v];
+		double gap = fmin(segment_distance(p, low_out, low),
+		                  fmin(segment_distance(p, low, high), segment_distance(p, high, high_out)));
+		if (gap < 1e-9)
+			fail_msg("vertex %d at (%g, %g) lies on the slot", v, p.x, p.y);
+	}
+	plume_mesh_destroy(mesh);
+	assert_int_equal(plume_bytes_in_use(), before);
+}
+
 static void test_guides_spec_errors(void **state)
 {
 	(void)state;
@@ -764,8 +835,9 @@ static void test_guides_spec_splines(void **state)
 /// A feather five times the example's size: the strip walk's spatial index
 /// (src/mesh/aligned.c) gives the scan's mesh. The counts are those the
 /// mesher gives with every query scanned (MESH_SCAN_MAX raised past the pool;
-/// re-measured so for the staggered guide vertices of issue 13). The index took
-/// the time from 5x down here, 150x at 20x the size.
+/// re-measured so for the staggered guide vertices and the joined short guides
+/// of issue 13). The index took the time from 5x down here, 150x at 20x the
+/// size.
 static void test_tall_guides(void **state)
 {
 	(void)state;
@@ -778,8 +850,8 @@ static void test_tall_guides(void **state)
 	plume_error err;
 	if (plume_mesh_spec_read(path, &options, &mesh, &report, &err) != PLUME_OK)
 		fail_msg("%s", err.message);
-	assert_int_equal(mesh->vertex_count, 10031);
-	assert_int_equal(mesh->face_count, 19747);
+	assert_int_equal(mesh->vertex_count, 10019);
+	assert_int_equal(mesh->face_count, 19733);
 	assert_int_equal(mesh->barb_edge_count, 9729);
 	assert_int_equal(report.vertices_trimmed, 96);
 	assert_int_equal(report.guide_count[0], 148);
@@ -1003,6 +1075,7 @@ int main(void)
 	    cmocka_unit_test(test_curved_rest_shape_and_zero_length_barbs),
 	    cmocka_unit_test(test_short_vanes_and_no_barbs),
 	    cmocka_unit_test(test_explicit_guides),
+	    cmocka_unit_test(test_short_guide_joined),
 	    cmocka_unit_test(test_guides_spec_errors),
 	    cmocka_unit_test(test_guides_spec_splines),
 	    cmocka_unit_test(test_tall_guides),
