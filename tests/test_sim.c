@@ -2,6 +2,8 @@
 // monotone Newton, handles, free fall under implicit Euler, reactions,
 // determinism and bad definitions.
 #include <math.h>
+#include <omp.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -478,6 +480,45 @@ static void test_shared_edge_bending_matches_finite_differences(void **state)
 	plume_mesh_destroy(mesh);
 }
 
+/// Factors a 3 x 3 diagonal matrix 2000 times; returns non-NULL when every one succeeded,
+/// and then the calling thread's OpenMP limit must be what it was (the next test).
+static void *factor_repeatedly(void *unused)
+{
+	(void)unused;
+	int levels = omp_get_max_active_levels();
+	plume_sparse matrix;
+	plume_error err = {0};
+	plume_sparse_entry entries[3] = {{0, 0}, {1, 1}, {2, 2}};
+	bool ok = plume_sparse_init(&matrix, 3, entries, 3, true, "the test's matrix", &err) == PLUME_OK;
+	for (int k = 0; k < 3 && ok; ++k)
+		((double *)matrix.matrix->x)[k] = 1 + k;
+	for (int round = 0; round < 2000 && ok; ++round)
+		ok = plume_sparse_factor(&matrix);
+	plume_sparse_free(&matrix);
+	static int success;
+	return ok && omp_get_max_active_levels() == levels ? &success : NULL;
+}
+
+static void test_factorisation_restores_openmp_levels(void **state)
+{
+	(void)state;
+	// A factorisation switches CHOLMOD's OpenMP regions off (sim/sparse.c) and must hand the
+	// caller's limit back, on every thread, also while another thread factors.
+	int levels = omp_get_max_active_levels();
+	assert_true(levels > 0);
+	pthread_t threads[2];
+	for (int t = 0; t < 2; ++t)
+		assert_int_equal(pthread_create(threads + t, NULL, factor_repeatedly, NULL), 0);
+	for (int t = 0; t < 2; ++t) {
+		void *result = NULL;
+		assert_int_equal(pthread_join(threads[t], &result), 0);
+		assert_non_null(result);
+	}
+	assert_int_equal(omp_get_max_active_levels(), levels);
+	assert_non_null(factor_repeatedly(NULL));
+	assert_int_equal(omp_get_max_active_levels(), levels);
+}
+
 static void test_bad_definitions(void **state)
 {
 	(void)state;
@@ -518,6 +559,7 @@ int main(void)
 	    cmocka_unit_test(test_steps_are_deterministic),
 	    cmocka_unit_test(test_kkt_factor_reports_indefinite),
 	    cmocka_unit_test(test_shared_edge_bending_matches_finite_differences),
+	    cmocka_unit_test(test_factorisation_restores_openmp_levels),
 	    cmocka_unit_test(test_kkt_factor_inertia),
 	    cmocka_unit_test(test_bad_definitions),
 	};

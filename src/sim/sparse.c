@@ -196,7 +196,9 @@ bool plume_sparse_factor(plume_sparse *s)
 	// CHOLMOD's supernodal factorisation zeroes and scatters each large supernode in
 	// OpenMP regions of four threads: on two cores their wake-ups and spinning cost more
 	// than the loops (measured: a third of Figure 1's run at e = 2.5 mm), so it runs
-	// with no parallel region active. The dense work is in the (one-thread) BLAS.
+	// with no parallel region active; the dense work is in the (one-thread) BLAS. The
+	// limit is the calling thread's (an ICV of its data environment in libgomp and
+	// libomp alike): other threads' parallel regions are untouched.
 	int levels = omp_get_max_active_levels();
 	omp_set_max_active_levels(0);
 	cholmod_factorize(s->matrix, s->factor, &s->common);
