@@ -8,7 +8,7 @@
 // curvature lambda_k (I - t t^T) / l. Each solve starts with per-element Hessians
 // projected to positive semidefinite and only the curvature of barbs in tension
 // (lambda_k > 0), which makes every step a descent step; once a full step is
-// accepted it switches to the exact H, and falls back when the inertia of its factors
+// accepted it switches to the exact H, and falls back when its factorisation (kkt.h)
 // shows it is not positive definite on the constraints' tangent space. A backtracking
 // line search on the exact l1
 // merit Phi + mu |c|_1 (mu above the largest multiplier) keeps every accepted
@@ -251,8 +251,9 @@ static plume_status newton(plume_sim *sim, const sim_problem *problem, plume_sol
 	// Projected Hessians make every step a descent step far from the solution; near it
 	// they slow Newton to a linear rate (bending's indefinite part is dropped). Once a
 	// full step is accepted, use the exact Hessian; fall back when it is not positive
-	// definite on the constraints' tangent space. That test is the inertia of the
-	// factors, free once factored: one factorisation an iteration unless it fails. (The
+	// definite on the constraints' tangent space. That test is whether the Cholesky
+	// factorisation of H + C^T R C succeeds (kkt.h), free once factored: one
+	// factorisation an iteration unless it fails. (The
 	// sign of g . dx is no test: on a constrained step it is positive whenever reaching
 	// the constraints costs potential, and the merit still descends.)
 	bool exact = !sim->exact_hessian_failed;
@@ -296,7 +297,7 @@ static plume_status newton(plume_sim *sim, const sim_problem *problem, plume_sol
 		// an ascent step. (With constraints its sign is no test, see above.)
 		if (exact && (status == PLUME_ERROR_NUMERIC || (m == 0 && status == PLUME_OK && slope >= 0))) {
 			// The exact Hessian is not positive definite on the constraints' tangent space
-			// (its factors' inertia says so, kkt.h): project. The exact one is tried again
+			// (its Cholesky factorisation failed, kkt.h): project. The exact one is tried again
 			// after a full step (projected Newton alone is linear, too slow on the lab's
 			// locked meshes), and the next solve starts projected.
 			exact = false;
