@@ -41,7 +41,7 @@ void cli_help_lab(void)
 	     "  --unconstrained        fit E_vw without the barb constraint (on quadratic triangles)\n"
 	     "  --tilted-strain EPS    eps_max of the tilted test, the fit of E_vw (default 0.1)\n"
 	     "  --compression KAPPA    Kikuuwe's coefficient in both lab models, Pa (default 0:\n"
-	     "                         the thesis's chapter-5 materials; the simulator's is 5.04e7)\n"
+	     "                         the thesis's chapter-5 materials; the simulator's is 4.2e11)\n"
 	     "  --linear-macro         unconstrained fit on the simulator's linear triangles\n"
 	     "  --no-uncertainty       skip the spreads and the sensitivity (eleven traction tests)\n"
 	     "  -o DIR                 also write DIR/calibration.json (the printed JSON),\n"

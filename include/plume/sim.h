@@ -50,13 +50,15 @@ typedef struct plume_material {
 	/// (bends the barbs; stiff). Isotropic materials use bending_along for both when bending_across is negative.
 	double bending_along;
 	double bending_across;
-	/// Kikuuwe coefficient kappa, Pa (thesis eq. 6.6); 0 disables the compression term.
+	/// Kikuuwe coefficient kappa, Pa (thesis eq. 6.6: b kappa / 12 ((1 - J)/6)^3 per unit area);
+	/// 0 disables the compression term.
 	double compression_coefficient;
 } plume_material;
 
 /// The vane of thesis Table 6.1 with the inextensibility constraint: E_ww = 4.80e4 Pa,
 /// E_vw = 1.99e4 Pa (plume's calibration, docs/lab.md), thickness 1.2e-4 m (mean of
-/// Table 3.1), 2.6e-2 kg/m^2, bending 1e-7 / 2.5e-4 N m, kappa 5.04e7.
+/// Table 3.1), 2.6e-2 kg/m^2, bending 1e-7 / 2.5e-4 N m, kappa 4.2e11 Pa (Table 6.1's
+/// 5.04e7 N/m is b kappa; docs/physics-energies.md).
 plume_material plume_material_vane(void);
 /// The rachis of thesis Table 6.1: isotropic, E = 34 MPa, nu = 0.49, thickness 1.2e-2 m, 0.54 kg/m^2;
 /// bending D = E t^3 / (12 (1 - nu^2)) = 6.44 N m.

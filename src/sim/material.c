@@ -4,6 +4,7 @@
 plume_material plume_material_vane(void)
 {
 	const double E_ww = 4.80e4; // Pa, thesis Table 5.2 / 6.1 (NOTES.md: 1.22452 E_b, E_b = 3.92e4 Pa)
+	const double thickness = 1.2e-4; // m, mean of thesis Table 3.1
 	return (plume_material){
 	    .kind = PLUME_MATERIAL_ORTHOTROPIC,
 	    // With the barb constraint the longitudinal stiffness is the constraint itself and
@@ -24,16 +25,20 @@ plume_material plume_material_vane(void)
 	    // only when kind is switched to PLUME_MATERIAL_ISOTROPIC.
 	    .youngs_modulus = E_ww,
 	    .poisson_ratio = 0.0,
-	    .thickness = 1.2e-4,       // m, mean of thesis Table 3.1
+	    .thickness = thickness,
 	    .surface_density = 2.6e-2, // kg/m^2, Table 6.1
 	    .barb_constraint = true,
 	    // Table 6.1 "anisotropic" moduli, N m. NOTES.md: along-barb edges (beta = 0) are the
 	    // soft hinge that keeps the barbs straight; across-barb edges bend the barbs.
 	    .bending_along = 1e-7,
 	    .bending_across = 2.5e-4,
-	    // Table 6.1 prints kappa's unit as N/m, but in eq. 6.6 it multiplies the thickness b
-	    // (m) to give an energy per unit area (J/m^2 = N/m): kappa is a stress, Pa.
-	    .compression_coefficient = 5.04e7,
+	    // Table 6.1 prints kappa = 5.04e7 N/m. In eq. 6.6 the term is b kappa / 12 ((1 - J)/6)^3
+	    // per unit area, so the printed N/m is the thickness-integrated coefficient b kappa
+	    // (as ARCSim, which the thesis builds on, takes its stiffnesses), and kappa is
+	    // 5.04e7 / b Pa. Read as Pa instead, kappa would be 1050 E_ww, below the 3e3 E that
+	    // section 6.5 (Figure 6.8) needs for buckling, and the vane collapses in plane
+	    // (docs/physics-energies.md, "Which reading of Table 6.1").
+	    .compression_coefficient = 5.04e7 / thickness,
 	};
 }
 
