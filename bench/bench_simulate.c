@@ -1,6 +1,8 @@
-// Benchmark: the paper's Figure 1 scenario (examples/scenes/figure1-anisotropic.json)
-// at the paper's resolution (e = 5 mm) and on finer meshes (e = 2.5, 1.75, 1.25 mm), with
-// the isotropic comparison at 5 mm, and the solver's floor: per mesh size, the CPU
+// Benchmark: the paper's Figure 1 scenario (examples/scenes/figure1-anisotropic.json, the
+// vane tip pulled 3 cm) in full, anisotropic and isotropic, at the paper's resolution
+// (e = 5 mm) and at 2.5 mm: wall and CPU time, steps, Newton iterations a step, steps
+// retried in substeps and the largest barb strain (issue 13). Then the scaling series on
+// finer meshes (e = 2.5, 1.75, 1.25 mm) and the solver's floor: per mesh size, the CPU
 // of one Newton iteration against the CPU of one numeric factorisation of the same
 // KKT matrix in the same run, their ratio, factorisations and solves per iteration,
 // CHOLMOD's GFlop/s, and the exponent k of time ~ V^k fitted over the sizes. Last,
@@ -12,10 +14,10 @@
 // --wrap=cholmod_solve2), so the library carries no benchmark code. Times are CPU
 // times (the machine may be shared: CPU seconds are steadier than wall seconds).
 // The scaling series runs every mesh size over the scene's first SCALING_DURATION
-// seconds (the 2 cm pull stops converging on the finer meshes from t = 0.66 s on, where the
-// vane collapses in plane at the handle: issue 13), and fits CPU per step against vertex
-// count. `bench_simulate quick` runs the 5 mm sizes only, `bench_simulate all` adds
-// e = 1.25 mm (5,000 vertices).
+// seconds, before the vane buckles (the buckling steps take many more Newton iterations
+// and would measure the bifurcation, not the solver's growth), and fits CPU per step
+// against vertex count. `bench_simulate quick` runs the 5 mm runs only, `bench_simulate all`
+// adds e = 1.25 mm (5,000 vertices) to the series.
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>
@@ -48,6 +50,13 @@ static double thread_cpu(void)
 {
 	struct timespec t;
 	clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+	return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static double wall_clock(void)
+{
+	struct timespec t;
+	clock_gettime(CLOCK_MONOTONIC, &t);
 	return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
@@ -159,21 +168,21 @@ static int run(const char *name, double edge_length, double duration, result *ou
 	counted = (counters){0};
 	plume_scene_summary summary;
 	plume_error err = {0};
-	double run_start = process_cpu();
+	double run_start = process_cpu(), wall_start = wall_clock();
 	plume_status status = plume_scene_run(scene, NULL, NULL, &summary, &err);
-	double end = process_cpu();
-	*out = (result){summary.vertex_count, summary.steps, end - start, end - run_start, summary.newton_iterations,
-	                counted};
+	double end = process_cpu(), wall = wall_clock() - wall_start;
+	*out =
+	    (result){summary.vertex_count, summary.steps, end - start, end - run_start, summary.newton_iterations, counted};
 	const counters *c = &out->c;
 	double iterations = summary.newton_iterations > 0 ? summary.newton_iterations : 1;
 	double per_iteration = out->run_cpu / iterations;
 	double per_factor = c->factorizations > 0 ? c->factor_cpu / (double)c->factorizations : 0;
-	printf("%-20s e = %4.2f mm %5d vertices %5d faces %4d constraints | %s %3d steps %5d iterations (%.2f a step) "
-	       "%6.2f s CPU (%.1f ms a step), strain %.1e\n",
+	printf("%-20s e = %4.2f mm %5d vertices %5d faces %4d constraints | %s %3d steps (%d retried) %5d iterations "
+	       "(%.2f a step) %6.2f s CPU (%.1f ms a step), %6.2f s wall, strain %.1e\n",
 	       name, 1000 * edge_length, summary.vertex_count, summary.face_count, summary.constraint_count,
-	       status == PLUME_OK ? "ok    " : "FAILED", summary.steps, summary.newton_iterations,
+	       status == PLUME_OK ? "ok    " : "FAILED", summary.steps, summary.retried_steps, summary.newton_iterations,
 	       summary.steps > 0 ? (double)summary.newton_iterations / summary.steps : 0.0, out->run_cpu,
-	       summary.steps > 0 ? 1e3 * out->run_cpu / summary.steps : 0.0, summary.max_barb_strain);
+	       summary.steps > 0 ? 1e3 * out->run_cpu / summary.steps : 0.0, wall, summary.max_barb_strain);
 	printf("%-20s   per iteration %7.2f ms CPU; one factorisation %6.2f ms (fastest %6.2f ms); ratio %5.2f; "
 	       "%.2f factorisations and %.2f solves an iteration; factorisation %4.1f %% of the run at %.2f GFlop/s; "
 	       "solves %4.1f %%\n",
@@ -230,6 +239,11 @@ int main(int argc, char **argv)
 	result paper, results[4], isotropic;
 	int failures = run("figure1-anisotropic", 0.005, 0, &paper);
 	failures += run("figure1-isotropic", 0.005, 0, &isotropic);
+	if (!quick) {
+		result fine;
+		failures += run("figure1-anisotropic", 0.0025, 0, &fine);
+		failures += run("figure1-isotropic", 0.0025, 0, &fine);
+	}
 	if (size_count > 1) {
 		printf("scaling series: every size over the first %.2f s\n", SCALING_DURATION);
 		for (int i = 0; i < size_count; ++i)

@@ -15,6 +15,12 @@ for model in anisotropic isotropic; do
 		cp "$work/$model/frames/$frame.png" "$here/sim-figure1-$model-$frame.png"
 	done
 done
+# Figure 1 (b) and (c) ray-traced: both runs at the same five frames (t = 0, 0.275, ... 1.1 s) through
+# one fixed camera, barbs and all.
+for model in anisotropic isotropic; do
+	"$plume" render "$work/$model" -o "$work/$model-render" -c "$here/figure1-camera.json" --strip 5 -f png >/dev/null
+	cp "$work/$model-render/strip.png" "$here/rt-figure1-$model-strip.png"
+done
 # Thesis Figure 6.5: the rachis tip pulled out of the vane's plane, seen from three-quarters.
 "$plume" simulate "$root/examples/scenes/figure6.5-pull.json" -o "$work/pull" --png --size 480x480 --view 60,15 >/dev/null
 for frame in 0000 0050 0100; do

@@ -3,7 +3,7 @@
 
 plume_material plume_material_vane(void)
 {
-	const double E_ww = 4.80e4; // Pa, thesis Table 5.2 / 6.1 (NOTES.md: 1.22452 E_b, E_b = 3.92e4 Pa)
+	const double E_ww = 4.80e4;      // Pa, thesis Table 5.2 / 6.1 (NOTES.md: 1.22452 E_b, E_b = 3.92e4 Pa)
 	const double thickness = 1.2e-4; // m, mean of thesis Table 3.1
 	return (plume_material){
 	    .kind = PLUME_MATERIAL_ORTHOTROPIC,
