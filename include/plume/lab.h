@@ -176,10 +176,11 @@ typedef struct plume_lab_material {
 	/// Band geometry of the mesoscale model.
 	plume_band_def bands;
 	/// Kikuuwe's compression coefficient kappa, Pa, >= 0, in both models (thesis eq. 6.6).
-	/// Default: the simulator's vane, plume_material_vane().compression_coefficient (4.2e11,
-	/// thesis Table 6.1's 5.04e7 N/m over the vane's thickness). The lab's samples are planar: without out-of-plane buckling,
-	/// compressed St-Venant-Kirchhoff elements collapse and invert (thesis Figure 6.7), the
-	/// solution localises on the mesh and Newton stalls; 0 gives that pure model.
+	/// Default: the simulator's vane, plume_material_vane().compression_coefficient (4.2e11 Pa,
+	/// thesis Table 6.1's 5.04e7 N/m over the vane's thickness, 1.2e-4 m). The lab's samples
+	/// are planar: without out-of-plane buckling, compressed St-Venant-Kirchhoff elements
+	/// collapse and invert (thesis Figure 6.7), the solution localises on the mesh and Newton
+	/// stalls; 0 gives that pure model.
 	double compression_coefficient;
 } plume_lab_material;
 

@@ -106,7 +106,7 @@ assert p['barb_constraint'] is False and p['macroscale_elements'] == 'quadratic'
 "
 
 # No answer: H/W and W/H swapped, the barbs run from clamp to clamp and, under the
-# old protocol (eps_max 0.4 with Kikuuwe's term, linear triangles), the mesoscale tilted slope is below
+# old protocol (eps_max 0.4 with Kikuuwe's term at kappa = 5.04e7 Pa, linear triangles), the mesoscale tilted slope is below
 # anything the macroscale model reaches. The search stops at the ends of its range
 # (1e-3 to 1e3 E_ww) and names both. (Under the chapter-5 protocol, eps_max 0.1, this
 # sample has an answer: E_vw = 3.5e5 Pa on these meshes.)
