@@ -115,11 +115,12 @@ static plume_status slope_of(const plume_lab_material *material, const plume_sam
 	// The slope needs a few significant digits; 1e-6 of the force scale is plenty and
 	// keeps the stiff tilted problems from stalling on round-off.
 	traction.solver.tolerance = 1e-6;
-	// Newton can stall in the stiff tilted problems once the barbules go into compression
-	// (a shear band forms): a stalled step whose gradient is below 1e-3 of the clamp force
-	// moves that sample's stress, and the slope, by about that much at most, well inside the
-	// mesoscale mesh's own error.
-	traction.accept_residual = 1e-3;
+	// Every step must converge (accept_residual stays 0): the protocol's tilted tests stay
+	// below the strain where the pure model stalls (docs/lab.md, The protocol). Measured
+	// 2026-11-25: the three Table 5.1 calibrations with their uncertainty runs, the old
+	// protocol (eps_max = 0.4 with kappa = 5.04e7 Pa) and the 24 calibrations of
+	// examples/sweeps/uq-calibration.json all converge with no stalled step allowed, and
+	// give the same moduli as when stalls below 1e-3 of the clamp force were accepted.
 	int solves = 0;
 	bool keep = curve >= 0 && result->curve_samples > 0;
 	plume_status status = lab_mean_curve(material, sample, &traction, phase_count, slope, phase_slopes, &solves,
