@@ -87,13 +87,6 @@ void cli_remove_tree(const char *path);
 plume_status cli_write_feather(cli_output *output, const plume_feather *feather, const char *stem, unsigned formats,
                                const cli_image_options *images, plume_error *err);
 
-/// Ray-traced frames of a simulation at barb level: the feather's barbs embedded in
-/// the rest shell and carried by it (include/plume/embed.h), one camera for the sequence.
-typedef struct cli_barb_renderer {
-	plume_barb_embedding *embedding;
-	plume_raytrace_def def;
-} cli_barb_renderer;
-
 /// Many feathers carried by one joined shell, and a body, drawn together (cli/carry.c): the
 /// one path of `plume simulate --render` and `plume render` of a many-feather run folder.
 /// Each feather's barbs are embedded in its own face range of the shell
@@ -124,13 +117,12 @@ void cli_carried_end(cli_carried *c);
 /// translation (at least a tenth of its size), so every frame shares one framing.
 void cli_scene_bounds(const plume_scene *scene, plume_vec3 *lo, plume_vec3 *hi);
 
-/// Frames the box [lo, hi] (the whole sequence's reach) in a width x height image.
-plume_status cli_barb_renderer_begin(cli_barb_renderer *renderer, const plume_feather *feather, const plume_mesh *mesh,
-                                     plume_vec3 lo, plume_vec3 hi, int width, int height, int spp, plume_error *err);
-/// Renders the feather carried by the shell at positions to path (PNG).
-plume_status cli_barb_renderer_frame(const cli_barb_renderer *renderer, const plume_vec3 *positions, const char *path,
-                                     plume_error *err);
-void cli_barb_renderer_end(cli_barb_renderer *renderer);
+/// Ray-traced frames of a simulation at barb level: the render settings with a camera that
+/// frames the box [lo, hi] (the whole sequence's reach) in a width x height image.
+plume_raytrace_def cli_sequence_render_def(plume_vec3 lo, plume_vec3 hi, int width, int height, int spp);
+/// The scene's feathers, each embedded in its own faces of the scene's shell, and its body
+/// (cli_carried_begin): what cli_carried_pose then carries to every frame.
+plume_status cli_carry_scene(const plume_scene *scene, cli_carried *carried, plume_error *err);
 
 /// A progress line with a time estimate on stderr, when it is a terminal (cli/progress.c).
 typedef struct cli_progress {

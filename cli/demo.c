@@ -38,7 +38,8 @@ enum { DEMO_FRAMES = 3 };
 
 typedef struct demo_run {
 	cli_output *output;
-	cli_barb_renderer renderer;
+	plume_raytrace_def render_def;
+	cli_carried carried;
 	int steps;
 } demo_run;
 
@@ -51,8 +52,12 @@ static plume_status demo_step(void *user, int step, double time, const plume_sim
 		return PLUME_OK;
 	char name[64], path[4352];
 	snprintf(name, sizeof name, "figure1-%04d.png", step);
-	return cli_barb_renderer_frame(&run->renderer, plume_sim_positions(sim),
-	                               cli_output_path(run->output, name, path, sizeof path), err);
+	plume_raytrace_scene picture;
+	plume_status status = cli_carried_pose(&run->carried, plume_sim_positions(sim), NULL, &picture, err);
+	if (status == PLUME_OK)
+		status = plume_raytrace_render_png(&picture, &run->render_def,
+		                                   cli_output_path(run->output, name, path, sizeof path), NULL, err);
+	return status;
 }
 
 /// Meshes, simulates and ray-traces the demo scene into the staging folder.
@@ -62,13 +67,14 @@ static plume_status simulate_demo(cli_output *output, plume_scene_summary *summa
 	plume_status status = plume_scene_parse(demo_scene, "demo scene", NULL, &scene, err);
 	if (status != PLUME_OK)
 		return status;
-	demo_run run = {output, {0}, (int)(scene->duration / scene->sim.time_step + 0.5)};
 	plume_vec3 lo, hi;
 	cli_scene_bounds(scene, &lo, &hi);
-	status = cli_barb_renderer_begin(&run.renderer, scene->feather, scene->mesh, lo, hi, 400, 640, 4, err);
+	demo_run run = {
+	    output, cli_sequence_render_def(lo, hi, 400, 640, 4), {0}, (int)(scene->duration / scene->sim.time_step + 0.5)};
+	status = cli_carry_scene(scene, &run.carried, err);
 	if (status == PLUME_OK)
 		status = plume_scene_run(scene, demo_step, &run, summary, err);
-	cli_barb_renderer_end(&run.renderer);
+	cli_carried_end(&run.carried);
 	plume_scene_destroy(scene);
 	return status;
 }

@@ -74,36 +74,14 @@ void cli_help_simulate(void)
 	     "Scenes are described in docs/scene.md; examples/scenes/ has ready ones.");
 }
 
-plume_status cli_barb_renderer_begin(cli_barb_renderer *renderer, const plume_feather *feather, const plume_mesh *mesh,
-                                     plume_vec3 lo, plume_vec3 hi, int width, int height, int spp, plume_error *err)
+plume_raytrace_def cli_sequence_render_def(plume_vec3 lo, plume_vec3 hi, int width, int height, int spp)
 {
-	renderer->embedding = NULL;
-	renderer->def = plume_raytrace_default_def();
-	renderer->def.camera.width = width;
-	renderer->def.camera.height = height;
-	renderer->def.spp = spp;
-	renderer->def.camera = plume_camera_frame_bounds(&renderer->def.camera, lo, hi);
-	return plume_embedding_create(feather, mesh, &renderer->embedding, err);
-}
-
-plume_status cli_barb_renderer_frame(const cli_barb_renderer *renderer, const plume_vec3 *positions, const char *path,
-                                     plume_error *err)
-{
-	plume_feather *moved = NULL;
-	plume_status status = plume_embedding_apply(renderer->embedding, positions, &moved, err);
-	if (status == PLUME_OK) {
-		const plume_feather *list[1] = {moved};
-		plume_raytrace_scene scene = {1, list, NULL, NULL};
-		status = plume_raytrace_render_png(&scene, &renderer->def, path, NULL, err);
-	}
-	plume_feather_destroy(moved);
-	return status;
-}
-
-void cli_barb_renderer_end(cli_barb_renderer *renderer)
-{
-	plume_embedding_destroy(renderer->embedding);
-	renderer->embedding = NULL;
+	plume_raytrace_def def = plume_raytrace_default_def();
+	def.camera.width = width;
+	def.camera.height = height;
+	def.spp = spp;
+	def.camera = plume_camera_frame_bounds(&def.camera, lo, hi);
+	return def;
 }
 
 typedef struct run_state {
@@ -112,7 +90,7 @@ typedef struct run_state {
 	FILE *stats;
 	bool png;
 	bool render;
-	cli_barb_renderer renderer;
+	plume_raytrace_def render_def; ///< --render: the camera frames the whole sequence
 	plume_shell_view_def view;
 	int frames;
 	int total_steps;
@@ -136,9 +114,7 @@ typedef struct run_state {
 	plume_mesh *body_mesh;                ///< the body at rest, for sim.glb
 	plume_mesh_animation *body_animation; ///< the body's frames, node "body" of sim.glb
 	cli_carried glb_carried;              ///< --glb-feather of many feathers: their embeddings
-	/// --render of a scene that lists "feathers" or has a body (cli/carry.c).
-	bool many;
-	cli_carried carried_scene;
+	cli_carried rendered;                 ///< --render: every feather and the body (cli/carry.c)
 } run_state;
 
 /// The body's rest mesh as a plume_mesh (for drawing and sim.glb), or NULL when memory runs out.
@@ -154,7 +130,7 @@ static plume_mesh *body_mesh(const plume_body *body)
 
 /// Every feather of the scene embedded in its own faces of the joined shell (cli/carry.c, the
 /// path `plume render` takes for the run folder), and the body when with_body.
-static plume_status carry_scene(const plume_scene *scene, bool with_body, cli_carried *carried, plume_error *err)
+static plume_status carry_feathers(const plume_scene *scene, bool with_body, cli_carried *carried, plume_error *err)
 {
 	const plume_feather **feathers = calloc((size_t)scene->feather_count, sizeof *feathers);
 	int *faces = calloc(2 * (size_t)scene->feather_count, sizeof *faces);
@@ -175,31 +151,22 @@ static plume_status carry_scene(const plume_scene *scene, bool with_body, cli_ca
 	return status;
 }
 
-/// Sets up --render for many feathers and a body: the camera as cli_barb_renderer_begin
-/// frames it, the feathers and the body drawn by carry_scene.
-static plume_status many_renderer_begin(run_state *run, plume_vec3 lo, plume_vec3 hi, int spp, plume_error *err)
+plume_status cli_carry_scene(const plume_scene *scene, cli_carried *carried, plume_error *err)
 {
-	run->renderer.embedding = NULL;
-	run->renderer.def = plume_raytrace_default_def();
-	run->renderer.def.camera.width = run->view.width;
-	run->renderer.def.camera.height = run->view.height;
-	run->renderer.def.spp = spp;
-	run->renderer.def.camera = plume_camera_frame_bounds(&run->renderer.def.camera, lo, hi);
-	run->many = true;
-	return carry_scene(run->scene, true, &run->carried_scene, err);
+	return carry_feathers(scene, true, carried, err);
 }
 
 /// Every feather carried by the shell at positions, and the body posed at time, to path (PNG).
-static plume_status many_renderer_frame(run_state *run, const plume_vec3 *positions, double time, const char *path,
-                                        plume_error *err)
+static plume_status render_frame(run_state *run, const plume_vec3 *positions, double time, const char *path,
+                                 plume_error *err)
 {
 	if (run->scene->body != NULL)
 		plume_scene_body_pose(run->scene, time, run->body_positions);
 	plume_raytrace_scene picture;
-	plume_status status = cli_carried_pose(&run->carried_scene, positions,
+	plume_status status = cli_carried_pose(&run->rendered, positions,
 	                                       run->scene->body != NULL ? run->body_positions : NULL, &picture, err);
 	if (status == PLUME_OK)
-		status = plume_raytrace_render_png(&picture, &run->renderer.def, path, NULL, err);
+		status = plume_raytrace_render_png(&picture, &run->render_def, path, NULL, err);
 	return status;
 }
 
@@ -259,8 +226,7 @@ static plume_status write_frame(run_state *run, int frame, double time, const pl
 	if (status == PLUME_OK && run->render) {
 		snprintf(name, sizeof name, "frames/%04d-rt.png", frame);
 		cli_output_path(run->output, name, path, sizeof path);
-		status = run->many ? many_renderer_frame(run, plume_sim_positions(sim), time, path, err)
-		                   : cli_barb_renderer_frame(&run->renderer, plume_sim_positions(sim), path, err);
+		status = render_frame(run, plume_sim_positions(sim), time, path, err);
 	}
 	run->frames = frame + 1;
 	return status;
@@ -308,7 +274,8 @@ static plume_status on_step(void *user, int step, double time, const plume_sim *
 		plume_sim_vane_shape vane = plume_sim_vane_shape_measure(sim, run->vane_base);
 		fprintf(run->stats, "%.9g,%d,%.6e,%.12e,%.6e,%.6f,%.9e,%.9e,%.9e,%.9e,%.9e,%.9g,%.9e", time,
 		        report->newton_iterations, report->gradient_norm, report->energy, report->max_barb_strain, wall_seconds,
-		        e.kinetic, elastic, e.gravity, e.contact, e.friction, vane.min_principal_stretch, vane.max_out_of_plane);
+		        e.kinetic, elastic, e.gravity, e.contact, e.friction, vane.min_principal_stretch,
+		        vane.max_out_of_plane);
 		// fmin/fmax skip NaN: a measure that is never defined stays NaN (null in summary.json).
 		run->min_stretch = fmin(run->min_stretch, vane.min_principal_stretch);
 		run->max_out_of_plane = fmax(run->max_out_of_plane, vane.max_out_of_plane);
@@ -566,7 +533,7 @@ static plume_status simulate(const plume_scene *scene, cli_output *output, run_s
 		if (status == PLUME_OK)
 			plume_mesh_animation_set_feather(run->animation, run->carried);
 	} else if (status == PLUME_OK && run->glb_feather) { // many feathers: node feather_NAME each
-		status = carry_scene(scene, false, &run->glb_carried, err);
+		status = carry_feathers(scene, false, &run->glb_carried, err);
 		for (int i = 0; i < scene->feather_count && status == PLUME_OK; ++i)
 			if (run->glb_carried.embeddings[i] != NULL)
 				status = plume_mesh_animation_add_feather(run->animation, run->glb_carried.embeddings[i],
@@ -594,9 +561,10 @@ static plume_status simulate(const plume_scene *scene, cli_output *output, run_s
 	run->stats = fopen(cli_output_path(output, "stats.csv", path, sizeof path), "wb");
 	if (run->stats == NULL)
 		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write", path);
-	fprintf(run->stats, "time,newton_iterations,gradient_norm,energy,max_barb_strain,wall_seconds,kinetic_energy,"
-	                    "elastic_energy,gravitational_energy,contact_energy,friction_potential,vane_min_principal_stretch,"
-	                    "vane_max_out_of_plane");
+	fprintf(run->stats,
+	        "time,newton_iterations,gradient_norm,energy,max_barb_strain,wall_seconds,kinetic_energy,"
+	        "elastic_energy,gravitational_energy,contact_energy,friction_potential,vane_min_principal_stretch,"
+	        "vane_max_out_of_plane");
 	for (int h = 0; h < scene->handle_count; ++h)
 		fprintf(run->stats, ",handle%d_fx,handle%d_fy,handle%d_fz,handle%d_dx,handle%d_dy,handle%d_dz", h, h, h, h, h,
 		        h);
@@ -776,7 +744,6 @@ int cli_simulate(int argc, char **argv)
 		return cli_usage_error("simulate", "--glb-feather needs a scene whose feathers are generated (not guides)");
 	}
 	if (run.render) {
-		bool many = scene->feather_count > 1 || scene->feather == NULL || scene->body != NULL;
 		if (!generated) {
 			plume_scene_destroy(scene);
 			return cli_usage_error("simulate", "--render needs a scene whose feathers are generated (not guides)");
@@ -788,13 +755,11 @@ int cli_simulate(int argc, char **argv)
 				hi = plume_v3(fmax(hi.x, p.x), fmax(hi.y, p.y), fmax(hi.z, p.z));
 			}
 		run.scene = scene;
-		status = many ? many_renderer_begin(&run, lo, hi, spp, &err)
-		              : cli_barb_renderer_begin(&run.renderer, scene->feather, scene->mesh, lo, hi, run.view.width,
-		                                        run.view.height, spp, &err);
+		run.render_def = cli_sequence_render_def(lo, hi, run.view.width, run.view.height, spp);
+		status = cli_carry_scene(scene, &run.rendered, &err);
 		if (status != PLUME_OK) {
-			cli_carried_end(&run.carried_scene);
+			cli_carried_end(&run.rendered);
 			plume_scene_destroy(scene);
-			cli_barb_renderer_end(&run.renderer);
 			return cli_fail(&err);
 		}
 	}
@@ -825,8 +790,7 @@ int cli_simulate(int argc, char **argv)
 	plume_mesh_animation_destroy(run.body_animation);
 	plume_mesh_destroy(run.body_mesh);
 	cli_carried_end(&run.glb_carried);
-	cli_barb_renderer_end(&run.renderer);
-	cli_carried_end(&run.carried_scene);
+	cli_carried_end(&run.rendered);
 	if (status != PLUME_OK)
 		return cli_fail(status == PLUME_ERROR_NUMERIC && failure.message[0] ? &failure : &err);
 	return CLI_EXIT_OK;
