@@ -68,41 +68,25 @@ plume_zk_def plume_zk_default_def(void)
 // ---------------------------------------------------------------------------
 // Validation: messages name the spec's JSON path.
 
-static plume_status spec_error(plume_error *err, const char *format, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 2, 3)))
-#endif
-    ;
-
-static plume_status spec_error(plume_error *err, const char *format, ...)
-{
-	char message[900];
-	va_list args;
-	va_start(args, format);
-	vsnprintf(message, sizeof message, format, args);
-	va_end(args);
-	return plume_error_set(err, PLUME_ERROR_SPEC, "%s", message);
-}
-
 static plume_status check_range(double value, double lo, double hi, const char *path, plume_error *err)
 {
 	if (!(value >= lo && value <= hi))
-		return spec_error(err, "%s is %g, allowed [%g, %g]", path, value, lo, hi);
+		return plume_error_set(err, PLUME_ERROR_SPEC, "%s is %g, allowed [%g, %g]", path, value, lo, hi);
 	return PLUME_OK;
 }
 
 static plume_status check_positive(double value, const char *path, const char *what, plume_error *err)
 {
 	if (!(value > 0.0 && isfinite(value)))
-		return spec_error(err, "%s is %g, must be a positive %s", path, value, what);
+		return plume_error_set(err, PLUME_ERROR_SPEC, "%s is %g, must be a positive %s", path, value, what);
 	return PLUME_OK;
 }
 
 static plume_status check_curve(const plume_zk_curve *curve, const char *key, const char *what, plume_error *err)
 {
 	if (curve->count < 1 || curve->count > PLUME_ZK_MAX_CURVE_POINTS)
-		return spec_error(err, "$.%s has %d control points, allowed 1 to %d", key, curve->count,
-		                  PLUME_ZK_MAX_CURVE_POINTS);
+		return plume_error_set(err, PLUME_ERROR_SPEC, "$.%s has %d control points, allowed 1 to %d", key, curve->count,
+		                       PLUME_ZK_MAX_CURVE_POINTS);
 	for (int k = 0; k < curve->count; ++k) {
 		char path[96];
 		if (curve->count == 1)
@@ -110,15 +94,16 @@ static plume_status check_curve(const plume_zk_curve *curve, const char *key, co
 		else
 			snprintf(path, sizeof path, "$.%s[%d]", key, k);
 		if (!(curve->s[k] >= 0.0 && curve->s[k] <= 1.0))
-			return spec_error(err, "%s: locus %g is outside the collar's [0, 1]", path, curve->s[k]);
+			return plume_error_set(err, PLUME_ERROR_SPEC, "%s: locus %g is outside the collar's [0, 1]", path,
+			                       curve->s[k]);
 		if (k > 0 && !(curve->s[k] > curve->s[k - 1]))
-			return spec_error(err, "%s: locus %g does not follow %g; loci must increase", path, curve->s[k],
-			                  curve->s[k - 1]);
+			return plume_error_set(err, PLUME_ERROR_SPEC, "%s: locus %g does not follow %g; loci must increase", path,
+			                       curve->s[k], curve->s[k - 1]);
 		if (!(curve->value[k] > 0.0 && isfinite(curve->value[k])))
-			return spec_error(err,
-			                  "%s: %s %g must be positive (> 0) everywhere; the curve stays between its control "
-			                  "values, so every control value must be positive",
-			                  path, what, curve->value[k]);
+			return plume_error_set(err, PLUME_ERROR_SPEC,
+			                       "%s: %s %g must be positive (> 0) everywhere; the curve stays between its control "
+			                       "values, so every control value must be positive",
+			                       path, what, curve->value[k]);
 	}
 	return PLUME_OK;
 }
@@ -128,25 +113,27 @@ static plume_status check_collar(const plume_zk_def *def, plume_error *err)
 	if (def->collar_kind == PLUME_ZK_COLLAR_CIRCLE)
 		return check_positive(def->collar_radius, "$.collar.radius", "radius in metres", err);
 	if (def->collar_kind != PLUME_ZK_COLLAR_BEZIER)
-		return spec_error(err, "$.collar: unknown collar kind %d", (int)def->collar_kind);
+		return plume_error_set(err, PLUME_ERROR_SPEC, "$.collar: unknown collar kind %d", (int)def->collar_kind);
 	int n = def->collar_point_count;
 	if (n < 4 || n > PLUME_ZK_MAX_COLLAR_POINTS)
-		return spec_error(err,
-		                  "$.collar.points has %d control points; a closed composite cubic Bézier collar needs 4 "
-		                  "to %d",
-		                  n, PLUME_ZK_MAX_COLLAR_POINTS);
+		return plume_error_set(err, PLUME_ERROR_SPEC,
+		                       "$.collar.points has %d control points; a closed composite cubic Bézier collar needs 4 "
+		                       "to %d",
+		                       n, PLUME_ZK_MAX_COLLAR_POINTS);
 	double area = 0.0;
 	for (int k = 0; k < n; ++k) {
 		plume_vec2 a = def->collar_points[k], b = def->collar_points[(k + 1) % n];
 		if (!isfinite(a.x) || !isfinite(a.y))
-			return spec_error(err, "$.collar.points[%d] is not a finite point", k);
+			return plume_error_set(err, PLUME_ERROR_SPEC, "$.collar.points[%d] is not a finite point", k);
 		if (a.x == b.x && a.y == b.y)
-			return spec_error(err, "$.collar.points[%d] repeats the point before it", (k + 1) % n);
+			return plume_error_set(err, PLUME_ERROR_SPEC, "$.collar.points[%d] repeats the point before it",
+			                       (k + 1) % n);
 		area += a.x * b.y - b.x * a.y;
 	}
 	// Eq. 1 runs from -z towards +x: a positive shoelace sum in (x, z).
 	if (!(area > 0.0))
-		return spec_error(err, "$.collar.points run the wrong way round: list them like eq. 1, from -z towards +x "
+		return plume_error_set(err, PLUME_ERROR_SPEC,
+		                       "$.collar.points run the wrong way round: list them like eq. 1, from -z towards +x "
 		                       "(x = sin 2 pi s, z = -cos 2 pi s)");
 	return PLUME_OK;
 }
@@ -161,13 +148,14 @@ static plume_status check_intervals(const plume_zk_def *def, plume_error *err)
 		return status;
 	double al = def->anterior[0], ar = def->anterior[1], pl = def->posterior[0], pr = def->posterior[1];
 	if (!(ar < pr && pr <= pl && pl < al))
-		return spec_error(err,
-		                  "$.posterior <%g, %g> and $.anterior <%g, %g> overlap or are out of order: I_A = <left, "
-		                  "right> contains s = 0 and the loci must satisfy anterior.right < posterior.right <= "
-		                  "posterior.left < anterior.left, e.g. anterior [0.98, 0.02], posterior [0.51, 0.49]",
-		                  pl, pr, al, ar);
+		return plume_error_set(err, PLUME_ERROR_SPEC,
+		                       "$.posterior <%g, %g> and $.anterior <%g, %g> overlap or are out of order: I_A = <left, "
+		                       "right> contains s = 0 and the loci must satisfy anterior.right < posterior.right <= "
+		                       "posterior.left < anterior.left, e.g. anterior [0.98, 0.02], posterior [0.51, 0.49]",
+		                       pl, pr, al, ar);
 	if (!((1.0 - al) + ar > 0.0))
-		return spec_error(err, "$.anterior <%g, %g> is empty; the rachidial ridge needs a width", al, ar);
+		return plume_error_set(err, PLUME_ERROR_SPEC, "$.anterior <%g, %g> is empty; the rachidial ridge needs a width",
+		                       al, ar);
 	return PLUME_OK;
 }
 
@@ -196,27 +184,32 @@ plume_status plume_zk_def_validate(const plume_zk_def *def, plume_error *err)
 	    (status = check_positive(def->barbule_width, "$.barbule_width", "width in metres", err)) != PLUME_OK)
 		return status;
 	if (!(def->rachis_taper > 0.0 && def->rachis_taper <= 1.0))
-		return spec_error(err, "$.rachis_taper is %g, allowed (0, 1]", def->rachis_taper);
+		return plume_error_set(err, PLUME_ERROR_SPEC, "$.rachis_taper is %g, allowed (0, 1]", def->rachis_taper);
 	if (!(def->theta_distal > 0.0 && def->theta_distal < 180.0 * deg))
-		return spec_error(err, "$.theta_distal_deg is %g, allowed (0, 180)", def->theta_distal / deg);
+		return plume_error_set(err, PLUME_ERROR_SPEC, "$.theta_distal_deg is %g, allowed (0, 180)",
+		                       def->theta_distal / deg);
 	if (!(def->theta_proximal > 0.0 && def->theta_proximal < 180.0 * deg))
-		return spec_error(err, "$.theta_proximal_deg is %g, allowed (0, 180)", def->theta_proximal / deg);
+		return plume_error_set(err, PLUME_ERROR_SPEC, "$.theta_proximal_deg is %g, allowed (0, 180)",
+		                       def->theta_proximal / deg);
 	if ((status = check_range(def->azimuth / deg, 0.0, 180.0, "$.azimuth_deg", err)) != PLUME_OK)
 		return status;
 	if (def->split_count < 0 || def->split_count > PLUME_ZK_MAX_SPLITS)
-		return spec_error(err, "$.splits has %d entries, allowed at most %d", def->split_count, PLUME_ZK_MAX_SPLITS);
+		return plume_error_set(err, PLUME_ERROR_SPEC, "$.splits has %d entries, allowed at most %d", def->split_count,
+		                       PLUME_ZK_MAX_SPLITS);
 	for (int k = 0; k < def->split_count; ++k) {
 		const plume_zk_split *split = def->splits + k;
 		char path[64];
 		if (split->side != PLUME_SIDE_LEFT && split->side != PLUME_SIDE_RIGHT)
-			return spec_error(err, "$.splits[%d].side must be \"left\" or \"right\"", k);
+			return plume_error_set(err, PLUME_ERROR_SPEC, "$.splits[%d].side must be \"left\" or \"right\"", k);
 		if (split->barb < 0 || split->barb >= PLUME_ZK_MAX_BARBS)
-			return spec_error(err, "$.splits[%d].barb is %d, allowed [0, %d)", k, split->barb, PLUME_ZK_MAX_BARBS);
+			return plume_error_set(err, PLUME_ERROR_SPEC, "$.splits[%d].barb is %d, allowed [0, %d)", k, split->barb,
+			                       PLUME_ZK_MAX_BARBS);
 		snprintf(path, sizeof path, "$.splits[%d].at", k);
 		if ((status = check_range(split->at, 0.0, 1.0, path, err)) != PLUME_OK)
 			return status;
 		if (!(fabs(split->angle) < 180.0 * deg))
-			return spec_error(err, "$.splits[%d].angle_deg is %g, allowed (-180, 180)", k, split->angle / deg);
+			return plume_error_set(err, PLUME_ERROR_SPEC, "$.splits[%d].angle_deg is %g, allowed (-180, 180)", k,
+			                       split->angle / deg);
 	}
 	return PLUME_OK;
 }
