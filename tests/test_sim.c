@@ -334,14 +334,14 @@ static void test_kkt_factor_reports_indefinite(void **state)
 	plume_kkt_zero(&kkt);
 	for (int v = 0; v < 2; ++v)
 		for (int d = 0; d < 3; ++d)
-			values[kkt.vertex_slots[9 * v + 4 * d]] = 2.0;
+			values[kkt.diagonal_slots[3 * v + d]] = 2.0;
 	assert_int_equal(plume_kkt_factor(&kkt, false, &shift, &err), PLUME_OK);
 	assert_true(shift == 0.0);
 	assert_int_equal(plume_kkt_solve(&kkt, rhs, x, &err), PLUME_OK);
 	for (int i = 0; i < 6; ++i)
 		assert_close(x[i], rhs[i] / 2.0, 1e-15);
 
-	values[kkt.vertex_slots[9 * 1 + 4 * 2]] = -1.0; // mean |diagonal| 11/6
+	values[kkt.diagonal_slots[3 * 1 + 2]] = -1.0; // mean |diagonal| 11/6
 	assert_int_equal(plume_kkt_factor(&kkt, false, &shift, &err), PLUME_ERROR_NUMERIC);
 	assert_non_null(strstr(err.message, "not positive definite"));
 	assert_int_equal(plume_kkt_factor(&kkt, true, &shift, &err), PLUME_OK);
@@ -352,7 +352,7 @@ static void test_kkt_factor_reports_indefinite(void **state)
 	plume_kkt_zero(&kkt);
 	for (int v = 0; v < 2; ++v)
 		for (int d = 0; d < 3; ++d)
-			values[kkt.vertex_slots[9 * v + 4 * d]] = v == 1 && d == 1 ? NAN : 2.0;
+			values[kkt.diagonal_slots[3 * v + d]] = v == 1 && d == 1 ? NAN : 2.0;
 	assert_int_equal(plume_kkt_factor(&kkt, false, &shift, &err), PLUME_ERROR_NUMERIC);
 	plume_kkt_free(&kkt);
 }
@@ -373,13 +373,13 @@ static void test_kkt_factor_inertia(void **state)
 		plume_kkt_zero(&kkt);
 		for (int v = 0; v < 2; ++v)
 			for (int d = 0; d < 3; ++d)
-				values[kkt.vertex_slots[9 * v + 4 * d]] = 2.0;
+				values[kkt.diagonal_slots[3 * v + d]] = 2.0;
 		values[kkt.constraint_slots[0]] = -1.0;
 		values[kkt.constraint_slots[3]] = 1.0;
 		// Trial 0: H_x0x0 = -1 makes H indefinite, but the tangent space sees x0 only with
 		// x1 ((-1 + 2) / 2 > 0 along x0 = x1): accepted. Trial 1: H_y0y0 = -1 is a tangent
 		// direction: refused.
-		values[kkt.vertex_slots[4 * trial]] = -1.0;
+		values[kkt.diagonal_slots[trial]] = -1.0;
 		plume_status status = plume_kkt_factor(&kkt, false, &shift, &err);
 		if (trial == 1) {
 			assert_int_equal(status, PLUME_ERROR_NUMERIC);

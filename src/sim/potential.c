@@ -116,16 +116,17 @@ static void evaluate_ff_faces(plume_sim *sim, const plume_vec3 *x, bool gradient
 	}
 }
 
-/// Adds a symmetric element block into the matrix, skipping held unknowns.
+/// Adds a symmetric element block (n x n, n = 3 count) into the matrix through its upper
+/// slots (kkt.h), skipping held unknowns.
 static void scatter_block(const plume_sim *sim, double *values, const int *vertices, int count, const int *slots,
                           const double *block)
 {
 	int n = 3 * count;
-	for (int a = 0; a < n; ++a) {
+	for (int a = 0; a < n; slots += n - a, ++a) {
 		if (vertices[a / 3] < 0 || sim->fixed[3 * vertices[a / 3] + a % 3])
 			continue;
-		for (int b = 0; b < n; ++b) {
-			int slot = slots[a * n + b]; // -1 for the lower part and absent vertices
+		for (int b = a; b < n; ++b) {
+			int slot = slots[b - a]; // -1 for absent vertices
 			if (slot >= 0 && !sim->fixed[3 * vertices[b / 3] + b % 3])
 				values[slot] += block[a * n + b];
 		}
@@ -170,9 +171,9 @@ double plume_sim_potential(plume_sim *sim, const sim_problem *problem, const plu
 		if (want_gradient)
 			scatter_gradient(gradient, vertices, 3, sim->face_gradient + 9 * f);
 		if (hessian)
-			scatter_block(sim, values, vertices, 3, sim->kkt.face_slots + 81 * f, sim->face_hessian + 81 * f);
+			scatter_block(sim, values, vertices, 3, sim->kkt.face_slots + 45 * f, sim->face_hessian + 81 * f);
 	}
-	int size = plume_sim_bending_size(sim), dofs = 3 * size;
+	int size = plume_sim_bending_size(sim), dofs = 3 * size, upper = plume_kkt_upper_size(size);
 	for (int e = 0; sim->def.bending && e < plume_sim_bending_count(sim); ++e) {
 		energy += sim->hinge_energy[e];
 		const int *vertices = plume_sim_bending_vertices(sim, e);
@@ -180,7 +181,8 @@ double plume_sim_potential(plume_sim *sim, const sim_problem *problem, const plu
 		if (want_gradient)
 			scatter_gradient(gradient, vertices, size, sim->hinge_gradient + (size_t)dofs * e);
 		if (hessian)
-			scatter_block(sim, values, vertices, size, sim->kkt.bending_slots + block, sim->hinge_hessian + block);
+			scatter_block(sim, values, vertices, size, sim->kkt.bending_slots + (size_t)upper * e,
+			              sim->hinge_hessian + block);
 	}
 
 	plume_vec3 g = sim->def.gravity;
@@ -217,7 +219,7 @@ double plume_sim_potential(plume_sim *sim, const sim_problem *problem, const plu
 			for (int a = 0; a < 3; ++a)
 				gradient[3 * i + a] += local_gradient[a];
 		if (hessian)
-			scatter_block(sim, values, &i, 1, sim->kkt.vertex_slots + 9 * i, block);
+			scatter_block(sim, values, &i, 1, sim->kkt.vertex_slots + 6 * i, block);
 	}
 
 	if (contact && plume_contact_any(sim)) {
@@ -229,7 +231,7 @@ double plume_sim_potential(plume_sim *sim, const sim_problem *problem, const plu
 	if (hessian)
 		for (int i = 0; i < 3 * n; ++i)
 			if (sim->fixed[i])
-				values[sim->kkt.vertex_slots[9 * (i / 3) + 4 * (i % 3)]] = 1;
+				values[sim->kkt.diagonal_slots[i]] = 1;
 	return isfinite(energy) ? energy : NAN;
 }
 
