@@ -328,7 +328,7 @@ static void test_kkt_factor_reports_indefinite(void **state)
 	plume_kkt kkt;
 	memset(&kkt, 0, sizeof kkt);
 	plume_error err = {0};
-	assert_int_equal(plume_kkt_init(&kkt, 2, 0, NULL, 0, NULL, 0, 4, 0, NULL, &err), PLUME_OK);
+	assert_int_equal(plume_kkt_init(&kkt, 2, 0, NULL, 0, NULL, 0, 4, 0, NULL, 0, NULL, &err), PLUME_OK);
 	double *values = plume_kkt_values(&kkt);
 	double shift = -1.0, rhs[6] = {1, 2, 3, 4, 5, 6}, x[6];
 	plume_kkt_zero(&kkt);
@@ -367,7 +367,7 @@ static void test_kkt_factor_inertia(void **state)
 	memset(&kkt, 0, sizeof kkt);
 	plume_error err = {0};
 	const int pair[2] = {0, 1};
-	assert_int_equal(plume_kkt_init(&kkt, 2, 0, NULL, 0, NULL, 4, 0, 1, pair, &err), PLUME_OK);
+	assert_int_equal(plume_kkt_init(&kkt, 2, 0, NULL, 0, NULL, 4, 0, 0, NULL, 1, pair, &err), PLUME_OK);
 	double *values = plume_kkt_values(&kkt), shift;
 	for (int trial = 0; trial < 2; ++trial) {
 		plume_kkt_zero(&kkt);

@@ -46,8 +46,9 @@ static void fill_upper_slots(const plume_sparse *system, const int *vertices, in
 }
 
 static plume_status build(plume_kkt *kkt, int vertex_count, int face_count, const int *faces, int bending_count,
-                          const int *bending_vertices, int bending_stride, int bending_size, int constraint_count,
-                          const int *constraint_vertices, int extra_count, const int *extra, plume_error *err)
+                          const int *bending_vertices, int bending_stride, int bending_size, int edge_count,
+                          const int *edge_vertices, int constraint_count, const int *constraint_vertices,
+                          int extra_count, const int *extra, plume_error *err)
 {
 	memset(kkt, 0, sizeof *kkt);
 	kkt->vertex_count = vertex_count;
@@ -56,6 +57,8 @@ static plume_status build(plume_kkt *kkt, int vertex_count, int face_count, cons
 	kkt->bending_count = bending_count;
 	kkt->bending_vertices = bending_vertices;
 	kkt->bending_stride = bending_stride;
+	kkt->edge_count = edge_count;
+	kkt->edge_vertices = edge_vertices;
 	kkt->constraint_vertices = constraint_vertices;
 	kkt->extra_count = extra_count;
 	kkt->dof_count = 3 * vertex_count;
@@ -71,6 +74,8 @@ static plume_status build(plume_kkt *kkt, int vertex_count, int face_count, cons
 	for (int h = 0; h < bending_count && !failed; ++h)
 		failed =
 		    push_block(&list, (const int *)((const char *)bending_vertices + (size_t)h * bending_stride), bending_size);
+	for (int e = 0; e < edge_count && !failed; ++e)
+		failed = push_block(&list, edge_vertices + 4 * e, 4);
 	for (int k = 0; k < constraint_count && !failed; ++k)
 		failed = push_block(&list, constraint_vertices + 2 * k, 2);
 	for (int k = 0; k < extra_count && !failed; ++k)
@@ -113,13 +118,15 @@ static plume_status build(plume_kkt *kkt, int vertex_count, int face_count, cons
 	int block = plume_kkt_upper_size(bending_size);
 	kkt->bending_size = bending_size;
 	kkt->bending_slots = plume_alloc(sizeof(int) * (size_t)block * (size_t)(bending_count > 0 ? bending_count : 1));
+	kkt->edge_slots =
+	    plume_alloc(sizeof(int) * (size_t)plume_kkt_upper_size(4) * (size_t)(edge_count > 0 ? edge_count : 1));
 	size_t constraints = (size_t)(constraint_count > 0 ? constraint_count : 1);
 	kkt->constraint_slots = plume_alloc(sizeof(int) * 6 * constraints);
 	kkt->pair_slots = plume_alloc(sizeof(int) * 21 * constraints);
 	kkt->augment_slots = plume_alloc(sizeof(int) * 21 * constraints);
 	kkt->rho = plume_alloc(sizeof(double) * constraints);
 	kkt->position_slots = plume_alloc(sizeof(int) * (size_t)(position_entries > 0 ? position_entries : 1));
-	if (!kkt->diagonal_slots || !kkt->vertex_slots || !kkt->face_slots || !kkt->bending_slots ||
+	if (!kkt->diagonal_slots || !kkt->vertex_slots || !kkt->face_slots || !kkt->bending_slots || !kkt->edge_slots ||
 	    !kkt->constraint_slots || !kkt->pair_slots || !kkt->augment_slots || !kkt->rho || !kkt->position_slots) {
 		plume_kkt_free(kkt);
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory allocating the solver's slot maps");
@@ -133,6 +140,8 @@ static plume_status build(plume_kkt *kkt, int vertex_count, int face_count, cons
 	for (int h = 0; h < bending_count; ++h)
 		fill_upper_slots(matrix, (const int *)((const char *)bending_vertices + (size_t)h * bending_stride),
 		                 bending_size, kkt->bending_slots + (size_t)block * h);
+	for (int e = 0; e < edge_count; ++e)
+		fill_upper_slots(matrix, edge_vertices + 4 * e, 4, kkt->edge_slots + plume_kkt_upper_size(4) * (size_t)e);
 	for (int k = 0; k < constraint_count; ++k) {
 		int column = kkt->dof_count + k;
 		fill_upper_slots(matrix, constraint_vertices + 2 * k, 2, kkt->pair_slots + 21 * k);
@@ -150,19 +159,21 @@ static plume_status build(plume_kkt *kkt, int vertex_count, int face_count, cons
 }
 
 plume_status plume_kkt_init(plume_kkt *kkt, int vertex_count, int face_count, const int *faces, int bending_count,
-                            const int *bending_vertices, int bending_stride, int bending_size, int constraint_count,
-                            const int *constraint_vertices, plume_error *err)
+                            const int *bending_vertices, int bending_stride, int bending_size, int edge_count,
+                            const int *edge_vertices, int constraint_count, const int *constraint_vertices,
+                            plume_error *err)
 {
 	return build(kkt, vertex_count, face_count, faces, bending_count, bending_vertices, bending_stride, bending_size,
-	             constraint_count, constraint_vertices, 0, NULL, err);
+	             edge_count, edge_vertices, constraint_count, constraint_vertices, 0, NULL, err);
 }
 
 plume_status plume_kkt_set_extra_blocks(plume_kkt *kkt, int count, const int *vertices, plume_error *err)
 {
 	plume_kkt rebuilt;
-	plume_status status = build(&rebuilt, kkt->vertex_count, kkt->face_count, kkt->faces, kkt->bending_count,
-	                            kkt->bending_vertices, kkt->bending_stride, kkt->bending_size, kkt->constraint_count,
-	                            kkt->constraint_vertices, count, vertices, err);
+	plume_status status =
+	    build(&rebuilt, kkt->vertex_count, kkt->face_count, kkt->faces, kkt->bending_count, kkt->bending_vertices,
+	          kkt->bending_stride, kkt->bending_size, kkt->edge_count, kkt->edge_vertices, kkt->constraint_count,
+	          kkt->constraint_vertices, count, vertices, err);
 	if (status != PLUME_OK)
 		return status;
 	plume_kkt_free(kkt);
@@ -181,6 +192,7 @@ void plume_kkt_free(plume_kkt *kkt)
 	plume_free(kkt->vertex_slots);
 	plume_free(kkt->face_slots);
 	plume_free(kkt->bending_slots);
+	plume_free(kkt->edge_slots);
 	plume_free(kkt->constraint_slots);
 	plume_free(kkt->pair_slots);
 	plume_free(kkt->refine);

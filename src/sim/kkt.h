@@ -44,6 +44,7 @@ typedef struct plume_kkt {
 	/// (a, b) with a <= b row by row (plume_kkt_upper_size); -1 where a vertex is absent.
 	int *face_slots;       ///< 45 per face
 	int *bending_slots;    ///< plume_kkt_upper_size(k) per bending element of k vertices
+	int *edge_slots;       ///< plume_kkt_upper_size(4) per shared edge (4 vertices)
 	int bending_size;      ///< k: 4 (hinge) or 6 (fundamental-form face)
 	int *vertex_slots;     ///< 6 per vertex
 	int *diagonal_slots;   ///< 1 per position unknown: its diagonal entry
@@ -51,8 +52,8 @@ typedef struct plume_kkt {
 	int *pair_slots;       ///< 21 per constraint: the 6x6 position block of its two vertices
 	double *refine;        ///< scratch for iterative refinement (2 x size)
 	/// plume_kkt_init's arguments (the caller keeps the arrays alive), for plume_kkt_set_extra_blocks.
-	int vertex_count, face_count, bending_count, bending_stride;
-	const int *faces, *bending_vertices, *constraint_vertices;
+	int vertex_count, face_count, bending_count, bending_stride, edge_count;
+	const int *faces, *bending_vertices, *edge_vertices, *constraint_vertices;
 	/// 4-vertex blocks beyond the mesh's (contact pairs) in the current pattern.
 	int extra_count;
 } plume_kkt;
@@ -61,11 +62,13 @@ typedef struct plume_kkt {
 static inline int plume_kkt_upper_size(int k) { return 3 * k * (3 * k + 1) / 2; }
 
 /// Builds the pattern from faces (3 vertices), bending elements (bending_size vertices
-/// each, bending_stride bytes apart; a negative vertex is absent), per-vertex blocks and
-/// constraints (2 vertices each), and runs the symbolic analysis.
+/// each, bending_stride bytes apart; a negative vertex is absent), the fundamental-form
+/// faces' shared edges (4 vertices each, blocks of the faces' own: slots only), per-vertex
+/// blocks and constraints (2 vertices each), and runs the symbolic analysis.
 plume_status plume_kkt_init(plume_kkt *kkt, int vertex_count, int face_count, const int *faces, int bending_count,
-                            const int *bending_vertices, int bending_stride, int bending_size, int constraint_count,
-                            const int *constraint_vertices, plume_error *err);
+                            const int *bending_vertices, int bending_stride, int bending_size, int edge_count,
+                            const int *edge_vertices, int constraint_count, const int *constraint_vertices,
+                            plume_error *err);
 void plume_kkt_free(plume_kkt *kkt);
 
 /// Rebuilds the pattern (and its symbolic analysis) with count extra blocks of 4 vertices
