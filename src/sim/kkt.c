@@ -288,9 +288,12 @@ plume_status plume_kkt_factor(plume_kkt *kkt, bool allow_shift, double *shift, p
 	                       kkt->positions.common.status);
 }
 
-/// [dx; lambda] = M^-1 [r1; r2] for the regularised matrix M = [H C^T; C -R^-1]:
-/// (H + C^T R C) dx = r1 + C^T R r2, lambda = R (C dx - r2).
-static plume_status solve_regularised(plume_kkt *kkt, const double *rhs, double *solution, plume_error *err)
+/// [dx; lambda] = [0; g] + M^-1 ([r1; r2] - K [0; g]) for the regularised matrix
+/// M = [H C^T; C -R^-1], starting from the multipliers' guess g (NULL: 0):
+/// (H + C^T R C) dx = r1 + C^T (R r2 - g), lambda = g + R (C dx - r2). Its residual
+/// against K is [0; (g - lambda) / rho]: the better the guess, the fewer refinement steps.
+static plume_status solve_regularised(plume_kkt *kkt, const double *rhs, const double *guess, double *solution,
+                                      plume_error *err)
 {
 	plume_sparse *positions = &kkt->positions;
 	const double *stored = kkt->system.matrix->x;
@@ -298,7 +301,7 @@ static plume_status solve_regularised(plume_kkt *kkt, const double *rhs, double 
 	double *b = positions->rhs->x;
 	memcpy(b, rhs, sizeof(double) * (size_t)n);
 	for (int k = 0; k < kkt->constraint_count; ++k) {
-		double weight = kkt->rho[k] * rhs[n + k];
+		double weight = kkt->rho[k] * rhs[n + k] - (guess != NULL ? guess[k] : 0);
 		for (int a = 0; a < 6; ++a)
 			b[3 * kkt->constraint_vertices[2 * k + a / 3] + a % 3] += weight * stored[kkt->constraint_slots[6 * k + a]];
 	}
@@ -310,7 +313,7 @@ static plume_status solve_regularised(plume_kkt *kkt, const double *rhs, double 
 		double cdx = 0;
 		for (int a = 0; a < 6; ++a)
 			cdx += stored[kkt->constraint_slots[6 * k + a]] * dx[3 * kkt->constraint_vertices[2 * k + a / 3] + a % 3];
-		solution[n + k] = kkt->rho[k] * (cdx - rhs[n + k]);
+		solution[n + k] = (guess != NULL ? guess[k] : 0) + kkt->rho[k] * (cdx - rhs[n + k]);
 	}
 	return PLUME_OK;
 }
@@ -361,9 +364,10 @@ static double backward_error(const plume_kkt *kkt, const double *rhs, const doub
 	return worst;
 }
 
-plume_status plume_kkt_solve(plume_kkt *kkt, const double *rhs, double *solution, plume_error *err)
+plume_status plume_kkt_solve(plume_kkt *kkt, const double *rhs, const double *multipliers, double *solution,
+                             plume_error *err)
 {
-	plume_status status = solve_regularised(kkt, rhs, solution, err);
+	plume_status status = solve_regularised(kkt, rhs, multipliers, solution, err);
 	if (status != PLUME_OK || kkt->constraint_count == 0)
 		return status;
 	size_t size = kkt->system.matrix->ncol;
@@ -376,7 +380,7 @@ plume_status plume_kkt_solve(plume_kkt *kkt, const double *rhs, double *solution
 		if (step == REFINEMENT_STEPS || error <= REFINEMENT_TOLERANCE || !(error < 0.5 * previous))
 			break;
 		previous = error;
-		if ((status = solve_regularised(kkt, residual, correction, err)) != PLUME_OK)
+		if ((status = solve_regularised(kkt, residual, NULL, correction, err)) != PLUME_OK)
 			return status;
 		for (size_t i = 0; i < size; ++i)
 			solution[i] += correction[i];

@@ -15,8 +15,8 @@
 // Optimization, 2nd ed., theorem 17.5), and then factored by Cholesky, supernodal where
 // it pays (sim/sparse.h). Iterative refinement against K itself removes the
 // regularisation's error (each step shrinks it by about 1/(1 + rho_k s_k), s_k the
-// constraint's compliance); its residual, K - M applied to the last correction, is
-// known in closed form (kkt.c). This replaced a simplicial LDL' of the quasi-definite K
+// constraint's compliance); a guess of the multipliers (the last iterate's) starts it
+// closer. This replaced a simplicial LDL' of the quasi-definite K
 // (Vanderbei 1995), which CHOLMOD cannot factor supernodally: docs/simulation.md,
 // "Linear algebra", measures both. Without constraints the matrix is H alone.
 // The pattern is fixed per mesh, the symbolic analysis runs once, except when contact
@@ -50,7 +50,7 @@ typedef struct plume_kkt {
 	int *diagonal_slots;   ///< 1 per position unknown: its diagonal entry
 	int *constraint_slots; ///< 6 per constraint: its row of C
 	int *pair_slots;       ///< 21 per constraint: the 6x6 position block of its two vertices
-	double *refine;        ///< scratch for iterative refinement (2 x size)
+	double *refine;        ///< scratch for iterative refinement (3 x size)
 	/// plume_kkt_init's arguments (the caller keeps the arrays alive), for plume_kkt_set_extra_blocks.
 	int vertex_count, face_count, bending_count, bending_stride, edge_count;
 	const int *faces, *bending_vertices, *edge_vertices, *constraint_vertices;
@@ -92,10 +92,12 @@ plume_status plume_kkt_factor(plume_kkt *kkt, bool allow_shift, double *shift, p
 
 /// Solves K [dx; lambda] = rhs with the last factorisation: rhs and solution have
 /// dof_count + constraint_count entries. With constraints, iterative refinement against
-/// K: a step only while the constraint rows' componentwise backward error is above 1e-14
-/// and falling, at most 8, so the linearised constraints hold to rounding (the position
-/// rows hold to the rounding of the regularised solve, about 1e-10 relative).
-plume_status plume_kkt_solve(plume_kkt *kkt, const double *rhs, double *solution, plume_error *err);
+/// K: a step only while the componentwise backward error is above 1e-14 and falling, at
+/// most 8, so the linearised constraints hold to rounding. multipliers (constraint_count
+/// entries, or NULL for 0) is a guess of the solution's lambda for the regularised solve
+/// to start from: the first residual is the guess's error over rho.
+plume_status plume_kkt_solve(plume_kkt *kkt, const double *rhs, const double *multipliers, double *solution,
+                             plume_error *err);
 
 /// y += K x for the assembled (symmetric) matrix.
 void plume_kkt_multiply_add(const plume_kkt *kkt, const double *x, double *y);
