@@ -118,8 +118,7 @@ static plume_status build(plume_kkt *kkt, int vertex_count, int face_count, cons
 	int block = plume_kkt_upper_size(bending_size);
 	kkt->bending_size = bending_size;
 	kkt->bending_slots = plume_alloc(sizeof(int) * (size_t)block * (size_t)(bending_count > 0 ? bending_count : 1));
-	kkt->edge_slots =
-	    plume_alloc(sizeof(int) * (size_t)plume_kkt_upper_size(4) * (size_t)(edge_count > 0 ? edge_count : 1));
+	kkt->edge_slots = plume_alloc(sizeof(int) * 78 * (size_t)(edge_count > 0 ? edge_count : 1));
 	size_t constraints = (size_t)(constraint_count > 0 ? constraint_count : 1);
 	kkt->constraint_slots = plume_alloc(sizeof(int) * 6 * constraints);
 	kkt->pair_slots = plume_alloc(sizeof(int) * 21 * constraints);
@@ -141,7 +140,7 @@ static plume_status build(plume_kkt *kkt, int vertex_count, int face_count, cons
 		fill_upper_slots(matrix, (const int *)((const char *)bending_vertices + (size_t)h * bending_stride),
 		                 bending_size, kkt->bending_slots + (size_t)block * h);
 	for (int e = 0; e < edge_count; ++e)
-		fill_upper_slots(matrix, edge_vertices + 4 * e, 4, kkt->edge_slots + plume_kkt_upper_size(4) * (size_t)e);
+		fill_upper_slots(matrix, edge_vertices + 4 * e, 4, kkt->edge_slots + 78 * (size_t)e);
 	for (int k = 0; k < constraint_count; ++k) {
 		int column = kkt->dof_count + k;
 		fill_upper_slots(matrix, constraint_vertices + 2 * k, 2, kkt->pair_slots + 21 * k);

@@ -44,7 +44,7 @@ typedef struct plume_kkt {
 	/// (a, b) with a <= b row by row (plume_kkt_upper_size); -1 where a vertex is absent.
 	int *face_slots;       ///< 45 per face
 	int *bending_slots;    ///< plume_kkt_upper_size(k) per bending element of k vertices
-	int *edge_slots;       ///< plume_kkt_upper_size(4) per shared edge (4 vertices)
+	int *edge_slots;       ///< 78 per shared edge (4 vertices)
 	int bending_size;      ///< k: 4 (hinge) or 6 (fundamental-form face)
 	int *vertex_slots;     ///< 6 per vertex
 	int *diagonal_slots;   ///< 1 per position unknown: its diagonal entry

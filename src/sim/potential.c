@@ -119,8 +119,10 @@ static void evaluate_ff_faces(plume_sim *sim, const plume_vec3 *x, bool gradient
 static bool all_free(const plume_sim *sim, const int *vertices, int count)
 {
 	for (int k = 0; k < count; ++k) {
+		if (vertices[k] < 0)
+			return false;
 		const unsigned char *fixed = sim->fixed + 3 * vertices[k];
-		if (vertices[k] < 0 || fixed[0] || fixed[1] || fixed[2])
+		if (fixed[0] || fixed[1] || fixed[2])
 			return false;
 	}
 	return true;
@@ -163,9 +165,8 @@ static void scatter_angle_curvature(plume_sim *sim, double *values)
 				weight[sim->ff_faces[f].edge[i]] += sim->ff_face_weight[3 * f + i];
 	for (int e = 0; e < sim->ff_edge_count; ++e)
 		if (weight[e] != 0)
-			scatter_block(sim, values, sim->ff_edge_vertices + 4 * e, 4,
-			              sim->kkt.edge_slots + plume_kkt_upper_size(4) * (size_t)e, weight[e],
-			              sim->ff_edge_hessian + 144 * (size_t)e);
+			scatter_block(sim, values, sim->ff_edge_vertices + 4 * e, 4, sim->kkt.edge_slots + 78 * (size_t)e,
+			              weight[e], sim->ff_edge_hessian + 144 * (size_t)e);
 }
 
 static void scatter_gradient(double *gradient, const int *vertices, int count, const double *local)
