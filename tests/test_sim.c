@@ -328,31 +328,31 @@ static void test_kkt_factor_reports_indefinite(void **state)
 	plume_kkt kkt;
 	memset(&kkt, 0, sizeof kkt);
 	plume_error err = {0};
-	assert_int_equal(plume_kkt_init(&kkt, 2, 0, NULL, 0, NULL, 0, 4, 0, NULL, &err), PLUME_OK);
+	assert_int_equal(plume_kkt_init(&kkt, 2, 0, NULL, 0, NULL, 0, 4, 0, NULL, 0, NULL, &err), PLUME_OK);
 	double *values = plume_kkt_values(&kkt);
 	double shift = -1.0, rhs[6] = {1, 2, 3, 4, 5, 6}, x[6];
 	plume_kkt_zero(&kkt);
 	for (int v = 0; v < 2; ++v)
 		for (int d = 0; d < 3; ++d)
-			values[kkt.vertex_slots[9 * v + 4 * d]] = 2.0;
+			values[kkt.diagonal_slots[3 * v + d]] = 2.0;
 	assert_int_equal(plume_kkt_factor(&kkt, false, &shift, &err), PLUME_OK);
 	assert_true(shift == 0.0);
-	assert_int_equal(plume_kkt_solve(&kkt, rhs, x, &err), PLUME_OK);
+	assert_int_equal(plume_kkt_solve(&kkt, rhs, NULL, x, &err), PLUME_OK);
 	for (int i = 0; i < 6; ++i)
 		assert_close(x[i], rhs[i] / 2.0, 1e-15);
 
-	values[kkt.vertex_slots[9 * 1 + 4 * 2]] = -1.0; // mean |diagonal| 11/6
+	values[kkt.diagonal_slots[3 * 1 + 2]] = -1.0; // mean |diagonal| 11/6
 	assert_int_equal(plume_kkt_factor(&kkt, false, &shift, &err), PLUME_ERROR_NUMERIC);
 	assert_non_null(strstr(err.message, "not positive definite"));
 	assert_int_equal(plume_kkt_factor(&kkt, true, &shift, &err), PLUME_OK);
 	assert_close(shift, 11.0 / 6.0, 1e-12); // 1e-10, 1e-9 ... 1 times the mean: the first past 1
-	assert_int_equal(plume_kkt_solve(&kkt, rhs, x, &err), PLUME_OK);
+	assert_int_equal(plume_kkt_solve(&kkt, rhs, NULL, x, &err), PLUME_OK);
 	assert_close(x[5], 6.0 / (shift - 1.0), 1e-12);
 
 	plume_kkt_zero(&kkt);
 	for (int v = 0; v < 2; ++v)
 		for (int d = 0; d < 3; ++d)
-			values[kkt.vertex_slots[9 * v + 4 * d]] = v == 1 && d == 1 ? NAN : 2.0;
+			values[kkt.diagonal_slots[3 * v + d]] = v == 1 && d == 1 ? NAN : 2.0;
 	assert_int_equal(plume_kkt_factor(&kkt, false, &shift, &err), PLUME_ERROR_NUMERIC);
 	plume_kkt_free(&kkt);
 }
@@ -367,19 +367,19 @@ static void test_kkt_factor_inertia(void **state)
 	memset(&kkt, 0, sizeof kkt);
 	plume_error err = {0};
 	const int pair[2] = {0, 1};
-	assert_int_equal(plume_kkt_init(&kkt, 2, 0, NULL, 0, NULL, 4, 0, 1, pair, &err), PLUME_OK);
+	assert_int_equal(plume_kkt_init(&kkt, 2, 0, NULL, 0, NULL, 4, 0, 0, NULL, 1, pair, &err), PLUME_OK);
 	double *values = plume_kkt_values(&kkt), shift;
 	for (int trial = 0; trial < 2; ++trial) {
 		plume_kkt_zero(&kkt);
 		for (int v = 0; v < 2; ++v)
 			for (int d = 0; d < 3; ++d)
-				values[kkt.vertex_slots[9 * v + 4 * d]] = 2.0;
+				values[kkt.diagonal_slots[3 * v + d]] = 2.0;
 		values[kkt.constraint_slots[0]] = -1.0;
 		values[kkt.constraint_slots[3]] = 1.0;
 		// Trial 0: H_x0x0 = -1 makes H indefinite, but the tangent space sees x0 only with
 		// x1 ((-1 + 2) / 2 > 0 along x0 = x1): accepted. Trial 1: H_y0y0 = -1 is a tangent
 		// direction: refused.
-		values[kkt.vertex_slots[4 * trial]] = -1.0;
+		values[kkt.diagonal_slots[trial]] = -1.0;
 		plume_status status = plume_kkt_factor(&kkt, false, &shift, &err);
 		if (trial == 1) {
 			assert_int_equal(status, PLUME_ERROR_NUMERIC);
@@ -388,7 +388,7 @@ static void test_kkt_factor_inertia(void **state)
 		}
 		assert_int_equal(status, PLUME_OK);
 		double rhs[7] = {1, 2, 3, 4, 5, 6, 0.5}, x[7];
-		assert_int_equal(plume_kkt_solve(&kkt, rhs, x, &err), PLUME_OK);
+		assert_int_equal(plume_kkt_solve(&kkt, rhs, NULL, x, &err), PLUME_OK);
 		assert_close(x[3] - x[0], 0.5, 1e-14);  // the linearised constraint, to rounding
 		assert_close(-x[0] - x[6], 1.0, 1e-12); // H dx + C^T lambda = rhs on x0
 	}

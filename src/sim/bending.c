@@ -46,12 +46,13 @@ static void add_cross_block(double D[36], int k, const double v[3], double s)
 // dm/dx (3 x 12) for m = n / |n|^2 given dn/dx (3 x 12).
 static void normal_over_square_derivative(const double n[3], const double dn[36], double dm[36])
 {
-	double n2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+	// One division, not two per entry: 144 divisions an edge were a sixth of the angle's Hessian.
+	double inverse = 1.0 / (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
 	for (int a = 0; a < 3; ++a) {
 		for (int c = 0; c < 12; ++c) {
 			// (I - 2 n n^T / |n|^2) dn / |n|^2
 			double ndn = n[0] * dn[c] + n[1] * dn[12 + c] + n[2] * dn[24 + c];
-			dm[12 * a + c] = (dn[12 * a + c] - 2.0 * n[a] * ndn / n2) / n2;
+			dm[12 * a + c] = (dn[12 * a + c] - 2.0 * n[a] * ndn * inverse) * inverse;
 		}
 	}
 }
@@ -77,17 +78,20 @@ static void add_projection_gradient(double ds[12], int y, int z, const double *p
 
 double plume_dihedral_angle_derivatives(const plume_vec3 x[4], double gradient[12], double hessian[144])
 {
-	if (gradient)
-		memset(gradient, 0, 12 * sizeof(double));
-	if (hessian)
-		memset(hessian, 0, 144 * sizeof(double));
 	plume_vec3 edge = plume_v3_sub(x[1], x[0]);
 	plume_vec3 nA = plume_v3_cross(edge, plume_v3_sub(x[2], x[0]));
 	plume_vec3 nB = plume_v3_cross(plume_v3_sub(x[3], x[0]), edge);
 	double length = plume_v3_length(edge);
 	double nA2 = plume_v3_dot(nA, nA), nB2 = plume_v3_dot(nB, nB);
-	if (!(length > 0.0) || !(nA2 > 0.0) || !(nB2 > 0.0))
+	if (!(length > 0.0) || !(nA2 > 0.0) || !(nB2 > 0.0)) {
+		// A degenerate stencil has no angle: zero, and zero derivatives. (Otherwise both
+		// are written whole below.)
+		if (gradient)
+			memset(gradient, 0, 12 * sizeof(double));
+		if (hessian)
+			memset(hessian, 0, 144 * sizeof(double));
 		return 0.0;
+	}
 	plume_vec3 ehat_v = plume_v3_scale(edge, 1.0 / length);
 	// Positive when the wings fold towards n_A (see bending.h).
 	double sine = plume_v3_dot(plume_v3_cross(nB, nA), ehat_v);
@@ -163,22 +167,17 @@ double plume_dihedral_angle_derivatives(const plume_vec3 x[4], double gradient[1
 	add_cross_block(dn[1], 3, e, -1.0);
 	normal_over_square_derivative(n[0], dn[0], dm[0]);
 	normal_over_square_derivative(n[1], dn[1], dm[1]);
+	// The exact Hessian is symmetric: its upper triangle, mirrored.
 	for (int i = 0; i < 4; ++i) {
 		for (int a = 0; a < 3; ++a) {
-			double *row = hessian + 12 * (3 * i + a);
-			for (int col = 0; col < 12; ++col) {
-				row[col] = m[0][a] * dc[0][i][col] + c[0][i] * dm[0][12 * a + col] + m[1][a] * dc[1][i][col] +
+			int r = 3 * i + a;
+			for (int col = r; col < 12; ++col) {
+				double h = m[0][a] * dc[0][i][col] + c[0][i] * dm[0][12 * a + col] + m[1][a] * dc[1][i][col] +
 				           c[1][i] * dm[1][12 * a + col];
+				hessian[12 * r + col] = hessian[12 * col + r] = h;
 			}
 		}
 	}
-	// The exact Hessian is symmetric; average away the rounding.
-	for (int r = 0; r < 12; ++r)
-		for (int col = r + 1; col < 12; ++col) {
-			double mean = 0.5 * (hessian[12 * r + col] + hessian[12 * col + r]);
-			hessian[12 * r + col] = mean;
-			hessian[12 * col + r] = mean;
-		}
 	return angle;
 }
 

@@ -163,11 +163,12 @@ static void gauss_newton(const double M[9], const double J[54], double hessian[3
 	}
 }
 
-// Energy 1/2 dchi^T M dchi, gradient (M dchi)^T J, and the Gauss-Newton Hessian J^T M J
-// plus, when exact, sum_i (M dchi)_i Hess chi_i, from the three edges' views (J: the
-// stencil gradients of the scaled angle changes, 3 x 18).
-static double combine(const plume_ff_face *face, const edge_view view[3], bool exact, double gradient[18],
-                      double hessian[324])
+// Energy 1/2 dchi^T M dchi, gradient (M dchi)^T J and the Gauss-Newton Hessian J^T M J
+// from the three edges' views (J: the stencil gradients of the scaled angle changes,
+// 3 x 18), and each edge's weight (M dchi)_i s_i sign_i: the exact Hessian is
+// J^T M J + sum_i weight_i Hess chi_i (plume_ff_face_energy_from_edges).
+static double combine(const plume_ff_face *face, const edge_view view[3], double gradient[18], double hessian[324],
+                      double weight[3])
 {
 	double delta[3], J[54];
 	bool derivatives = gradient != NULL || hessian != NULL;
@@ -186,32 +187,38 @@ static double combine(const plume_ff_face *face, const edge_view view[3], bool e
 	}
 	const double *M = face->stiffness;
 	double force[3];
-	for (int i = 0; i < 3; ++i)
+	for (int i = 0; i < 3; ++i) {
 		force[i] = M[3 * i] * delta[0] + M[3 * i + 1] * delta[1] + M[3 * i + 2] * delta[2];
+		weight[i] = face->vertices[3 + i] < 0 ? 0 : force[i] * face->edge_scale[i] * view[i].sign;
+	}
 	if (gradient)
 		for (int r = 0; r < 18; ++r)
 			gradient[r] = force[0] * J[r] + force[1] * J[18 + r] + force[2] * J[36 + r];
-	if (hessian) {
+	if (hessian)
 		gauss_newton(M, J, hessian);
-		for (int i = 0; exact && i < 3; ++i) {
-			if (force[i] == 0 || face->vertices[3 + i] < 0)
-				continue;
-			int h[4], face_row[12], edge_row[12];
-			hinge_indices(i, h);
-			for (int a = 0; a < 12; ++a) {
-				face_row[a] = 3 * h[a / 3] + a % 3;
-				edge_row[a] = 3 * view[i].order[a / 3] + a % 3;
-			}
-			double scale = force[i] * face->edge_scale[i] * view[i].sign;
-			for (int a = 0; a < 12; ++a) {
-				double *out = hessian + 18 * face_row[a];
-				const double *in = view[i].hessian + 12 * edge_row[a];
-				for (int b = 0; b < 12; ++b)
-					out[face_row[b]] += scale * in[edge_row[b]];
-			}
+	return 0.5 * (force[0] * delta[0] + force[1] * delta[1] + force[2] * delta[2]);
+}
+
+// Adds sum_i weight_i Hess chi_i, each angle's Hessian in its view's stencil order.
+static void add_angle_curvature(const plume_ff_face *face, const edge_view view[3], const double weight[3],
+                                double hessian[324])
+{
+	for (int i = 0; i < 3; ++i) {
+		if (weight[i] == 0 || face->vertices[3 + i] < 0)
+			continue;
+		int h[4], face_row[12], edge_row[12];
+		hinge_indices(i, h);
+		for (int a = 0; a < 12; ++a) {
+			face_row[a] = 3 * h[a / 3] + a % 3;
+			edge_row[a] = 3 * view[i].order[a / 3] + a % 3;
+		}
+		for (int a = 0; a < 12; ++a) {
+			double *out = hessian + 18 * face_row[a];
+			const double *in = view[i].hessian + 12 * edge_row[a];
+			for (int b = 0; b < 12; ++b)
+				out[face_row[b]] += weight[i] * in[edge_row[b]];
 		}
 	}
-	return 0.5 * (force[0] * delta[0] + force[1] * delta[1] + force[2] * delta[2]);
 }
 
 // The face's three angles with their derivatives (hinge order) from the positions.
@@ -231,7 +238,11 @@ static double evaluate(const plume_ff_face *face, const plume_vec3 x[6], bool ex
 		view[i].chi = plume_dihedral_angle_derivatives(local, derivatives ? local_gradient[i] : NULL,
 		                                               want_hessian ? local_hessian[i] : NULL);
 	}
-	return combine(face, view, exact, gradient, hessian);
+	double weight[3];
+	double energy = combine(face, view, gradient, hessian, weight);
+	if (want_hessian)
+		add_angle_curvature(face, view, weight, hessian);
+	return energy;
 }
 
 double plume_ff_face_energy_gauss_newton(const plume_ff_face *face, const plume_vec3 x[6], double gradient[18],
@@ -269,7 +280,7 @@ void plume_ff_face_link(plume_ff_face *face, int i, int edge, const int stencil[
 }
 
 double plume_ff_face_energy_from_edges(const plume_ff_face *face, const double *chi, const double *gradients,
-                                       const double *hessians, bool exact, double gradient[18], double hessian[324])
+                                       double gradient[18], double gauss_newton[324], double weight[3])
 {
 	edge_view view[3];
 	for (int i = 0; i < 3; ++i) {
@@ -279,8 +290,7 @@ double plume_ff_face_energy_from_edges(const plume_ff_face *face, const double *
 			continue;
 		}
 		double sign = face->edge_sign[i];
-		view[i] = (edge_view){sign * chi[e], gradients + 12 * (size_t)e,
-		                      hessians != NULL ? hessians + 144 * (size_t)e : NULL, face->edge_order[i], sign};
+		view[i] = (edge_view){sign * chi[e], gradients + 12 * (size_t)e, NULL, face->edge_order[i], sign};
 	}
-	return combine(face, view, exact, gradient, hessian);
+	return combine(face, view, gradient, gauss_newton, weight);
 }

@@ -106,7 +106,12 @@ double plume_ff_face_energy_gauss_newton(const plume_ff_face *face, const plume_
 // Hessian is most of the cost of a fundamental-form Hessian (Figure 1: a fifth of the
 // run), so the solver computes each edge's angle and derivatives once, with
 // plume_dihedral_angle_derivatives on the edge's stencil, and each face combines its
-// three edges' (plume_ff_face_energy_from_edges).
+// three edges' (plume_ff_face_energy_from_edges). The exact Hessian,
+//   J^T M J + sum_i (M dchi)_i s_i Hess chi_i
+// (J the scaled angle changes' gradients, s_i their scales and signs), takes each angle's
+// Hessian times a weight: the solver sums an edge's weights over its two faces and adds
+// its 12 x 12 Hessian once, instead of once into each face's 18 x 18 block (half the
+// cost of combining the faces' derivatives: docs/simulation.md, "The solver's floor").
 
 /// The vertices of face's hinge across edge i, in plume_dihedral_angle's order: the edge
 /// v_{i+1} -> v_{i+2}, v_i, the vertex across (-1 on the boundary).
@@ -116,11 +121,13 @@ void plume_ff_hinge_vertices(const plume_ff_face *face, int i, int out[4]);
 /// four vertices in some plume_dihedral_angle order: the edge's two, then its two wings).
 void plume_ff_face_link(plume_ff_face *face, int i, int edge, const int stencil[4]);
 
-/// plume_ff_face_energy (exact) or plume_ff_face_energy_gauss_newton (not exact) from the
-/// interior edges' angles (chi, one per edge), gradients (12 per edge, the edge's stencil
-/// order) and, when exact and a Hessian is asked for, Hessians (144 per edge). Every
-/// interior edge of the face must be linked.
+/// The face's energy from the interior edges' angles (chi, one per edge) and gradients (12
+/// per edge, the edge's stencil order), with its gradient (18) and Gauss-Newton Hessian
+/// J^T M J (324), either may be NULL, and weight[i], the weight of edge i's angle Hessian
+/// in the face's exact Hessian (0 on the boundary):
+///   plume_ff_face_energy's Hessian = J^T M J + sum_i weight[i] Hess chi_{edge[i]}.
+/// Every interior edge of the face must be linked.
 double plume_ff_face_energy_from_edges(const plume_ff_face *face, const double *chi, const double *gradients,
-                                       const double *hessians, bool exact, double gradient[18], double hessian[324]);
+                                       double gradient[18], double gauss_newton[324], double weight[3]);
 
 #endif // PLUME_SIM_FUNDAMENTAL_FORM_H

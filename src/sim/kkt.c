@@ -29,20 +29,26 @@ static int push_block(entry_list *list, const int *vertices, int count)
 	return 0;
 }
 
-static void fill_block_slots(const plume_sparse *system, const int *vertices, int count, int *slots)
+/// The slots of an element block's upper triangle in the element's order, (a, b) for
+/// a <= b, row by row (plume_kkt_upper_size entries): each pair of unknowns once, so a
+/// symmetric block scatters with no test for the matrix's triangle (whose side, in the
+/// permuted pattern, is a coin toss per pair that the branch predictor lost half the time).
+/// -1 where a vertex is absent.
+static void fill_upper_slots(const plume_sparse *system, const int *vertices, int count, int *slots)
 {
 	int n = 3 * count;
 	for (int a = 0; a < n; ++a)
-		for (int b = 0; b < n; ++b) {
+		for (int b = a; b < n; ++b) {
 			int i = 3 * vertices[a / 3] + a % 3, j = 3 * vertices[b / 3] + b % 3;
 			bool present = vertices[a / 3] >= 0 && vertices[b / 3] >= 0;
-			slots[a * n + b] = present && i <= j ? plume_sparse_find(system, i, j) : -1;
+			*slots++ = present ? plume_sparse_find(system, i, j) : -1;
 		}
 }
 
 static plume_status build(plume_kkt *kkt, int vertex_count, int face_count, const int *faces, int bending_count,
-                          const int *bending_vertices, int bending_stride, int bending_size, int constraint_count,
-                          const int *constraint_vertices, int extra_count, const int *extra, plume_error *err)
+                          const int *bending_vertices, int bending_stride, int bending_size, int edge_count,
+                          const int *edge_vertices, int constraint_count, const int *constraint_vertices,
+                          int extra_count, const int *extra, plume_error *err)
 {
 	memset(kkt, 0, sizeof *kkt);
 	kkt->vertex_count = vertex_count;
@@ -51,6 +57,8 @@ static plume_status build(plume_kkt *kkt, int vertex_count, int face_count, cons
 	kkt->bending_count = bending_count;
 	kkt->bending_vertices = bending_vertices;
 	kkt->bending_stride = bending_stride;
+	kkt->edge_count = edge_count;
+	kkt->edge_vertices = edge_vertices;
 	kkt->constraint_vertices = constraint_vertices;
 	kkt->extra_count = extra_count;
 	kkt->dof_count = 3 * vertex_count;
@@ -66,6 +74,8 @@ static plume_status build(plume_kkt *kkt, int vertex_count, int face_count, cons
 	for (int h = 0; h < bending_count && !failed; ++h)
 		failed =
 		    push_block(&list, (const int *)((const char *)bending_vertices + (size_t)h * bending_stride), bending_size);
+	for (int e = 0; e < edge_count && !failed; ++e)
+		failed = push_block(&list, edge_vertices + 4 * e, 4);
 	for (int k = 0; k < constraint_count && !failed; ++k)
 		failed = push_block(&list, constraint_vertices + 2 * k, 2);
 	for (int k = 0; k < extra_count && !failed; ++k)
@@ -101,33 +111,40 @@ static plume_status build(plume_kkt *kkt, int vertex_count, int face_count, cons
 	}
 	const plume_sparse *matrix = &kkt->system;
 
-	kkt->vertex_slots = plume_alloc(sizeof(int) * 9 * (size_t)(vertex_count > 0 ? vertex_count : 1));
-	kkt->face_slots = plume_alloc(sizeof(int) * 81 * (size_t)(face_count > 0 ? face_count : 1));
-	int block = 9 * bending_size * bending_size;
+	size_t vertices = (size_t)(vertex_count > 0 ? vertex_count : 1);
+	kkt->diagonal_slots = plume_alloc(sizeof(int) * 3 * vertices);
+	kkt->vertex_slots = plume_alloc(sizeof(int) * 6 * vertices);
+	kkt->face_slots = plume_alloc(sizeof(int) * 45 * (size_t)(face_count > 0 ? face_count : 1));
+	int block = plume_kkt_upper_size(bending_size);
 	kkt->bending_size = bending_size;
 	kkt->bending_slots = plume_alloc(sizeof(int) * (size_t)block * (size_t)(bending_count > 0 ? bending_count : 1));
+	kkt->edge_slots = plume_alloc(sizeof(int) * 78 * (size_t)(edge_count > 0 ? edge_count : 1));
 	size_t constraints = (size_t)(constraint_count > 0 ? constraint_count : 1);
 	kkt->constraint_slots = plume_alloc(sizeof(int) * 6 * constraints);
-	kkt->pair_slots = plume_alloc(sizeof(int) * 36 * constraints);
-	kkt->augment_slots = plume_alloc(sizeof(int) * 36 * constraints);
+	kkt->pair_slots = plume_alloc(sizeof(int) * 21 * constraints);
+	kkt->augment_slots = plume_alloc(sizeof(int) * 21 * constraints);
 	kkt->rho = plume_alloc(sizeof(double) * constraints);
 	kkt->position_slots = plume_alloc(sizeof(int) * (size_t)(position_entries > 0 ? position_entries : 1));
-	if (!kkt->vertex_slots || !kkt->face_slots || !kkt->bending_slots || !kkt->constraint_slots || !kkt->pair_slots ||
-	    !kkt->augment_slots || !kkt->rho || !kkt->position_slots) {
+	if (!kkt->diagonal_slots || !kkt->vertex_slots || !kkt->face_slots || !kkt->bending_slots || !kkt->edge_slots ||
+	    !kkt->constraint_slots || !kkt->pair_slots || !kkt->augment_slots || !kkt->rho || !kkt->position_slots) {
 		plume_kkt_free(kkt);
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory allocating the solver's slot maps");
 	}
+	for (int i = 0; i < kkt->dof_count; ++i)
+		kkt->diagonal_slots[i] = plume_sparse_find(matrix, i, i);
 	for (int v = 0; v < vertex_count; ++v)
-		fill_block_slots(matrix, &v, 1, kkt->vertex_slots + 9 * v);
+		fill_upper_slots(matrix, &v, 1, kkt->vertex_slots + 6 * v);
 	for (int f = 0; f < face_count; ++f)
-		fill_block_slots(matrix, faces + 3 * f, 3, kkt->face_slots + 81 * f);
+		fill_upper_slots(matrix, faces + 3 * f, 3, kkt->face_slots + 45 * f);
 	for (int h = 0; h < bending_count; ++h)
-		fill_block_slots(matrix, (const int *)((const char *)bending_vertices + (size_t)h * bending_stride),
+		fill_upper_slots(matrix, (const int *)((const char *)bending_vertices + (size_t)h * bending_stride),
 		                 bending_size, kkt->bending_slots + (size_t)block * h);
+	for (int e = 0; e < edge_count; ++e)
+		fill_upper_slots(matrix, edge_vertices + 4 * e, 4, kkt->edge_slots + 78 * (size_t)e);
 	for (int k = 0; k < constraint_count; ++k) {
 		int column = kkt->dof_count + k;
-		fill_block_slots(matrix, constraint_vertices + 2 * k, 2, kkt->pair_slots + 36 * k);
-		fill_block_slots(&kkt->positions, constraint_vertices + 2 * k, 2, kkt->augment_slots + 36 * k);
+		fill_upper_slots(matrix, constraint_vertices + 2 * k, 2, kkt->pair_slots + 21 * k);
+		fill_upper_slots(&kkt->positions, constraint_vertices + 2 * k, 2, kkt->augment_slots + 21 * k);
 		for (int a = 0; a < 6; ++a)
 			kkt->constraint_slots[6 * k + a] =
 			    plume_sparse_find(matrix, 3 * constraint_vertices[2 * k + a / 3] + a % 3, column);
@@ -141,19 +158,21 @@ static plume_status build(plume_kkt *kkt, int vertex_count, int face_count, cons
 }
 
 plume_status plume_kkt_init(plume_kkt *kkt, int vertex_count, int face_count, const int *faces, int bending_count,
-                            const int *bending_vertices, int bending_stride, int bending_size, int constraint_count,
-                            const int *constraint_vertices, plume_error *err)
+                            const int *bending_vertices, int bending_stride, int bending_size, int edge_count,
+                            const int *edge_vertices, int constraint_count, const int *constraint_vertices,
+                            plume_error *err)
 {
 	return build(kkt, vertex_count, face_count, faces, bending_count, bending_vertices, bending_stride, bending_size,
-	             constraint_count, constraint_vertices, 0, NULL, err);
+	             edge_count, edge_vertices, constraint_count, constraint_vertices, 0, NULL, err);
 }
 
 plume_status plume_kkt_set_extra_blocks(plume_kkt *kkt, int count, const int *vertices, plume_error *err)
 {
 	plume_kkt rebuilt;
-	plume_status status = build(&rebuilt, kkt->vertex_count, kkt->face_count, kkt->faces, kkt->bending_count,
-	                            kkt->bending_vertices, kkt->bending_stride, kkt->bending_size, kkt->constraint_count,
-	                            kkt->constraint_vertices, count, vertices, err);
+	plume_status status =
+	    build(&rebuilt, kkt->vertex_count, kkt->face_count, kkt->faces, kkt->bending_count, kkt->bending_vertices,
+	          kkt->bending_stride, kkt->bending_size, kkt->edge_count, kkt->edge_vertices, kkt->constraint_count,
+	          kkt->constraint_vertices, count, vertices, err);
 	if (status != PLUME_OK)
 		return status;
 	plume_kkt_free(kkt);
@@ -168,9 +187,11 @@ void plume_kkt_free(plume_kkt *kkt)
 	plume_free(kkt->position_slots);
 	plume_free(kkt->augment_slots);
 	plume_free(kkt->rho);
+	plume_free(kkt->diagonal_slots);
 	plume_free(kkt->vertex_slots);
 	plume_free(kkt->face_slots);
 	plume_free(kkt->bending_slots);
+	plume_free(kkt->edge_slots);
 	plume_free(kkt->constraint_slots);
 	plume_free(kkt->pair_slots);
 	plume_free(kkt->refine);
@@ -189,20 +210,16 @@ static double mean_position_diagonal(const plume_kkt *kkt)
 {
 	const double *values = kkt->system.matrix->x;
 	double sum = 0;
-	int vertex_count = kkt->dof_count / 3;
-	for (int v = 0; v < vertex_count; ++v)
-		for (int d = 0; d < 3; ++d)
-			sum += fabs(values[kkt->vertex_slots[9 * v + 4 * d]]);
+	for (int i = 0; i < kkt->dof_count; ++i)
+		sum += fabs(values[kkt->diagonal_slots[i]]);
 	return kkt->dof_count > 0 ? sum / kkt->dof_count : 1;
 }
 
 static void shift_positions(plume_kkt *kkt, double amount)
 {
 	double *values = kkt->system.matrix->x;
-	int vertex_count = kkt->dof_count / 3;
-	for (int v = 0; v < vertex_count; ++v)
-		for (int d = 0; d < 3; ++d)
-			values[kkt->vertex_slots[9 * v + 4 * d]] += amount;
+	for (int i = 0; i < kkt->dof_count; ++i)
+		values[kkt->diagonal_slots[i]] += amount;
 }
 
 /// rho_k over the largest diagonal entry of H at the constraint's free unknowns: large
@@ -228,14 +245,13 @@ static void load_positions(plume_kkt *kkt)
 		for (int a = 0; a < 6; ++a) {
 			c[a] = stored[kkt->constraint_slots[6 * k + a]];
 			if (c[a] != 0)
-				diagonal = fmax(diagonal, fabs(stored[kkt->vertex_slots[9 * vertices[a / 3] + 4 * (a % 3)]]));
+				diagonal = fmax(diagonal, fabs(stored[kkt->diagonal_slots[3 * vertices[a / 3] + a % 3]]));
 		}
 		double rho = kkt->rho[k] = AUGMENTATION * (diagonal > 0 ? diagonal : 1);
-		const int *slots = kkt->augment_slots + 36 * k;
+		const int *slots = kkt->augment_slots + 21 * k;
 		for (int a = 0; a < 6; ++a)
-			for (int b = 0; b < 6; ++b)
-				if (slots[6 * a + b] >= 0)
-					values[slots[6 * a + b]] += rho * c[a] * c[b];
+			for (int b = a; b < 6; ++b, ++slots)
+				values[*slots] += rho * c[a] * c[b];
 	}
 }
 
@@ -271,9 +287,12 @@ plume_status plume_kkt_factor(plume_kkt *kkt, bool allow_shift, double *shift, p
 	                       kkt->positions.common.status);
 }
 
-/// [dx; lambda] = M^-1 [r1; r2] for the regularised matrix M = [H C^T; C -R^-1]:
-/// (H + C^T R C) dx = r1 + C^T R r2, lambda = R (C dx - r2).
-static plume_status solve_regularised(plume_kkt *kkt, const double *rhs, double *solution, plume_error *err)
+/// [dx; lambda] = [0; g] + M^-1 ([r1; r2] - K [0; g]) for the regularised matrix
+/// M = [H C^T; C -R^-1], starting from the multipliers' guess g (NULL: 0):
+/// (H + C^T R C) dx = r1 + C^T (R r2 - g), lambda = g + R (C dx - r2). Its residual
+/// against K is [0; (g - lambda) / rho]: the better the guess, the fewer refinement steps.
+static plume_status solve_regularised(plume_kkt *kkt, const double *rhs, const double *guess, double *solution,
+                                      plume_error *err)
 {
 	plume_sparse *positions = &kkt->positions;
 	const double *stored = kkt->system.matrix->x;
@@ -281,7 +300,7 @@ static plume_status solve_regularised(plume_kkt *kkt, const double *rhs, double 
 	double *b = positions->rhs->x;
 	memcpy(b, rhs, sizeof(double) * (size_t)n);
 	for (int k = 0; k < kkt->constraint_count; ++k) {
-		double weight = kkt->rho[k] * rhs[n + k];
+		double weight = kkt->rho[k] * rhs[n + k] - (guess != NULL ? guess[k] : 0);
 		for (int a = 0; a < 6; ++a)
 			b[3 * kkt->constraint_vertices[2 * k + a / 3] + a % 3] += weight * stored[kkt->constraint_slots[6 * k + a]];
 	}
@@ -293,7 +312,7 @@ static plume_status solve_regularised(plume_kkt *kkt, const double *rhs, double 
 		double cdx = 0;
 		for (int a = 0; a < 6; ++a)
 			cdx += stored[kkt->constraint_slots[6 * k + a]] * dx[3 * kkt->constraint_vertices[2 * k + a / 3] + a % 3];
-		solution[n + k] = kkt->rho[k] * (cdx - rhs[n + k]);
+		solution[n + k] = (guess != NULL ? guess[k] : 0) + kkt->rho[k] * (cdx - rhs[n + k]);
 	}
 	return PLUME_OK;
 }
@@ -306,8 +325,12 @@ static const double REFINEMENT_TOLERANCE = 1e-14;
 /// residual = rhs - K x and the componentwise backward error
 /// max_i |residual_i| / (|K| |x| + |rhs|)_i (Arioli, Demmel & Duff 1989): the relative
 /// change of K's entries and of rhs that makes x exact. Rows whose denominator is zero
-/// (held unknowns, zero rows) do not count.
-static double backward_error(const plume_kkt *kkt, const double *rhs, const double *x, double *residual, double *scale)
+/// (held unknowns, zero rows) do not count. K's upper triangle gives each column's entries
+/// to two rows: the other rows' terms are scattered, the column's own row's are summed in
+/// registers and added once (adding into memory on every entry chains each addition to
+/// the store before it, which made this product cost more than a solve).
+static double backward_error(const plume_kkt *kkt, const double *rhs, const double *x, double *restrict residual,
+                             double *restrict scale)
 {
 	const cholmod_sparse *stored = kkt->system.matrix;
 	const int *p = stored->p, *rows = stored->i;
@@ -317,16 +340,22 @@ static double backward_error(const plume_kkt *kkt, const double *rhs, const doub
 		residual[i] = rhs[i];
 		scale[i] = fabs(rhs[i]);
 	}
-	for (size_t j = 0; j < size; ++j)
+	for (size_t j = 0; j < size; ++j) {
+		double xj = x[j], row_residual = 0, row_scale = 0;
 		for (int e = p[j]; e < p[j + 1]; ++e) {
 			size_t i = (size_t)rows[e];
-			residual[i] -= values[e] * x[j];
-			scale[i] += fabs(values[e] * x[j]);
+			double upper = values[e] * xj;
+			residual[i] -= upper;
+			scale[i] += fabs(upper);
 			if (i != j) {
-				residual[j] -= values[e] * x[i];
-				scale[j] += fabs(values[e] * x[i]);
+				double lower = values[e] * x[i];
+				row_residual += lower;
+				row_scale += fabs(lower);
 			}
 		}
+		residual[j] -= row_residual;
+		scale[j] += row_scale;
+	}
 	double worst = 0;
 	for (size_t i = 0; i < size; ++i)
 		if (scale[i] > 0)
@@ -334,9 +363,10 @@ static double backward_error(const plume_kkt *kkt, const double *rhs, const doub
 	return worst;
 }
 
-plume_status plume_kkt_solve(plume_kkt *kkt, const double *rhs, double *solution, plume_error *err)
+plume_status plume_kkt_solve(plume_kkt *kkt, const double *rhs, const double *multipliers, double *solution,
+                             plume_error *err)
 {
-	plume_status status = solve_regularised(kkt, rhs, solution, err);
+	plume_status status = solve_regularised(kkt, rhs, multipliers, solution, err);
 	if (status != PLUME_OK || kkt->constraint_count == 0)
 		return status;
 	size_t size = kkt->system.matrix->ncol;
@@ -349,7 +379,7 @@ plume_status plume_kkt_solve(plume_kkt *kkt, const double *rhs, double *solution
 		if (step == REFINEMENT_STEPS || error <= REFINEMENT_TOLERANCE || !(error < 0.5 * previous))
 			break;
 		previous = error;
-		if ((status = solve_regularised(kkt, residual, correction, err)) != PLUME_OK)
+		if ((status = solve_regularised(kkt, residual, NULL, correction, err)) != PLUME_OK)
 			return status;
 		for (size_t i = 0; i < size; ++i)
 			solution[i] += correction[i];

@@ -15,7 +15,8 @@
 // Optimization, 2nd ed., theorem 17.5), and then factored by Cholesky, supernodal where
 // it pays (sim/sparse.h). Iterative refinement against K itself removes the
 // regularisation's error (each step shrinks it by about 1/(1 + rho_k s_k), s_k the
-// constraint's compliance). This replaced a simplicial LDL' of the quasi-definite K
+// constraint's compliance); a guess of the multipliers (the last iterate's) starts it
+// closer. This replaced a simplicial LDL' of the quasi-definite K
 // (Vanderbei 1995), which CHOLMOD cannot factor supernodally: docs/simulation.md,
 // "Linear algebra", measures both. Without constraints the matrix is H alone.
 // The pattern is fixed per mesh, the symbolic analysis runs once, except when contact
@@ -35,31 +36,39 @@ typedef struct plume_kkt {
 	/// H + C^T R C over the position unknowns, factored.
 	plume_sparse positions;
 	int *position_slots; ///< per stored entry of K's position block (they come first), its slot in positions
-	int *augment_slots;  ///< 36 per constraint: positions' slots of its two vertices' 6x6 block
+	int *augment_slots;  ///< 21 per constraint: positions' slots of its two vertices' 6x6 block (upper)
 	double *rho;         ///< per constraint, the regularisation's rho_k of the last factorisation
 	int dof_count;
 	int constraint_count;
-	/// Slot of the entry for each element block pair (upper part), -1 for the lower part.
-	int *face_slots;       ///< 81 per face
-	int *bending_slots;    ///< (3 k)^2 per bending element of k vertices
+	/// Slots of each element block's upper triangle in the element's order, the pairs
+	/// (a, b) with a <= b row by row (plume_kkt_upper_size); -1 where a vertex is absent.
+	int *face_slots;       ///< 45 per face
+	int *bending_slots;    ///< plume_kkt_upper_size(k) per bending element of k vertices
+	int *edge_slots;       ///< 78 per shared edge (4 vertices)
 	int bending_size;      ///< k: 4 (hinge) or 6 (fundamental-form face)
-	int *vertex_slots;     ///< 9 per vertex
+	int *vertex_slots;     ///< 6 per vertex
+	int *diagonal_slots;   ///< 1 per position unknown: its diagonal entry
 	int *constraint_slots; ///< 6 per constraint: its row of C
-	int *pair_slots;       ///< 36 per constraint: the 6x6 position block of its two vertices
+	int *pair_slots;       ///< 21 per constraint: the 6x6 position block of its two vertices
 	double *refine;        ///< scratch for iterative refinement (3 x size)
 	/// plume_kkt_init's arguments (the caller keeps the arrays alive), for plume_kkt_set_extra_blocks.
-	int vertex_count, face_count, bending_count, bending_stride;
-	const int *faces, *bending_vertices, *constraint_vertices;
+	int vertex_count, face_count, bending_count, bending_stride, edge_count;
+	const int *faces, *bending_vertices, *edge_vertices, *constraint_vertices;
 	/// 4-vertex blocks beyond the mesh's (contact pairs) in the current pattern.
 	int extra_count;
 } plume_kkt;
 
+/// The number of pairs a <= b of an element of k vertices (3 k unknowns): its upper slots.
+static inline int plume_kkt_upper_size(int k) { return 3 * k * (3 * k + 1) / 2; }
+
 /// Builds the pattern from faces (3 vertices), bending elements (bending_size vertices
-/// each, bending_stride bytes apart; a negative vertex is absent), per-vertex blocks and
-/// constraints (2 vertices each), and runs the symbolic analysis.
+/// each, bending_stride bytes apart; a negative vertex is absent), the fundamental-form
+/// faces' shared edges (4 vertices each, blocks of the faces' own: slots only), per-vertex
+/// blocks and constraints (2 vertices each), and runs the symbolic analysis.
 plume_status plume_kkt_init(plume_kkt *kkt, int vertex_count, int face_count, const int *faces, int bending_count,
-                            const int *bending_vertices, int bending_stride, int bending_size, int constraint_count,
-                            const int *constraint_vertices, plume_error *err);
+                            const int *bending_vertices, int bending_stride, int bending_size, int edge_count,
+                            const int *edge_vertices, int constraint_count, const int *constraint_vertices,
+                            plume_error *err);
 void plume_kkt_free(plume_kkt *kkt);
 
 /// Rebuilds the pattern (and its symbolic analysis) with count extra blocks of 4 vertices
@@ -84,8 +93,11 @@ plume_status plume_kkt_factor(plume_kkt *kkt, bool allow_shift, double *shift, p
 /// Solves K [dx; lambda] = rhs with the last factorisation: rhs and solution have
 /// dof_count + constraint_count entries. With constraints, iterative refinement against
 /// K: a step only while the componentwise backward error is above 1e-14 and falling, at
-/// most 8, so the linearised constraints hold to rounding.
-plume_status plume_kkt_solve(plume_kkt *kkt, const double *rhs, double *solution, plume_error *err);
+/// most 8, so the linearised constraints hold to rounding. multipliers (constraint_count
+/// entries, or NULL for 0) is a guess of the solution's lambda for the regularised solve
+/// to start from: the first residual is the guess's error over rho.
+plume_status plume_kkt_solve(plume_kkt *kkt, const double *rhs, const double *multipliers, double *solution,
+                             plume_error *err);
 
 /// y += K x for the assembled (symmetric) matrix.
 void plume_kkt_multiply_add(const plume_kkt *kkt, const double *x, double *y);

@@ -113,12 +113,12 @@ static double add_constraints(plume_sim *sim, const plume_vec3 *x, double *gradi
 					double p = ((a % 3) == (b % 3) ? 1 : 0) - tv[a % 3] * tv[b % 3];
 					block[6 * a + b] = ((a < 3) == (b < 3) ? 1 : -1) * sim->lambda[k] * p / l;
 				}
-			const int *pair = sim->kkt.pair_slots + 36 * k;
+			const int *pair = sim->kkt.pair_slots + 21 * k; // upper triangle (kkt.h)
 			for (int a = 0; a < 6; ++a)
-				for (int b = 0; b < 6; ++b) {
+				for (int b = a; b < 6; ++b, ++pair) {
 					int ra = 3 * vertices[a / 3] + a % 3, rb = 3 * vertices[b / 3] + b % 3;
-					if (pair[6 * a + b] >= 0 && !sim->fixed[ra] && !sim->fixed[rb])
-						values[pair[6 * a + b]] += block[6 * a + b];
+					if (!sim->fixed[ra] && !sim->fixed[rb])
+						values[*pair] += block[6 * a + b];
 				}
 		}
 	}
@@ -224,7 +224,7 @@ static plume_status factor_and_solve(plume_sim *sim, bool exact, plume_solve_rep
 	if (status != PLUME_OK)
 		return status;
 	t0 = omp_get_wtime();
-	status = plume_kkt_solve(&sim->kkt, sim->rhs, sim->step, err);
+	status = plume_kkt_solve(&sim->kkt, sim->rhs, sim->lambda, sim->step, err);
 	report->seconds_solve += omp_get_wtime() - t0;
 	return status;
 }
@@ -373,7 +373,7 @@ static plume_status newton(plume_sim *sim, const sim_problem *problem, plume_sol
 					correction_rhs[n3 + k] =
 					    constraint_held(sim, k) ? 0 : -constraint_value(sim, sim->trial, k, NULL, NULL);
 				double *correction = g; // the gradient is not needed again this iteration
-				if (plume_kkt_solve(&sim->kkt, correction_rhs, correction, err) == PLUME_OK) {
+				if (plume_kkt_solve(&sim->kkt, correction_rhs, NULL, correction, err) == PLUME_OK) {
 					apply_step(sim, sim->trial, correction, 1, sim->scratch);
 					// The corrected point must be reached without passing through anything, too;
 					// it leaves the segment, so the evaluations from here on query again.

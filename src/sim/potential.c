@@ -110,26 +110,63 @@ static void evaluate_ff_faces(plume_sim *sim, const plume_vec3 *x, bool gradient
 	for (int e = 0; e < count; ++e) {
 		double *g = gradient ? sim->hinge_gradient + 18 * e : NULL;
 		double *h = hessian ? sim->hinge_hessian + 324 * e : NULL;
-		sim->hinge_energy[e] =
-		    plume_ff_face_energy_from_edges(sim->ff_faces + e, sim->ff_edge_chi, sim->ff_edge_gradient,
-		                                    angle_hessians ? sim->ff_edge_hessian : NULL, !project, g, h);
+		sim->hinge_energy[e] = plume_ff_face_energy_from_edges(
+		    sim->ff_faces + e, sim->ff_edge_chi, sim->ff_edge_gradient, g, h, sim->ff_face_weight + 3 * e);
 	}
 }
 
-/// Adds a symmetric element block into the matrix, skipping held unknowns.
+/// Every vertex of the element present and none of its unknowns held.
+static bool all_free(const plume_sim *sim, const int *vertices, int count)
+{
+	for (int k = 0; k < count; ++k) {
+		if (vertices[k] < 0)
+			return false;
+		const unsigned char *fixed = sim->fixed + 3 * vertices[k];
+		if (fixed[0] || fixed[1] || fixed[2])
+			return false;
+	}
+	return true;
+}
+
+/// Adds scale times a symmetric element block (n x n, n = 3 count) into the matrix through
+/// its upper slots (kkt.h), skipping held unknowns.
 static void scatter_block(const plume_sim *sim, double *values, const int *vertices, int count, const int *slots,
-                          const double *block)
+                          double scale, const double *block)
 {
 	int n = 3 * count;
-	for (int a = 0; a < n; ++a) {
+	if (all_free(sim, vertices, count)) {
+		// Most elements: no test per entry (the tests below were most of the scatter's time).
+		for (int a = 0; a < n; ++a)
+			for (int b = a; b < n; ++b)
+				values[*slots++] += scale * block[a * n + b];
+		return;
+	}
+	for (int a = 0; a < n; slots += n - a, ++a) {
 		if (vertices[a / 3] < 0 || sim->fixed[3 * vertices[a / 3] + a % 3])
 			continue;
-		for (int b = 0; b < n; ++b) {
-			int slot = slots[a * n + b]; // -1 for the lower part and absent vertices
+		for (int b = a; b < n; ++b) {
+			int slot = slots[b - a]; // -1 for absent vertices
 			if (slot >= 0 && !sim->fixed[3 * vertices[b / 3] + b % 3])
-				values[slot] += block[a * n + b];
+				values[slot] += scale * block[a * n + b];
 		}
 	}
+}
+
+/// The exact fundamental-form Hessian's angle curvature: each shared edge's angle Hessian
+/// once, times the sum of its two faces' weights (fundamental_form.h, Shared edges),
+/// summed in face order so that the bits do not depend on the thread count.
+static void scatter_angle_curvature(plume_sim *sim, double *values)
+{
+	double *weight = sim->ff_edge_weight;
+	memset(weight, 0, sizeof(double) * (size_t)sim->ff_edge_count);
+	for (int f = 0; f < sim->ff_count; ++f)
+		for (int i = 0; i < 3; ++i)
+			if (sim->ff_faces[f].edge[i] >= 0)
+				weight[sim->ff_faces[f].edge[i]] += sim->ff_face_weight[3 * f + i];
+	for (int e = 0; e < sim->ff_edge_count; ++e)
+		if (weight[e] != 0)
+			scatter_block(sim, values, sim->ff_edge_vertices + 4 * e, 4, sim->kkt.edge_slots + 78 * (size_t)e,
+			              weight[e], sim->ff_edge_hessian + 144 * (size_t)e);
 }
 
 static void scatter_gradient(double *gradient, const int *vertices, int count, const double *local)
@@ -170,9 +207,9 @@ double plume_sim_potential(plume_sim *sim, const sim_problem *problem, const plu
 		if (want_gradient)
 			scatter_gradient(gradient, vertices, 3, sim->face_gradient + 9 * f);
 		if (hessian)
-			scatter_block(sim, values, vertices, 3, sim->kkt.face_slots + 81 * f, sim->face_hessian + 81 * f);
+			scatter_block(sim, values, vertices, 3, sim->kkt.face_slots + 45 * f, 1, sim->face_hessian + 81 * f);
 	}
-	int size = plume_sim_bending_size(sim), dofs = 3 * size;
+	int size = plume_sim_bending_size(sim), dofs = 3 * size, upper = plume_kkt_upper_size(size);
 	for (int e = 0; sim->def.bending && e < plume_sim_bending_count(sim); ++e) {
 		energy += sim->hinge_energy[e];
 		const int *vertices = plume_sim_bending_vertices(sim, e);
@@ -180,8 +217,11 @@ double plume_sim_potential(plume_sim *sim, const sim_problem *problem, const plu
 		if (want_gradient)
 			scatter_gradient(gradient, vertices, size, sim->hinge_gradient + (size_t)dofs * e);
 		if (hessian)
-			scatter_block(sim, values, vertices, size, sim->kkt.bending_slots + block, sim->hinge_hessian + block);
+			scatter_block(sim, values, vertices, size, sim->kkt.bending_slots + (size_t)upper * e, 1,
+			              sim->hinge_hessian + block);
 	}
+	if (hessian && !project && sim->def.bending && sim->def.bending_model != PLUME_BENDING_PAPER_HINGE)
+		scatter_angle_curvature(sim, values);
 
 	plume_vec3 g = sim->def.gravity;
 	double inertia = problem->dynamic ? problem->inertia : 0;
@@ -217,7 +257,7 @@ double plume_sim_potential(plume_sim *sim, const sim_problem *problem, const plu
 			for (int a = 0; a < 3; ++a)
 				gradient[3 * i + a] += local_gradient[a];
 		if (hessian)
-			scatter_block(sim, values, &i, 1, sim->kkt.vertex_slots + 9 * i, block);
+			scatter_block(sim, values, &i, 1, sim->kkt.vertex_slots + 6 * i, 1, block);
 	}
 
 	if (contact && plume_contact_any(sim)) {
@@ -229,7 +269,7 @@ double plume_sim_potential(plume_sim *sim, const sim_problem *problem, const plu
 	if (hessian)
 		for (int i = 0; i < 3 * n; ++i)
 			if (sim->fixed[i])
-				values[sim->kkt.vertex_slots[9 * (i / 3) + 4 * (i % 3)]] = 1;
+				values[sim->kkt.diagonal_slots[i]] = 1;
 	return isfinite(energy) ? energy : NAN;
 }
 

@@ -332,7 +332,10 @@ static plume_status build_ff_faces(plume_sim *sim, const plume_mesh *mesh, const
 	sim->ff_edge_chi = plume_alloc(sizeof(double) * edges);
 	sim->ff_edge_gradient = plume_alloc(sizeof(double) * 12 * edges);
 	sim->ff_edge_hessian = plume_alloc(sizeof(double) * 144 * edges);
-	if (!sim->ff_edge_vertices || !sim->ff_edge_chi || !sim->ff_edge_gradient || !sim->ff_edge_hessian) {
+	sim->ff_face_weight = plume_alloc(sizeof(double) * 3 * (size_t)(faces > 0 ? faces : 1));
+	sim->ff_edge_weight = plume_alloc(sizeof(double) * edges);
+	if (!sim->ff_edge_vertices || !sim->ff_edge_chi || !sim->ff_edge_gradient || !sim->ff_edge_hessian ||
+	    !sim->ff_face_weight || !sim->ff_edge_weight) {
 		plume_free(across);
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory building the bending elements");
 	}
@@ -540,7 +543,8 @@ plume_status plume_sim_create(const plume_mesh *mesh, const plume_sim_def *def, 
 	if (status == PLUME_OK)
 		status = plume_kkt_init(&sim->kkt, sim->vertex_count, sim->face_count, sim->faces,
 		                        def->bending ? plume_sim_bending_count(sim) : 0, plume_sim_bending_vertices(sim, 0),
-		                        plume_sim_bending_stride(sim), plume_sim_bending_size(sim), sim->constraint_count,
+		                        plume_sim_bending_stride(sim), plume_sim_bending_size(sim),
+		                        def->bending ? sim->ff_edge_count : 0, sim->ff_edge_vertices, sim->constraint_count,
 		                        sim->constraint_vertices, err);
 	if (status != PLUME_OK) {
 		plume_sim_destroy(sim);
@@ -575,6 +579,8 @@ void plume_sim_destroy(plume_sim *sim)
 	                  sim->ff_edge_chi,
 	                  sim->ff_edge_gradient,
 	                  sim->ff_edge_hessian,
+	                  sim->ff_face_weight,
+	                  sim->ff_edge_weight,
 	                  sim->constraint_vertices,
 	                  sim->constraint_length,
 	                  sim->lambda,

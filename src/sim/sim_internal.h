@@ -68,12 +68,15 @@ struct plume_sim {
 	plume_ff_face *ff_faces;
 	/// The interior edges the fundamental-form faces share (fundamental_form.h, Shared
 	/// edges): a hinge stencil each (4 vertices), and per evaluation its angle, gradient (12)
-	/// and Hessian (144).
+	/// and Hessian (144), and the weight of that Hessian in the exact Hessian: each face's
+	/// share (3 per face) and their sum (1 per edge).
 	int ff_edge_count;
 	int *ff_edge_vertices;
 	double *ff_edge_chi;
 	double *ff_edge_gradient;
 	double *ff_edge_hessian;
+	double *ff_face_weight;
+	double *ff_edge_weight;
 
 	/// Barb-aligned edges held at their reference length (constraint rows).
 	int constraint_count;
