@@ -264,19 +264,19 @@ static const quality_row quality_rows[] = {
     {"franco-walter/blue.json", 5e-3, 20.0, 0},
     {"franco-walter/blue.json", 2.5e-3, 20.0, 0},
     {"franco-walter/figure6a.json", 5e-3, 20.0, 2},
-    {"franco-walter/figure6a.json", 2.5e-3, 12.89, 8},
+    {"franco-walter/figure6a.json", 2.5e-3, 20.0, 8},
     {"franco-walter/figure6b.json", 5e-3, 20.0, 1},
     {"franco-walter/figure6b.json", 2.5e-3, 20.0, 0},
     {"franco-walter/filoplume.json", 5e-3, 20.0, 1},
     {"franco-walter/filoplume.json", 2.5e-3, 16.36, 1},
     {"franco-walter/hawk.json", 5e-3, 20.0, 0},
     {"franco-walter/hawk.json", 2.5e-3, 19.06, 0},
-    {"franco-walter/peacock.json", 5e-3, 7.21, 2},
+    {"franco-walter/peacock.json", 5e-3, 8.17, 7},
     {"franco-walter/peacock.json", 2.5e-3, 3.39, 8},
     {"franco-walter/pigeon-primary.json", 5e-3, 20.0, 3},
-    {"franco-walter/pigeon-primary.json", 2.5e-3, 10.21, 7},
+    {"franco-walter/pigeon-primary.json", 2.5e-3, 20.0, 5},
     {"franco-walter/pigeon-secondary.json", 5e-3, 20.0, 0},
-    {"franco-walter/pigeon-secondary.json", 2.5e-3, 18.10, 2},
+    {"franco-walter/pigeon-secondary.json", 2.5e-3, 20.0, 3},
     {"streit-heidrich/bristle.json", 5e-3, 4.33, 0},
     {"streit-heidrich/bristle.json", 2.5e-3, 15.33, 0},
     {"streit-heidrich/continuum.json", 5e-3, 20.0, 0},
@@ -286,13 +286,13 @@ static const quality_row quality_rows[] = {
     {"streit-heidrich/down.json", 5e-3, 20.0, 1},
     {"streit-heidrich/down.json", 2.5e-3, 17.23, 0},
     {"streit-heidrich/filoplume.json", 5e-3, 20.0, 5},
-    {"streit-heidrich/filoplume.json", 2.5e-3, 5.17, 7},
-    {"streit-heidrich/flight.json", 5e-3, 16.59, 19},
-    {"streit-heidrich/flight.json", 2.5e-3, 17.91, 44},
-    {"streit-heidrich/peacock.json", 5e-3, 3.57, 53},
-    {"streit-heidrich/peacock.json", 2.5e-3, 0.19, 104},
+    {"streit-heidrich/filoplume.json", 2.5e-3, 5.64, 7},
+    {"streit-heidrich/flight.json", 5e-3, 20.0, 29},
+    {"streit-heidrich/flight.json", 2.5e-3, 20.0, 68},
+    {"streit-heidrich/peacock.json", 5e-3, 5.93, 78},
+    {"streit-heidrich/peacock.json", 2.5e-3, 0.23, 149},
     {"streit-heidrich/semiplume.json", 5e-3, 19.60, 4},
-    {"streit-heidrich/semiplume.json", 2.5e-3, 8.31, 6},
+    {"streit-heidrich/semiplume.json", 2.5e-3, 8.31, 9},
     {"zhang-kanai/figure10-asymmetry-020.json", 5e-3, 20.0, 0},
     {"zhang-kanai/figure10-asymmetry-020.json", 2.5e-3, 20.0, 0},
     {"zhang-kanai/figure10-asymmetry-040.json", 5e-3, 20.0, 0},
@@ -355,11 +355,10 @@ static void test_example_quality(void **state)
 	}
 	print_message("%d of %d example meshes reach %.0f degrees outside junction faces\n", meeting,
 	              (int)(sizeof quality_rows / sizeof quality_rows[0]), PLUME_MESH_QUALITY_ANGLE_DEG);
-	// 39 built by GCC, 36 by Clang: the Streit-Heidrich generator's growth turns last-bit
-	// differences between the two compilers into different feathers (different face counts),
-	// and three of its meshes sit near 20 degrees (down and continuum at 2.5 mm, semiplume at
-	// 5 mm). The rows above hold the lower floor of the two builds.
-	assert_true(meeting >= 36);
+	// 44 built by GCC and by Clang (39 and 36 before root-phased steps): the Streit-Heidrich
+	// generator's growth turns last-bit differences between the two compilers into different
+	// feathers (different face counts). The rows above hold the lower floor of the two builds.
+	assert_true(meeting >= 44);
 	assert_int_equal(plume_bytes_in_use(), before);
 }
 

@@ -40,6 +40,10 @@
 
 static const double pi = 3.14159265358979323846;
 
+/// root_phase_step
+static const double ROOT_PHASE_MAX_DEG = 22.0, ROOT_PHASE_MARGIN = 0.8;
+enum { ROOT_PHASE_MAX_K = 1 };
+
 /// Meshes bigger than this are refused (an edge length far too small).
 enum { MESH_MAX_VERTICES = 20000000 };
 
@@ -93,6 +97,10 @@ typedef struct mesher {
 	mesh_box *boxes;   ///< the pool's box tree (build_index), 2 * leaf_count nodes
 	int leaf_count;    ///< a power of two, at least the number of buckets
 	double max_memory; ///< bytes (plume_mesh_def.max_memory)
+	/// The second try where the first falls short of the quality bound (mesh_run):
+	/// guides rooted close get root-phased steps (root_phase_step) and sliding
+	/// leaves junction angles out of what it raises.
+	bool phased;
 	plume_error *err;
 } mesher;
 
@@ -335,9 +343,61 @@ typedef struct mesh_trace {
 	plume_vec2 uv[MESH_GUIDE_SAMPLES + 1];
 	int count;    ///< points in p and uv
 	double total; ///< plane arc length, m
-	double steps; ///< vertices after the root, one about every e (0: no guide); may be huge
+	double step;  ///< spacing of its vertices: e, or less where the next guide is rooted close (root_phase_step)
+	double steps; ///< vertices after the root, one about every step (0: no guide); may be huge
 } mesh_trace;
 
+/// Arc length along a trace (from its root) of the point nearest p, the first
+/// nearest on ties; *distance (may be NULL) gets how far p is from it.
+static double trace_project(const mesh_trace *trace, plume_vec3 p, double *distance)
+{
+	double best = INFINITY, where = 0.0, start = 0.0;
+	for (int k = 0; k + 1 < trace->count; ++k) {
+		plume_vec3 a = trace->p[k], b = trace->p[k + 1];
+		double dx = b.x - a.x, dy = b.y - a.y, length2 = dx * dx + dy * dy, length = sqrt(length2);
+		double u = length2 > 0.0 ? ((p.x - a.x) * dx + (p.y - a.y) * dy) / length2 : 0.0;
+		u = u < 0.0 ? 0.0 : u > 1.0 ? 1.0 : u;
+		double x = a.x + u * dx - p.x, y = a.y + u * dy - p.y, d2 = x * x + y * y;
+		if (d2 < best) {
+			best = d2;
+			where = start + u * length;
+		}
+		start += length;
+	}
+	if (distance != NULL)
+		*distance = sqrt(best);
+	return where;
+}
+
+/// The spacing of a guide's vertices: e, or a shorter step where the next
+/// guide on the side is rooted close to it. Barbs at an angle theta to the
+/// rachis, rooted e apart along it, lie h = e sin(theta) apart, and the next
+/// guide's root lies c = e cos(theta) along this one. Staggered guides
+/// (stagger_positions) zigzag: each vertex midway between two of the other
+/// guide's. Between two guides whose roots are c apart that holds from the root
+/// on only when c is an odd multiple of half the step, step = 2 c / (2 k + 1):
+/// with steps about e (c is about e), the first faces off the rachis had angles
+/// near theta (Streit-Heidrich flight, theta 18-20 degrees: 17.9 at 2.5 mm).
+/// k = 0 (step 2 c) gives faces of base angles atan(h / c) = theta too, so k
+/// is the least from 1 on that keeps the zigzag's base angles, atan(2 h /
+/// step), at ROOT_PHASE_MARGIN times the tangent of the quality bound; the face
+/// on the rachis edge then has angles theta (a junction angle), 180 -
+/// atan((2 k + 1) tan(theta)) and atan((2 k + 1) tan(theta)) - theta. Guides
+/// at ROOT_PHASE_MAX_DEG or more to the rachis keep e.
+static double root_phase_step(const mesher *m, int side, int r, const mesh_trace *trace)
+{
+	const mesh_input *in = m->input;
+	if (!m->phased || r + 1 >= m->row_count || m->rows[r + 1].sigma > in->sigma_last[side] + 0.5 * m->e)
+		return m->e;
+	double h, c = trace_project(trace, rachis_point(m->rows + r + 1, side), &h);
+	if (!(c > 0.0) || !(h < tan(ROOT_PHASE_MAX_DEG * pi / 180.0) * c))
+		return m->e;
+	double half = ROOT_PHASE_MARGIN * h / tan(PLUME_MESH_QUALITY_ANGLE_DEG * pi / 180.0);
+	int k = 1;
+	while (k < ROOT_PHASE_MAX_K && c / (2 * k + 1) > half)
+		++k;
+	return 2.0 * c / (2 * k + 1);
+}
 /// Traces the guide through a row's rachis vertex on one side. Returns false
 /// when the row has no guide there (trace->steps is 0 then too).
 static bool trace_line(const mesher *m, int side, int r, mesh_trace *trace)
@@ -401,30 +461,9 @@ static bool trace_line(const mesher *m, int side, int r, mesh_trace *trace)
 		total += sqrt(dist2(p[k], p[k + 1]));
 	trace->count = count;
 	trace->total = total;
-	trace->steps = total > 1e-6 * m->e ? fmax(1.0, round(total / m->e)) : 0.0;
+	trace->step = root_phase_step(m, side, r, trace);
+	trace->steps = total > 1e-6 * m->e ? fmax(1.0, round(total / trace->step)) : 0.0;
 	return true;
-}
-
-/// Arc length along a trace (from its root) of the point nearest p, the first
-/// nearest on ties; *distance (may be NULL) gets how far p is from it.
-static double trace_project(const mesh_trace *trace, plume_vec3 p, double *distance)
-{
-	double best = INFINITY, where = 0.0, start = 0.0;
-	for (int k = 0; k + 1 < trace->count; ++k) {
-		plume_vec3 a = trace->p[k], b = trace->p[k + 1];
-		double dx = b.x - a.x, dy = b.y - a.y, length2 = dx * dx + dy * dy, length = sqrt(length2);
-		double u = length2 > 0.0 ? ((p.x - a.x) * dx + (p.y - a.y) * dy) / length2 : 0.0;
-		u = u < 0.0 ? 0.0 : u > 1.0 ? 1.0 : u;
-		double x = a.x + u * dx - p.x, y = a.y + u * dy - p.y, d2 = x * x + y * y;
-		if (d2 < best) {
-			best = d2;
-			where = start + u * length;
-		}
-		start += length;
-	}
-	if (distance != NULL)
-		*distance = sqrt(best);
-	return where;
 }
 
 /// Appends steps equal steps from the last position to `to`.
@@ -459,7 +498,7 @@ static int stagger_positions(const mesher *m, const mesh_trace *trace, const mes
 {
 	if (below == NULL || !below->present || below->count < 2)
 		return 0;
-	double e = m->e, total = trace->total;
+	double e = m->e, step = trace->step, total = trace->total;
 	const plume_vec3 *nodes = m->points + below->first;
 	// Guides at least 0.6 e apart on average keep the even placement: their
 	// near-right triangles are no slivers (measured on the example feathers:
@@ -479,16 +518,16 @@ static int stagger_positions(const mesher *m, const mesh_trace *trace, const mes
 	for (int i = 0; i + 1 < below->count; ++i) {
 		double q = trace_project(trace, plume_v3_lerp(nodes[i], nodes[i + 1], 0.5), NULL);
 		double last = positions[count - 1];
-		if (q >= total - 0.5 * e)
+		if (q >= total - 0.5 * step)
 			break;
-		if (q - last < (count == 1 ? 0.75 * e : 0.5 * e))
+		if (q - last < (count == 1 && step == e ? 0.75 * e : 0.5 * step))
 			continue;
-		int steps = (int)fmax(1.0, round((q - last) / e));
+		int steps = (int)fmax(1.0, round((q - last) / step));
 		if (count + steps + 1 > capacity)
 			return 0;
 		count = fill_positions(positions, count, q, steps);
 	}
-	int steps = (int)fmax(1.0, round((total - positions[count - 1]) / e));
+	int steps = (int)fmax(1.0, round((total - positions[count - 1]) / step));
 	if (count + steps > capacity)
 		return 0;
 	return fill_positions(positions, count, total, steps);
@@ -515,8 +554,13 @@ static bool build_line(mesher *m, int side, int r)
 	if (positions == NULL)
 		return false;
 	const mesh_line *below = r > 0 ? m->lines + line_index(m, side, r - 1) : NULL;
-	int placed = stagger_positions(m, &trace, below, positions, capacity);
-	if (placed == 0) {
+	int placed = trace.step < m->e ? 0 : stagger_positions(m, &trace, below, positions, capacity);
+	if (placed == 0 && trace.step < m->e) {
+		positions[0] = 0.0;
+		for (placed = 1; placed < (int)trace.steps; ++placed)
+			positions[placed] = placed * trace.step;
+		positions[placed++] = total;
+	} else if (placed == 0) {
 		positions[0] = 0.0;
 		placed = fill_positions(positions, 1, total, (int)trace.steps);
 	}
@@ -1316,9 +1360,11 @@ static int join_short_guides(mesher *m)
 // ---------------------------------------------------------------------------
 // Sliding along the guides
 
-/// Smallest angle of vane face f with vertex v at p (reference plane), or -1
-/// when the face would be inverted or degenerate.
-static double moved_face_quality(const plume_mesh *mesh, int f, int v, plume_vec2 p, double tolerance)
+/// Smallest angle of vane face f with vertex v at p (reference plane) but its
+/// junction corners (mesh_junction_corners: set bits of junction), or -1 when the
+/// face would be inverted or degenerate.
+static double moved_face_quality(const plume_mesh *mesh, int f, int v, plume_vec2 p, unsigned junction,
+                                 double tolerance)
 {
 	plume_vec2 q[3];
 	for (int k = 0; k < 3; ++k) {
@@ -1328,7 +1374,13 @@ static double moved_face_quality(const plume_mesh *mesh, int f, int v, plume_vec
 	double area2 = (q[1].x - q[0].x) * (q[2].y - q[0].y) - (q[1].y - q[0].y) * (q[2].x - q[0].x);
 	if (!(area2 > tolerance))
 		return -1.0;
-	return smallest_corner(q);
+	double best = pi;
+	for (int k = 0; k < 3; ++k) {
+		plume_vec2 o = q[k], x = q[(k + 1) % 3], y = q[(k + 2) % 3];
+		if (!(junction & (1u << k)))
+			best = fmin(best, angle_between(x.x - o.x, x.y - o.y, y.x - o.x, y.y - o.y));
+	}
+	return best;
 }
 
 /// The point at arc length a along a trace, and its texture coordinates.
@@ -1362,9 +1414,12 @@ static bool slide_vertices(const mesher *m, plume_mesh *mesh)
 	int n = mesh->vertex_count;
 	int *start = plume_calloc((size_t)n + 1, sizeof *start);
 	int *list = plume_alloc(3 * (size_t)(mesh->face_count > 0 ? mesh->face_count : 1) * sizeof *list);
-	if (start == NULL || list == NULL) {
+	unsigned char *junction = m->phased ? mesh_junction_corners(mesh)
+	                                    : plume_calloc((size_t)(mesh->face_count > 0 ? mesh->face_count : 1), 1);
+	if (start == NULL || list == NULL || junction == NULL) {
 		plume_free(start);
 		plume_free(list);
+		plume_free(junction);
 		return false;
 	}
 	for (int f = 0; f < mesh->face_count; ++f)
@@ -1406,7 +1461,7 @@ static bool slide_vertices(const mesher *m, plume_mesh *mesh)
 					       a_next = trace_project(&trace, after, NULL);
 					double quality = pi;
 					for (int j = start[v]; j < start[v + 1]; ++j)
-						quality = fmin(quality, moved_face_quality(mesh, list[j], v, mesh->reference[v], tolerance));
+						quality = fmin(quality, moved_face_quality(mesh, list[j], v, mesh->reference[v], junction[list[j]], tolerance));
 					if (quality >= bound)
 						continue; // only vertices of faces under the bound move
 					for (int sign = -1; sign <= 1; sign += 2) {
@@ -1418,7 +1473,7 @@ static bool slide_vertices(const mesher *m, plume_mesh *mesh)
 						double moved = pi;
 						for (int j = start[v]; j < start[v + 1] && moved > 0.0; ++j)
 							moved =
-							    fmin(moved, moved_face_quality(mesh, list[j], v, (plume_vec2){p.x, p.y}, tolerance));
+							    fmin(moved, moved_face_quality(mesh, list[j], v, (plume_vec2){p.x, p.y}, junction[list[j]], tolerance));
 						if (moved > quality + 1e-9) {
 							quality = moved;
 							a = candidate;
@@ -1432,6 +1487,7 @@ static bool slide_vertices(const mesher *m, plume_mesh *mesh)
 	}
 	plume_free(start);
 	plume_free(list);
+	plume_free(junction);
 	for (int f = 0; f < mesh->face_count; ++f) { // the barb edges' directions moved with them
 		int k = mesh->barb_edge[f];
 		if (mesh->material[f] != PLUME_MATERIAL_VANE || k < 0)
@@ -1952,13 +2008,14 @@ static void count_mesh(const mesher *m, plume_mesh_estimate *out)
 }
 
 /// Places the rows (refusing past the limit before allocating them) and counts the rest.
-static plume_status mesh_begin(mesher *m, const mesh_input *input, const plume_mesh_def *def,
+static plume_status mesh_begin(mesher *m, const mesh_input *input, const plume_mesh_def *def, bool phased,
                                plume_mesh_estimate *estimate, plume_error *err)
 {
 	*m = (mesher){.input = input,
 	              .e = def->edge_length,
 	              .include_calamus = def->include_calamus,
 	              .max_memory = (double)(def->max_memory > 0 ? def->max_memory : PLUME_DEFAULT_MAX_MEMORY),
+	              .phased = phased,
 	              .err = err};
 	plume_status status = place_rows(m);
 	if (status != PLUME_OK)
@@ -1978,12 +2035,12 @@ static void mesh_end(mesher *m)
 	plume_free(m->boxes);
 }
 
-static plume_status mesh_run(const mesh_input *input, const plume_mesh_def *def, plume_mesh **out,
+static plume_status mesh_try(const mesh_input *input, const plume_mesh_def *def, bool phased, plume_mesh **out,
                              plume_mesh_report *report, plume_error *err)
 {
 	mesher m;
 	plume_mesh_estimate estimate;
-	plume_status status = mesh_begin(&m, input, def, &estimate, err);
+	plume_status status = mesh_begin(&m, input, def, phased, &estimate, err);
 	if (status == PLUME_OK && !(estimate.bytes <= m.max_memory))
 		status = limit_error(&m, &estimate);
 	if (status == PLUME_OK) {
@@ -2009,11 +2066,43 @@ static plume_status mesh_run(const mesh_input *input, const plume_mesh_def *def,
 	return status;
 }
 
+/// Meshes the input; where the vane's smallest angle outside junction faces
+/// falls short of PLUME_MESH_QUALITY_ANGLE_DEG, meshes it again phased
+/// (mesher.phased) and keeps that mesh when its smallest angle is higher. Meshes
+/// that reach the bound are never meshed twice, so they stay as they were (the
+/// Figure 1 hawk at 5 mm, whose simulation tests/test_scene.c pins); a phased
+/// mesh that fails (over the memory limit, or overlapping faces) leaves the first.
+static plume_status mesh_run(const mesh_input *input, const plume_mesh_def *def, plume_mesh **out,
+                             plume_mesh_report *report, plume_error *err)
+{
+	plume_mesh_report first, second;
+	plume_status status = mesh_try(input, def, false, out, &first, err);
+	if (status == PLUME_OK && first.vane_min_angle < PLUME_MESH_QUALITY_ANGLE_DEG * pi / 180.0) {
+		plume_mesh *phased = NULL;
+		plume_error scratch = {0};
+		plume_status phased_status = mesh_try(input, def, true, &phased, &second, &scratch);
+		if (phased_status == PLUME_ERROR_MEMORY) {
+			plume_mesh_destroy(*out);
+			*out = NULL;
+			return plume_error_set(err, PLUME_ERROR_MEMORY, "%s", scratch.message);
+		}
+		if (phased_status == PLUME_OK && second.vane_min_angle > first.vane_min_angle) {
+			plume_mesh_destroy(*out);
+			*out = phased;
+			first = second;
+		} else
+			plume_mesh_destroy(phased);
+	}
+	if (status == PLUME_OK && report != NULL)
+		*report = first;
+	return status;
+}
+
 static plume_status mesh_estimate(const mesh_input *input, const plume_mesh_def *def, plume_mesh_estimate *out,
                                   plume_error *err)
 {
 	mesher m;
-	plume_status status = mesh_begin(&m, input, def, out, err);
+	plume_status status = mesh_begin(&m, input, def, false, out, err);
 	mesh_end(&m);
 	return status;
 }
