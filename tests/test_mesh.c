@@ -711,6 +711,54 @@ static double segment_distance(plume_vec2 p, plume_vec2 a, plume_vec2 b)
 	return hypot(a.x + t * dx - p.x, a.y + t * dy - p.y);
 }
 
+/// Barbs at a shallow angle to the rachis (docs/meshing.md, "Root-phased
+/// steps"): straight barbs at 15 degrees to a straight rachis, rows 4 mm
+/// apart, so each guide lies h = 4 sin 15 = 1.04 mm from the next and the
+/// next guide's root lies c = 4 cos 15 = 3.86 mm along it; the outline cuts
+/// the guides square. Steps of about e leave neighbouring guides' vertices
+/// nearly side by side at the rachis: 16.4 degrees there (measured before the
+/// root-phased try). Steps of 2 c / 3 put every vertex midway between two of
+/// the next guide's from the root on: zigzag faces of base angles
+/// atan(3 tan 15) = 38.8 degrees, and 38.8 - 15 = 23.8 degrees at the next
+/// root in the face on the rachis edge (its 15 degrees at the root is a
+/// junction angle), so the vane reaches 20 degrees.
+static void test_shallow_barbs_phased(void **state)
+{
+	(void)state;
+	int64_t before = plume_bytes_in_use();
+	const double theta = 15.0 * pi / 180.0, reach = 0.06;
+	plume_vec2 u = {sin(theta), cos(theta)}, n = {u.y, -u.x};
+	double t = (-0.001 - reach * u.x) / n.x; // where the square cut meets x = -1 mm
+	plume_vec2 boundary[3] = {{-0.001, -0.002},
+	                          {reach * u.x + 0.05 * n.x, reach * u.y + 0.05 * n.y},
+	                          {reach * u.x + t * n.x, reach * u.y + t * n.y}};
+	plume_vec2 rachis[2] = {{0.0, 0.0}, {0.0, 0.1}};
+	plume_vec2 points[4] = {{0.0, 0.0}, {0.2 * u.x, 0.2 * u.y}, {0.0, 0.1}, {0.2 * u.x, 0.1 + 0.2 * u.y}};
+	int offsets[3] = {0, 2, 4};
+	plume_mesh_guides guides = {.boundary_count = 3,
+	                            .boundary = boundary,
+	                            .rachis_count = 2,
+	                            .rachis = rachis,
+	                            .guide_count = 2,
+	                            .guide_offsets = offsets,
+	                            .guide_points = points};
+	plume_mesh_def def = plume_mesh_default_def();
+	def.edge_length = 0.004;
+	def.rachis_width_base = 0.002;
+	def.rachis_width_tip = 0.001;
+	plume_mesh *mesh = NULL;
+	plume_mesh_report report;
+	plume_error err;
+	if (plume_mesh_from_guides(&guides, &def, &mesh, &report, &err) != PLUME_OK)
+		fail_msg("%s", err.message);
+	assert_aligned_mesh(mesh, &report, def.edge_length);
+	print_message("vane min angle %.3f deg, %d junction faces\n", report.vane_min_angle * 180.0 / pi,
+	              report.excepted_count);
+	assert_true(report.vane_min_angle * 180.0 / pi >= PLUME_MESH_QUALITY_ANGLE_DEG);
+	plume_mesh_destroy(mesh);
+	assert_int_equal(plume_bytes_in_use(), before);
+}
+
 /// A guide that ends well before its neighbours (docs/meshing.md, "Joining
 /// short guides"): straight barbs at 30 degrees to a straight rachis, rows 4 mm
 /// apart (guides 2 mm apart), and a slot 0.6 mm wide cut into the outline
@@ -1075,6 +1123,7 @@ int main(void)
 	    cmocka_unit_test(test_short_vanes_and_no_barbs),
 	    cmocka_unit_test(test_explicit_guides),
 	    cmocka_unit_test(test_short_guide_joined),
+	    cmocka_unit_test(test_shallow_barbs_phased),
 	    cmocka_unit_test(test_guides_spec_errors),
 	    cmocka_unit_test(test_guides_spec_splines),
 	    cmocka_unit_test(test_tall_guides),
