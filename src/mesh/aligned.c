@@ -24,7 +24,9 @@
 // of faces under 25 degrees slide along their guides (slide_vertices), so that
 // vane faces keep their smallest angle at 20 degrees or more outside the
 // junctions where a guide meets the rachis or the outline at a shallow angle
-// (plume_mesh_measure).
+// (plume_mesh_measure). A mesh that falls short is built again with
+// root-phased steps on the guides rooted close to the next (root_phase_step),
+// and the better of the two is kept (mesh_run).
 //
 // A step that would make an inverted or degenerate triangle (two guides
 // touching) is never taken: both guides are cut there and every strip is
@@ -39,10 +41,6 @@
 #include "aligned_internal.h"
 
 static const double pi = 3.14159265358979323846;
-
-/// root_phase_step
-static const double ROOT_PHASE_MAX_DEG = 22.0, ROOT_PHASE_MARGIN = 0.8;
-enum { ROOT_PHASE_MAX_K = 1 };
 
 /// Meshes bigger than this are refused (an edge length far too small).
 enum { MESH_MAX_VERTICES = 20000000 };
@@ -369,21 +367,23 @@ static double trace_project(const mesh_trace *trace, plume_vec3 p, double *dista
 	return where;
 }
 
-/// The spacing of a guide's vertices: e, or a shorter step where the next
-/// guide on the side is rooted close to it. Barbs at an angle theta to the
-/// rachis, rooted e apart along it, lie h = e sin(theta) apart, and the next
-/// guide's root lies c = e cos(theta) along this one. Staggered guides
-/// (stagger_positions) zigzag: each vertex midway between two of the other
-/// guide's. Between two guides whose roots are c apart that holds from the root
-/// on only when c is an odd multiple of half the step, step = 2 c / (2 k + 1):
-/// with steps about e (c is about e), the first faces off the rachis had angles
-/// near theta (Streit-Heidrich flight, theta 18-20 degrees: 17.9 at 2.5 mm).
-/// k = 0 (step 2 c) gives faces of base angles atan(h / c) = theta too, so k
-/// is the least from 1 on that keeps the zigzag's base angles, atan(2 h /
-/// step), at ROOT_PHASE_MARGIN times the tangent of the quality bound; the face
-/// on the rachis edge then has angles theta (a junction angle), 180 -
-/// atan((2 k + 1) tan(theta)) and atan((2 k + 1) tan(theta)) - theta. Guides
-/// at ROOT_PHASE_MAX_DEG or more to the rachis keep e.
+/// Guides rooted at less than this to the rachis get root-phased steps (root_phase_step).
+enum { ROOT_PHASE_MAX_DEG = 22 };
+
+/// The spacing of a guide's vertices: e, or in the phased try (mesher.phased)
+/// 2 c / 3 where the next guide on the side is rooted close (docs/meshing.md,
+/// step 9). Barbs at theta to the rachis, rooted e apart along it, lie h = e
+/// sin(theta) apart, and the next guide's root lies c = e cos(theta) along
+/// this one. Two guides' vertices zigzag (each midway between two of the
+/// other's) from the root on only when c is an odd multiple of half the step,
+/// step = 2 c / (2 k + 1). Steps of about e (c is about e) meet side by side
+/// near the rachis: Streit-Heidrich flight, theta 18-20 degrees, had 100
+/// faces under 20 degrees there at 2.5 mm. k = 0 (step 2 c) makes faces of
+/// base angles atan(h / c) = theta, k = 2 fans the next root over two steps
+/// of this guide; k = 1 gives base angles atan(3 tan(theta)) and, in the
+/// face on the rachis edge, theta at the root (a junction angle) and
+/// atan(3 tan(theta)) - theta at the next root: 20 degrees down to theta =
+/// 12 degrees.
 static double root_phase_step(const mesher *m, int side, int r, const mesh_trace *trace)
 {
 	const mesh_input *in = m->input;
@@ -392,12 +392,9 @@ static double root_phase_step(const mesher *m, int side, int r, const mesh_trace
 	double h, c = trace_project(trace, rachis_point(m->rows + r + 1, side), &h);
 	if (!(c > 0.0) || !(h < tan(ROOT_PHASE_MAX_DEG * pi / 180.0) * c))
 		return m->e;
-	double half = ROOT_PHASE_MARGIN * h / tan(PLUME_MESH_QUALITY_ANGLE_DEG * pi / 180.0);
-	int k = 1;
-	while (k < ROOT_PHASE_MAX_K && c / (2 * k + 1) > half)
-		++k;
-	return 2.0 * c / (2 * k + 1);
+	return 2.0 * c / 3.0;
 }
+
 /// Traces the guide through a row's rachis vertex on one side. Returns false
 /// when the row has no guide there (trace->steps is 0 then too).
 static bool trace_line(const mesher *m, int side, int r, mesh_trace *trace)
@@ -498,7 +495,7 @@ static int stagger_positions(const mesher *m, const mesh_trace *trace, const mes
 {
 	if (below == NULL || !below->present || below->count < 2)
 		return 0;
-	double e = m->e, step = trace->step, total = trace->total;
+	double e = m->e, total = trace->total;
 	const plume_vec3 *nodes = m->points + below->first;
 	// Guides at least 0.6 e apart on average keep the even placement: their
 	// near-right triangles are no slivers (measured on the example feathers:
@@ -518,19 +515,31 @@ static int stagger_positions(const mesher *m, const mesh_trace *trace, const mes
 	for (int i = 0; i + 1 < below->count; ++i) {
 		double q = trace_project(trace, plume_v3_lerp(nodes[i], nodes[i + 1], 0.5), NULL);
 		double last = positions[count - 1];
-		if (q >= total - 0.5 * step)
+		if (q >= total - 0.5 * e)
 			break;
-		if (q - last < (count == 1 && step == e ? 0.75 * e : 0.5 * step))
+		if (q - last < (count == 1 ? 0.75 * e : 0.5 * e))
 			continue;
-		int steps = (int)fmax(1.0, round((q - last) / step));
+		int steps = (int)fmax(1.0, round((q - last) / e));
 		if (count + steps + 1 > capacity)
 			return 0;
 		count = fill_positions(positions, count, q, steps);
 	}
-	int steps = (int)fmax(1.0, round((total - positions[count - 1]) / step));
+	int steps = (int)fmax(1.0, round((total - positions[count - 1]) / e));
 	if (count + steps > capacity)
 		return 0;
 	return fill_positions(positions, count, total, steps);
+}
+
+/// Root-phased positions (root_phase_step): one vertex every trace->step from
+/// the root, the last step (0.5 to 1.5 steps) ending at the tip. Returns the
+/// count, trace->steps + 1.
+static int phased_positions(const mesh_trace *trace, double *positions)
+{
+	int count = 0;
+	for (; count < (int)trace->steps; ++count)
+		positions[count] = count * trace->step;
+	positions[count++] = trace->total;
+	return count;
 }
 
 /// Places the vertices of a row's guide on one side (none when it has no guide),
@@ -554,13 +563,9 @@ static bool build_line(mesher *m, int side, int r)
 	if (positions == NULL)
 		return false;
 	const mesh_line *below = r > 0 ? m->lines + line_index(m, side, r - 1) : NULL;
-	int placed = trace.step < m->e ? 0 : stagger_positions(m, &trace, below, positions, capacity);
-	if (placed == 0 && trace.step < m->e) {
-		positions[0] = 0.0;
-		for (placed = 1; placed < (int)trace.steps; ++placed)
-			positions[placed] = placed * trace.step;
-		positions[placed++] = total;
-	} else if (placed == 0) {
+	int placed = trace.step < m->e ? phased_positions(&trace, positions)
+	                               : stagger_positions(m, &trace, below, positions, capacity);
+	if (placed == 0) {
 		positions[0] = 0.0;
 		placed = fill_positions(positions, 1, total, (int)trace.steps);
 	}
@@ -1461,7 +1466,8 @@ static bool slide_vertices(const mesher *m, plume_mesh *mesh)
 					       a_next = trace_project(&trace, after, NULL);
 					double quality = pi;
 					for (int j = start[v]; j < start[v + 1]; ++j)
-						quality = fmin(quality, moved_face_quality(mesh, list[j], v, mesh->reference[v], junction[list[j]], tolerance));
+						quality = fmin(quality, moved_face_quality(mesh, list[j], v, mesh->reference[v],
+						                                           junction[list[j]], tolerance));
 					if (quality >= bound)
 						continue; // only vertices of faces under the bound move
 					for (int sign = -1; sign <= 1; sign += 2) {
@@ -1472,8 +1478,8 @@ static bool slide_vertices(const mesher *m, plume_mesh *mesh)
 						plume_vec3 p = trace_point(&trace, candidate, &uv);
 						double moved = pi;
 						for (int j = start[v]; j < start[v + 1] && moved > 0.0; ++j)
-							moved =
-							    fmin(moved, moved_face_quality(mesh, list[j], v, (plume_vec2){p.x, p.y}, junction[list[j]], tolerance));
+							moved = fmin(moved, moved_face_quality(mesh, list[j], v, (plume_vec2){p.x, p.y},
+							                                       junction[list[j]], tolerance));
 						if (moved > quality + 1e-9) {
 							quality = moved;
 							a = candidate;
