@@ -280,18 +280,18 @@ static const quality_row quality_rows[] = {
     {"streit-heidrich/bristle.json", 5e-3, 4.33, 0},
     {"streit-heidrich/bristle.json", 2.5e-3, 15.33, 0},
     {"streit-heidrich/continuum.json", 5e-3, 20.0, 0},
-    {"streit-heidrich/continuum.json", 2.5e-3, 16.41, 2},
+    {"streit-heidrich/continuum.json", 2.5e-3, 20.0, 3},
     {"streit-heidrich/contour.json", 5e-3, 20.0, 0},
     {"streit-heidrich/contour.json", 2.5e-3, 20.0, 0},
     {"streit-heidrich/down.json", 5e-3, 20.0, 1},
-    {"streit-heidrich/down.json", 2.5e-3, 17.23, 0},
+    {"streit-heidrich/down.json", 2.5e-3, 20.0, 1},
     {"streit-heidrich/filoplume.json", 5e-3, 20.0, 5},
     {"streit-heidrich/filoplume.json", 2.5e-3, 5.64, 7},
     {"streit-heidrich/flight.json", 5e-3, 20.0, 29},
     {"streit-heidrich/flight.json", 2.5e-3, 20.0, 68},
     {"streit-heidrich/peacock.json", 5e-3, 5.93, 78},
     {"streit-heidrich/peacock.json", 2.5e-3, 0.23, 149},
-    {"streit-heidrich/semiplume.json", 5e-3, 19.60, 4},
+    {"streit-heidrich/semiplume.json", 5e-3, 20.0, 4},
     {"streit-heidrich/semiplume.json", 2.5e-3, 8.31, 9},
     {"zhang-kanai/figure10-asymmetry-020.json", 5e-3, 20.0, 0},
     {"zhang-kanai/figure10-asymmetry-020.json", 2.5e-3, 20.0, 0},
@@ -355,9 +355,10 @@ static void test_example_quality(void **state)
 	}
 	print_message("%d of %d example meshes reach %.0f degrees outside junction faces\n", meeting,
 	              (int)(sizeof quality_rows / sizeof quality_rows[0]), PLUME_MESH_QUALITY_ANGLE_DEG);
-	// 44 built by GCC and by Clang (39 and 36 before root-phased steps): the Streit-Heidrich
+	// 44 built by GCC and by Clang (39 by GCC before the root-phased try): the Streit-Heidrich
 	// generator's growth turns last-bit differences between the two compilers into different
-	// feathers (different face counts). The rows above hold the lower floor of the two builds.
+	// feathers (different face counts), not always the same 44. The rows above hold the lower
+	// floor of the two builds and the higher junction count.
 	assert_true(meeting >= 44);
 	assert_int_equal(plume_bytes_in_use(), before);
 }
