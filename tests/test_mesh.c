@@ -268,9 +268,9 @@ static const quality_row quality_rows[] = {
     {"franco-walter/figure6b.json", 5e-3, 20.0, 1},
     {"franco-walter/figure6b.json", 2.5e-3, 20.0, 0},
     {"franco-walter/filoplume.json", 5e-3, 20.0, 1},
-    {"franco-walter/filoplume.json", 2.5e-3, 16.36, 1},
+    {"franco-walter/filoplume.json", 2.5e-3, 18.66, 1},
     {"franco-walter/hawk.json", 5e-3, 20.0, 0},
-    {"franco-walter/hawk.json", 2.5e-3, 19.06, 0},
+    {"franco-walter/hawk.json", 2.5e-3, 20.0, 1},
     {"franco-walter/peacock.json", 5e-3, 8.17, 7},
     {"franco-walter/peacock.json", 2.5e-3, 3.39, 8},
     {"franco-walter/pigeon-primary.json", 5e-3, 20.0, 3},
@@ -355,11 +355,11 @@ static void test_example_quality(void **state)
 	}
 	print_message("%d of %d example meshes reach %.0f degrees outside junction faces\n", meeting,
 	              (int)(sizeof quality_rows / sizeof quality_rows[0]), PLUME_MESH_QUALITY_ANGLE_DEG);
-	// 44 built by GCC and by Clang (39 by GCC before the root-phased try): the Streit-Heidrich
+	// 45 built by GCC and by Clang (39 by GCC before the root-phased tries): the Streit-Heidrich
 	// generator's growth turns last-bit differences between the two compilers into different
-	// feathers (different face counts), not always the same 44. The rows above hold the lower
+	// feathers (different face counts), not always the same 45. The rows above hold the lower
 	// floor of the two builds and the higher junction count.
-	assert_true(meeting >= 44);
+	assert_true(meeting >= 45);
 	assert_int_equal(plume_bytes_in_use(), before);
 }
 

@@ -95,10 +95,11 @@ typedef struct mesher {
 	mesh_box *boxes;   ///< the pool's box tree (build_index), 2 * leaf_count nodes
 	int leaf_count;    ///< a power of two, at least the number of buckets
 	double max_memory; ///< bytes (plume_mesh_def.max_memory)
-	/// The second try where the first falls short of the quality bound (mesh_run):
-	/// guides rooted close get root-phased steps (root_phase_step) and sliding
-	/// leaves junction angles out of what it raises.
-	bool phased;
+	/// 0 in the first try; in the later ones where it falls short of the quality
+	/// bound (mesh_run), guides rooted at less than this many degrees to the
+	/// next get root-phased steps (root_phase_step) and sliding leaves junction
+	/// angles out of what it raises.
+	double phase_below_deg;
 	plume_error *err;
 } mesher;
 
@@ -367,12 +368,9 @@ static double trace_project(const mesh_trace *trace, plume_vec3 p, double *dista
 	return where;
 }
 
-/// Guides rooted at less than this to the rachis get root-phased steps (root_phase_step).
-enum { ROOT_PHASE_MAX_DEG = 22 };
-
-/// The spacing of a guide's vertices: e, or in the phased try (mesher.phased)
-/// 2 c / 3 where the next guide on the side is rooted close (docs/meshing.md,
-/// step 9). Barbs at theta to the rachis, rooted e apart along it, lie h = e
+/// The spacing of a guide's vertices: e, or in a phased try 2 c / 3 where the
+/// next guide on the side is rooted at less than mesher.phase_below_deg to
+/// this one (docs/meshing.md, step 9). Barbs at theta to the rachis, rooted e apart along it, lie h = e
 /// sin(theta) apart, and the next guide's root lies c = e cos(theta) along
 /// this one. Two guides' vertices zigzag (each midway between two of the
 /// other's) from the root on only when c is an odd multiple of half the step,
@@ -387,10 +385,10 @@ enum { ROOT_PHASE_MAX_DEG = 22 };
 static double root_phase_step(const mesher *m, int side, int r, const mesh_trace *trace)
 {
 	const mesh_input *in = m->input;
-	if (!m->phased || r + 1 >= m->row_count || m->rows[r + 1].sigma > in->sigma_last[side] + 0.5 * m->e)
+	if (m->phase_below_deg == 0.0 || r + 1 >= m->row_count || m->rows[r + 1].sigma > in->sigma_last[side] + 0.5 * m->e)
 		return m->e;
 	double h, c = trace_project(trace, rachis_point(m->rows + r + 1, side), &h);
-	if (!(c > 0.0) || !(h < tan(ROOT_PHASE_MAX_DEG * pi / 180.0) * c))
+	if (!(c > 0.0) || !(h < tan(m->phase_below_deg * pi / 180.0) * c))
 		return m->e;
 	return 2.0 * c / 3.0;
 }
@@ -1419,8 +1417,9 @@ static bool slide_vertices(const mesher *m, plume_mesh *mesh)
 	int n = mesh->vertex_count;
 	int *start = plume_calloc((size_t)n + 1, sizeof *start);
 	int *list = plume_alloc(3 * (size_t)(mesh->face_count > 0 ? mesh->face_count : 1) * sizeof *list);
-	unsigned char *junction = m->phased ? mesh_junction_corners(mesh)
-	                                    : plume_calloc((size_t)(mesh->face_count > 0 ? mesh->face_count : 1), 1);
+	unsigned char *junction = m->phase_below_deg > 0.0
+	                              ? mesh_junction_corners(mesh)
+	                              : plume_calloc((size_t)(mesh->face_count > 0 ? mesh->face_count : 1), 1);
 	if (start == NULL || list == NULL || junction == NULL) {
 		plume_free(start);
 		plume_free(list);
@@ -2014,14 +2013,14 @@ static void count_mesh(const mesher *m, plume_mesh_estimate *out)
 }
 
 /// Places the rows (refusing past the limit before allocating them) and counts the rest.
-static plume_status mesh_begin(mesher *m, const mesh_input *input, const plume_mesh_def *def, bool phased,
+static plume_status mesh_begin(mesher *m, const mesh_input *input, const plume_mesh_def *def, double phase_below_deg,
                                plume_mesh_estimate *estimate, plume_error *err)
 {
 	*m = (mesher){.input = input,
 	              .e = def->edge_length,
 	              .include_calamus = def->include_calamus,
 	              .max_memory = (double)(def->max_memory > 0 ? def->max_memory : PLUME_DEFAULT_MAX_MEMORY),
-	              .phased = phased,
+	              .phase_below_deg = phase_below_deg,
 	              .err = err};
 	plume_status status = place_rows(m);
 	if (status != PLUME_OK)
@@ -2041,12 +2040,12 @@ static void mesh_end(mesher *m)
 	plume_free(m->boxes);
 }
 
-static plume_status mesh_try(const mesh_input *input, const plume_mesh_def *def, bool phased, plume_mesh **out,
-                             plume_mesh_report *report, plume_error *err)
+static plume_status mesh_try(const mesh_input *input, const plume_mesh_def *def, double phase_below_deg,
+                             plume_mesh **out, plume_mesh_report *report, plume_error *err)
 {
 	mesher m;
 	plume_mesh_estimate estimate;
-	plume_status status = mesh_begin(&m, input, def, phased, &estimate, err);
+	plume_status status = mesh_begin(&m, input, def, phase_below_deg, &estimate, err);
 	if (status == PLUME_OK && !(estimate.bytes <= m.max_memory))
 		status = limit_error(&m, &estimate);
 	if (status == PLUME_OK) {
@@ -2074,33 +2073,43 @@ static plume_status mesh_try(const mesh_input *input, const plume_mesh_def *def,
 
 /// Meshes the input; where the vane's smallest angle outside junction faces
 /// falls short of PLUME_MESH_QUALITY_ANGLE_DEG, meshes it again phased
-/// (mesher.phased) and keeps that mesh when its smallest angle is higher. Meshes
-/// that reach the bound are never meshed twice, so they stay as they were (the
-/// Figure 1 hawk at 5 mm, whose simulation tests/test_scene.c pins); a phased
-/// mesh that fails (over the memory limit, or overlapping faces) leaves the first.
+/// (root_phase_step), with guides under 22, then 18, then 32 degrees to the
+/// next phased while none reaches the bound, and keeps the mesh with the
+/// highest smallest angle, the earliest on ties. Which guides gain from the
+/// phase depends on the feather (measured, docs/meshing.md: 22 degrees took
+/// the Streit-Heidrich flight over 20 at both edge lengths, 18 the
+/// Franco-Walter hawk at 2.5 mm, 32 raised the Franco-Walter filoplume and
+/// the Streit-Heidrich semiplume at 2.5 mm). Meshes that reach the bound are
+/// built once, as they were (the Figure 1 hawk at 5 mm, whose simulation
+/// tests/test_scene.c pins); a phased try that fails (over the memory limit,
+/// or overlapping faces) is passed over.
 static plume_status mesh_run(const mesh_input *input, const plume_mesh_def *def, plume_mesh **out,
                              plume_mesh_report *report, plume_error *err)
 {
-	plume_mesh_report first, second;
-	plume_status status = mesh_try(input, def, false, out, &first, err);
-	if (status == PLUME_OK && first.vane_min_angle < PLUME_MESH_QUALITY_ANGLE_DEG * pi / 180.0) {
+	static const double phase_below_deg[] = {22.0, 18.0, 32.0};
+	const double bound = PLUME_MESH_QUALITY_ANGLE_DEG * pi / 180.0;
+	plume_mesh_report best, tried;
+	plume_status status = mesh_try(input, def, 0.0, out, &best, err);
+	for (size_t i = 0;
+	     status == PLUME_OK && best.vane_min_angle < bound && i < sizeof phase_below_deg / sizeof phase_below_deg[0];
+	     ++i) {
 		plume_mesh *phased = NULL;
 		plume_error scratch = {0};
-		plume_status phased_status = mesh_try(input, def, true, &phased, &second, &scratch);
+		plume_status phased_status = mesh_try(input, def, phase_below_deg[i], &phased, &tried, &scratch);
 		if (phased_status == PLUME_ERROR_MEMORY) {
 			plume_mesh_destroy(*out);
 			*out = NULL;
 			return plume_error_set(err, PLUME_ERROR_MEMORY, "%s", scratch.message);
 		}
-		if (phased_status == PLUME_OK && second.vane_min_angle > first.vane_min_angle) {
+		if (phased_status == PLUME_OK && tried.vane_min_angle > best.vane_min_angle) {
 			plume_mesh_destroy(*out);
 			*out = phased;
-			first = second;
+			best = tried;
 		} else
 			plume_mesh_destroy(phased);
 	}
 	if (status == PLUME_OK && report != NULL)
-		*report = first;
+		*report = best;
 	return status;
 }
 
@@ -2108,7 +2117,7 @@ static plume_status mesh_estimate(const mesh_input *input, const plume_mesh_def 
                                   plume_error *err)
 {
 	mesher m;
-	plume_status status = mesh_begin(&m, input, def, false, out, err);
+	plume_status status = mesh_begin(&m, input, def, 0.0, out, err);
 	mesh_end(&m);
 	return status;
 }
