@@ -24,9 +24,9 @@
 // of faces under 25 degrees slide along their guides (slide_vertices), so that
 // vane faces keep their smallest angle at 20 degrees or more outside the
 // junctions where a guide meets the rachis or the outline at a shallow angle
-// (plume_mesh_measure). A mesh that falls short is built again with
-// root-phased steps on the guides rooted close to the next (root_phase_step),
-// and the better of the two is kept (mesh_run).
+// (plume_mesh_measure). A mesh that falls short is built again, up to three
+// times, with root-phased steps on the guides rooted close to the next
+// (root_phase_step), and the best is kept (mesh_run).
 //
 // A step that would make an inverted or degenerate triangle (two guides
 // touching) is never taken: both guides are cut there and every strip is
@@ -370,9 +370,9 @@ static double trace_project(const mesh_trace *trace, plume_vec3 p, double *dista
 
 /// The spacing of a guide's vertices: e, or in a phased try 2 c / 3 where the
 /// next guide on the side is rooted at less than mesher.phase_below_deg to
-/// this one (docs/meshing.md, step 9). Barbs at theta to the rachis, rooted e apart along it, lie h = e
-/// sin(theta) apart, and the next guide's root lies c = e cos(theta) along
-/// this one. Two guides' vertices zigzag (each midway between two of the
+/// this one (docs/meshing.md, step 9). Barbs at theta to the rachis, rooted e
+/// apart along it, lie h = e sin(theta) apart, and the next guide's root lies
+/// c = e cos(theta) along this one. Two guides' vertices zigzag (each midway between two of the
 /// other's) from the root on only when c is an odd multiple of half the step,
 /// step = 2 c / (2 k + 1). Steps of about e (c is about e) meet side by side
 /// near the rachis: Streit-Heidrich flight, theta 18-20 degrees, had 100
