@@ -264,35 +264,35 @@ static const quality_row quality_rows[] = {
     {"franco-walter/blue.json", 5e-3, 20.0, 0},
     {"franco-walter/blue.json", 2.5e-3, 20.0, 0},
     {"franco-walter/figure6a.json", 5e-3, 20.0, 2},
-    {"franco-walter/figure6a.json", 2.5e-3, 12.89, 8},
+    {"franco-walter/figure6a.json", 2.5e-3, 20.0, 8},
     {"franco-walter/figure6b.json", 5e-3, 20.0, 1},
     {"franco-walter/figure6b.json", 2.5e-3, 20.0, 0},
     {"franco-walter/filoplume.json", 5e-3, 20.0, 1},
-    {"franco-walter/filoplume.json", 2.5e-3, 16.36, 1},
+    {"franco-walter/filoplume.json", 2.5e-3, 18.66, 1},
     {"franco-walter/hawk.json", 5e-3, 20.0, 0},
-    {"franco-walter/hawk.json", 2.5e-3, 19.06, 0},
-    {"franco-walter/peacock.json", 5e-3, 7.21, 2},
+    {"franco-walter/hawk.json", 2.5e-3, 20.0, 1},
+    {"franco-walter/peacock.json", 5e-3, 8.17, 7},
     {"franco-walter/peacock.json", 2.5e-3, 3.39, 8},
     {"franco-walter/pigeon-primary.json", 5e-3, 20.0, 3},
-    {"franco-walter/pigeon-primary.json", 2.5e-3, 10.21, 7},
+    {"franco-walter/pigeon-primary.json", 2.5e-3, 20.0, 5},
     {"franco-walter/pigeon-secondary.json", 5e-3, 20.0, 0},
-    {"franco-walter/pigeon-secondary.json", 2.5e-3, 18.10, 2},
+    {"franco-walter/pigeon-secondary.json", 2.5e-3, 20.0, 3},
     {"streit-heidrich/bristle.json", 5e-3, 4.33, 0},
     {"streit-heidrich/bristle.json", 2.5e-3, 15.33, 0},
     {"streit-heidrich/continuum.json", 5e-3, 20.0, 0},
-    {"streit-heidrich/continuum.json", 2.5e-3, 16.41, 2},
+    {"streit-heidrich/continuum.json", 2.5e-3, 20.0, 3},
     {"streit-heidrich/contour.json", 5e-3, 20.0, 0},
     {"streit-heidrich/contour.json", 2.5e-3, 20.0, 0},
     {"streit-heidrich/down.json", 5e-3, 20.0, 1},
-    {"streit-heidrich/down.json", 2.5e-3, 17.23, 0},
+    {"streit-heidrich/down.json", 2.5e-3, 20.0, 1},
     {"streit-heidrich/filoplume.json", 5e-3, 20.0, 5},
-    {"streit-heidrich/filoplume.json", 2.5e-3, 5.17, 7},
-    {"streit-heidrich/flight.json", 5e-3, 16.59, 19},
-    {"streit-heidrich/flight.json", 2.5e-3, 17.91, 44},
-    {"streit-heidrich/peacock.json", 5e-3, 3.57, 53},
-    {"streit-heidrich/peacock.json", 2.5e-3, 0.19, 104},
-    {"streit-heidrich/semiplume.json", 5e-3, 19.60, 4},
-    {"streit-heidrich/semiplume.json", 2.5e-3, 8.31, 6},
+    {"streit-heidrich/filoplume.json", 2.5e-3, 5.64, 7},
+    {"streit-heidrich/flight.json", 5e-3, 20.0, 29},
+    {"streit-heidrich/flight.json", 2.5e-3, 20.0, 68},
+    {"streit-heidrich/peacock.json", 5e-3, 5.93, 78},
+    {"streit-heidrich/peacock.json", 2.5e-3, 0.23, 149},
+    {"streit-heidrich/semiplume.json", 5e-3, 20.0, 4},
+    {"streit-heidrich/semiplume.json", 2.5e-3, 8.31, 9},
     {"zhang-kanai/figure10-asymmetry-020.json", 5e-3, 20.0, 0},
     {"zhang-kanai/figure10-asymmetry-020.json", 2.5e-3, 20.0, 0},
     {"zhang-kanai/figure10-asymmetry-040.json", 5e-3, 20.0, 0},
@@ -355,11 +355,11 @@ static void test_example_quality(void **state)
 	}
 	print_message("%d of %d example meshes reach %.0f degrees outside junction faces\n", meeting,
 	              (int)(sizeof quality_rows / sizeof quality_rows[0]), PLUME_MESH_QUALITY_ANGLE_DEG);
-	// 39 built by GCC, 36 by Clang: the Streit-Heidrich generator's growth turns last-bit
-	// differences between the two compilers into different feathers (different face counts),
-	// and three of its meshes sit near 20 degrees (down and continuum at 2.5 mm, semiplume at
-	// 5 mm). The rows above hold the lower floor of the two builds.
-	assert_true(meeting >= 36);
+	// 45 built by GCC and by Clang (39 by GCC before the root-phased tries): the Streit-Heidrich
+	// generator's growth turns last-bit differences between the two compilers into different
+	// feathers (different face counts), not always the same 45. The rows above hold the lower
+	// floor of the two builds and the higher junction count.
+	assert_true(meeting >= 45);
 	assert_int_equal(plume_bytes_in_use(), before);
 }
 
@@ -710,6 +710,54 @@ static double segment_distance(plume_vec2 p, plume_vec2 a, plume_vec2 b)
 	double t = ((p.x - a.x) * dx + (p.y - a.y) * dy) / (dx * dx + dy * dy);
 	t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
 	return hypot(a.x + t * dx - p.x, a.y + t * dy - p.y);
+}
+
+/// Barbs at a shallow angle to the rachis (docs/meshing.md, "Root-phased
+/// steps"): straight barbs at 15 degrees to a straight rachis, rows 4 mm
+/// apart, so each guide lies h = 4 sin 15 = 1.04 mm from the next and the
+/// next guide's root lies c = 4 cos 15 = 3.86 mm along it; the outline cuts
+/// the guides square. Steps of about e leave neighbouring guides' vertices
+/// nearly side by side at the rachis: 16.4 degrees there (measured before the
+/// root-phased try). Steps of 2 c / 3 put every vertex midway between two of
+/// the next guide's from the root on: zigzag faces of base angles
+/// atan(3 tan 15) = 38.8 degrees, and 38.8 - 15 = 23.8 degrees at the next
+/// root in the face on the rachis edge (its 15 degrees at the root is a
+/// junction angle), so the vane reaches 20 degrees.
+static void test_shallow_barbs_phased(void **state)
+{
+	(void)state;
+	int64_t before = plume_bytes_in_use();
+	const double theta = 15.0 * pi / 180.0, reach = 0.06;
+	plume_vec2 u = {sin(theta), cos(theta)}, n = {u.y, -u.x};
+	double t = (-0.001 - reach * u.x) / n.x; // where the square cut meets x = -1 mm
+	plume_vec2 boundary[3] = {{-0.001, -0.002},
+	                          {reach * u.x + 0.05 * n.x, reach * u.y + 0.05 * n.y},
+	                          {reach * u.x + t * n.x, reach * u.y + t * n.y}};
+	plume_vec2 rachis[2] = {{0.0, 0.0}, {0.0, 0.1}};
+	plume_vec2 points[4] = {{0.0, 0.0}, {0.2 * u.x, 0.2 * u.y}, {0.0, 0.1}, {0.2 * u.x, 0.1 + 0.2 * u.y}};
+	int offsets[3] = {0, 2, 4};
+	plume_mesh_guides guides = {.boundary_count = 3,
+	                            .boundary = boundary,
+	                            .rachis_count = 2,
+	                            .rachis = rachis,
+	                            .guide_count = 2,
+	                            .guide_offsets = offsets,
+	                            .guide_points = points};
+	plume_mesh_def def = plume_mesh_default_def();
+	def.edge_length = 0.004;
+	def.rachis_width_base = 0.002;
+	def.rachis_width_tip = 0.001;
+	plume_mesh *mesh = NULL;
+	plume_mesh_report report;
+	plume_error err;
+	if (plume_mesh_from_guides(&guides, &def, &mesh, &report, &err) != PLUME_OK)
+		fail_msg("%s", err.message);
+	assert_aligned_mesh(mesh, &report, def.edge_length);
+	print_message("vane min angle %.3f deg, %d junction faces\n", report.vane_min_angle * 180.0 / pi,
+	              report.excepted_count);
+	assert_true(report.vane_min_angle * 180.0 / pi >= PLUME_MESH_QUALITY_ANGLE_DEG);
+	plume_mesh_destroy(mesh);
+	assert_int_equal(plume_bytes_in_use(), before);
 }
 
 /// A guide that ends well before its neighbours (docs/meshing.md, "Joining
@@ -1076,6 +1124,7 @@ int main(void)
 	    cmocka_unit_test(test_short_vanes_and_no_barbs),
 	    cmocka_unit_test(test_explicit_guides),
 	    cmocka_unit_test(test_short_guide_joined),
+	    cmocka_unit_test(test_shallow_barbs_phased),
 	    cmocka_unit_test(test_guides_spec_errors),
 	    cmocka_unit_test(test_guides_spec_splines),
 	    cmocka_unit_test(test_tall_guides),

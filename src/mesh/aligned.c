@@ -24,7 +24,9 @@
 // of faces under 25 degrees slide along their guides (slide_vertices), so that
 // vane faces keep their smallest angle at 20 degrees or more outside the
 // junctions where a guide meets the rachis or the outline at a shallow angle
-// (plume_mesh_measure).
+// (plume_mesh_measure). A mesh that falls short is built again, up to three
+// times, with root-phased steps on the guides rooted close to the next
+// (root_phase_step), and the best is kept (mesh_run).
 //
 // A step that would make an inverted or degenerate triangle (two guides
 // touching) is never taken: both guides are cut there and every strip is
@@ -93,6 +95,11 @@ typedef struct mesher {
 	mesh_box *boxes;   ///< the pool's box tree (build_index), 2 * leaf_count nodes
 	int leaf_count;    ///< a power of two, at least the number of buckets
 	double max_memory; ///< bytes (plume_mesh_def.max_memory)
+	/// 0 in the first try; in the later ones where it falls short of the quality
+	/// bound (mesh_run), guides rooted at less than this many degrees to the
+	/// next get root-phased steps (root_phase_step) and sliding leaves junction
+	/// angles out of what it raises.
+	double phase_below_deg;
 	plume_error *err;
 } mesher;
 
@@ -335,8 +342,56 @@ typedef struct mesh_trace {
 	plume_vec2 uv[MESH_GUIDE_SAMPLES + 1];
 	int count;    ///< points in p and uv
 	double total; ///< plane arc length, m
-	double steps; ///< vertices after the root, one about every e (0: no guide); may be huge
+	double step;  ///< spacing of its vertices: e, or less where the next guide is rooted close (root_phase_step)
+	double steps; ///< vertices after the root, one about every step (0: no guide); may be huge
 } mesh_trace;
+
+/// Arc length along a trace (from its root) of the point nearest p, the first
+/// nearest on ties; *distance (may be NULL) gets how far p is from it.
+static double trace_project(const mesh_trace *trace, plume_vec3 p, double *distance)
+{
+	double best = INFINITY, where = 0.0, start = 0.0;
+	for (int k = 0; k + 1 < trace->count; ++k) {
+		plume_vec3 a = trace->p[k], b = trace->p[k + 1];
+		double dx = b.x - a.x, dy = b.y - a.y, length2 = dx * dx + dy * dy, length = sqrt(length2);
+		double u = length2 > 0.0 ? ((p.x - a.x) * dx + (p.y - a.y) * dy) / length2 : 0.0;
+		u = u < 0.0 ? 0.0 : u > 1.0 ? 1.0 : u;
+		double x = a.x + u * dx - p.x, y = a.y + u * dy - p.y, d2 = x * x + y * y;
+		if (d2 < best) {
+			best = d2;
+			where = start + u * length;
+		}
+		start += length;
+	}
+	if (distance != NULL)
+		*distance = sqrt(best);
+	return where;
+}
+
+/// The spacing of a guide's vertices: e, or in a phased try 2 c / 3 where the
+/// next guide on the side is rooted at less than mesher.phase_below_deg to
+/// this one (docs/meshing.md, step 9). Barbs at theta to the rachis, rooted e
+/// apart along it, lie h = e sin(theta) apart, and the next guide's root lies
+/// c = e cos(theta) along this one. Two guides' vertices zigzag (each midway between two of the
+/// other's) from the root on only when c is an odd multiple of half the step,
+/// step = 2 c / (2 k + 1). Steps of about e (c is about e) meet side by side
+/// near the rachis: Streit-Heidrich flight, theta 18-20 degrees, had 100
+/// faces under 20 degrees there at 2.5 mm. k = 0 (step 2 c) makes faces of
+/// base angles atan(h / c) = theta, k = 2 fans the next root over two steps
+/// of this guide; k = 1 gives base angles atan(3 tan(theta)) and, in the
+/// face on the rachis edge, theta at the root (a junction angle) and
+/// atan(3 tan(theta)) - theta at the next root: 20 degrees down to theta =
+/// 12 degrees.
+static double root_phase_step(const mesher *m, int side, int r, const mesh_trace *trace)
+{
+	const mesh_input *in = m->input;
+	if (m->phase_below_deg == 0.0 || r + 1 >= m->row_count || m->rows[r + 1].sigma > in->sigma_last[side] + 0.5 * m->e)
+		return m->e;
+	double h, c = trace_project(trace, rachis_point(m->rows + r + 1, side), &h);
+	if (!(c > 0.0) || !(h < tan(m->phase_below_deg * pi / 180.0) * c))
+		return m->e;
+	return 2.0 * c / 3.0;
+}
 
 /// Traces the guide through a row's rachis vertex on one side. Returns false
 /// when the row has no guide there (trace->steps is 0 then too).
@@ -401,30 +456,9 @@ static bool trace_line(const mesher *m, int side, int r, mesh_trace *trace)
 		total += sqrt(dist2(p[k], p[k + 1]));
 	trace->count = count;
 	trace->total = total;
-	trace->steps = total > 1e-6 * m->e ? fmax(1.0, round(total / m->e)) : 0.0;
+	trace->step = root_phase_step(m, side, r, trace);
+	trace->steps = total > 1e-6 * m->e ? fmax(1.0, round(total / trace->step)) : 0.0;
 	return true;
-}
-
-/// Arc length along a trace (from its root) of the point nearest p, the first
-/// nearest on ties; *distance (may be NULL) gets how far p is from it.
-static double trace_project(const mesh_trace *trace, plume_vec3 p, double *distance)
-{
-	double best = INFINITY, where = 0.0, start = 0.0;
-	for (int k = 0; k + 1 < trace->count; ++k) {
-		plume_vec3 a = trace->p[k], b = trace->p[k + 1];
-		double dx = b.x - a.x, dy = b.y - a.y, length2 = dx * dx + dy * dy, length = sqrt(length2);
-		double u = length2 > 0.0 ? ((p.x - a.x) * dx + (p.y - a.y) * dy) / length2 : 0.0;
-		u = u < 0.0 ? 0.0 : u > 1.0 ? 1.0 : u;
-		double x = a.x + u * dx - p.x, y = a.y + u * dy - p.y, d2 = x * x + y * y;
-		if (d2 < best) {
-			best = d2;
-			where = start + u * length;
-		}
-		start += length;
-	}
-	if (distance != NULL)
-		*distance = sqrt(best);
-	return where;
 }
 
 /// Appends steps equal steps from the last position to `to`.
@@ -494,6 +528,18 @@ static int stagger_positions(const mesher *m, const mesh_trace *trace, const mes
 	return fill_positions(positions, count, total, steps);
 }
 
+/// Root-phased positions (root_phase_step): one vertex every trace->step from
+/// the root, the last step (0.5 to 1.5 steps) ending at the tip. Returns the
+/// count, trace->steps + 1.
+static int phased_positions(const mesh_trace *trace, double *positions)
+{
+	int count = 0;
+	for (; count < (int)trace->steps; ++count)
+		positions[count] = count * trace->step;
+	positions[count++] = trace->total;
+	return count;
+}
+
 /// Places the vertices of a row's guide on one side (none when it has no guide),
 /// staggered against the guide of the row below when there is one.
 static bool build_line(mesher *m, int side, int r)
@@ -515,7 +561,8 @@ static bool build_line(mesher *m, int side, int r)
 	if (positions == NULL)
 		return false;
 	const mesh_line *below = r > 0 ? m->lines + line_index(m, side, r - 1) : NULL;
-	int placed = stagger_positions(m, &trace, below, positions, capacity);
+	int placed = trace.step < m->e ? phased_positions(&trace, positions)
+	                               : stagger_positions(m, &trace, below, positions, capacity);
 	if (placed == 0) {
 		positions[0] = 0.0;
 		placed = fill_positions(positions, 1, total, (int)trace.steps);
@@ -1316,9 +1363,11 @@ static int join_short_guides(mesher *m)
 // ---------------------------------------------------------------------------
 // Sliding along the guides
 
-/// Smallest angle of vane face f with vertex v at p (reference plane), or -1
-/// when the face would be inverted or degenerate.
-static double moved_face_quality(const plume_mesh *mesh, int f, int v, plume_vec2 p, double tolerance)
+/// Smallest angle of vane face f with vertex v at p (reference plane) but its
+/// junction corners (mesh_junction_corners: set bits of junction), or -1 when the
+/// face would be inverted or degenerate.
+static double moved_face_quality(const plume_mesh *mesh, int f, int v, plume_vec2 p, unsigned junction,
+                                 double tolerance)
 {
 	plume_vec2 q[3];
 	for (int k = 0; k < 3; ++k) {
@@ -1328,7 +1377,13 @@ static double moved_face_quality(const plume_mesh *mesh, int f, int v, plume_vec
 	double area2 = (q[1].x - q[0].x) * (q[2].y - q[0].y) - (q[1].y - q[0].y) * (q[2].x - q[0].x);
 	if (!(area2 > tolerance))
 		return -1.0;
-	return smallest_corner(q);
+	double best = pi;
+	for (int k = 0; k < 3; ++k) {
+		plume_vec2 o = q[k], x = q[(k + 1) % 3], y = q[(k + 2) % 3];
+		if (!(junction & (1u << k)))
+			best = fmin(best, angle_between(x.x - o.x, x.y - o.y, y.x - o.x, y.y - o.y));
+	}
+	return best;
 }
 
 /// The point at arc length a along a trace, and its texture coordinates.
@@ -1362,9 +1417,13 @@ static bool slide_vertices(const mesher *m, plume_mesh *mesh)
 	int n = mesh->vertex_count;
 	int *start = plume_calloc((size_t)n + 1, sizeof *start);
 	int *list = plume_alloc(3 * (size_t)(mesh->face_count > 0 ? mesh->face_count : 1) * sizeof *list);
-	if (start == NULL || list == NULL) {
+	unsigned char *junction = m->phase_below_deg > 0.0
+	                              ? mesh_junction_corners(mesh)
+	                              : plume_calloc((size_t)(mesh->face_count > 0 ? mesh->face_count : 1), 1);
+	if (start == NULL || list == NULL || junction == NULL) {
 		plume_free(start);
 		plume_free(list);
+		plume_free(junction);
 		return false;
 	}
 	for (int f = 0; f < mesh->face_count; ++f)
@@ -1406,7 +1465,8 @@ static bool slide_vertices(const mesher *m, plume_mesh *mesh)
 					       a_next = trace_project(&trace, after, NULL);
 					double quality = pi;
 					for (int j = start[v]; j < start[v + 1]; ++j)
-						quality = fmin(quality, moved_face_quality(mesh, list[j], v, mesh->reference[v], tolerance));
+						quality = fmin(quality, moved_face_quality(mesh, list[j], v, mesh->reference[v],
+						                                           junction[list[j]], tolerance));
 					if (quality >= bound)
 						continue; // only vertices of faces under the bound move
 					for (int sign = -1; sign <= 1; sign += 2) {
@@ -1417,8 +1477,8 @@ static bool slide_vertices(const mesher *m, plume_mesh *mesh)
 						plume_vec3 p = trace_point(&trace, candidate, &uv);
 						double moved = pi;
 						for (int j = start[v]; j < start[v + 1] && moved > 0.0; ++j)
-							moved =
-							    fmin(moved, moved_face_quality(mesh, list[j], v, (plume_vec2){p.x, p.y}, tolerance));
+							moved = fmin(moved, moved_face_quality(mesh, list[j], v, (plume_vec2){p.x, p.y},
+							                                       junction[list[j]], tolerance));
 						if (moved > quality + 1e-9) {
 							quality = moved;
 							a = candidate;
@@ -1432,6 +1492,7 @@ static bool slide_vertices(const mesher *m, plume_mesh *mesh)
 	}
 	plume_free(start);
 	plume_free(list);
+	plume_free(junction);
 	for (int f = 0; f < mesh->face_count; ++f) { // the barb edges' directions moved with them
 		int k = mesh->barb_edge[f];
 		if (mesh->material[f] != PLUME_MATERIAL_VANE || k < 0)
@@ -1952,13 +2013,14 @@ static void count_mesh(const mesher *m, plume_mesh_estimate *out)
 }
 
 /// Places the rows (refusing past the limit before allocating them) and counts the rest.
-static plume_status mesh_begin(mesher *m, const mesh_input *input, const plume_mesh_def *def,
+static plume_status mesh_begin(mesher *m, const mesh_input *input, const plume_mesh_def *def, double phase_below_deg,
                                plume_mesh_estimate *estimate, plume_error *err)
 {
 	*m = (mesher){.input = input,
 	              .e = def->edge_length,
 	              .include_calamus = def->include_calamus,
 	              .max_memory = (double)(def->max_memory > 0 ? def->max_memory : PLUME_DEFAULT_MAX_MEMORY),
+	              .phase_below_deg = phase_below_deg,
 	              .err = err};
 	plume_status status = place_rows(m);
 	if (status != PLUME_OK)
@@ -1978,12 +2040,12 @@ static void mesh_end(mesher *m)
 	plume_free(m->boxes);
 }
 
-static plume_status mesh_run(const mesh_input *input, const plume_mesh_def *def, plume_mesh **out,
-                             plume_mesh_report *report, plume_error *err)
+static plume_status mesh_try(const mesh_input *input, const plume_mesh_def *def, double phase_below_deg,
+                             plume_mesh **out, plume_mesh_report *report, plume_error *err)
 {
 	mesher m;
 	plume_mesh_estimate estimate;
-	plume_status status = mesh_begin(&m, input, def, &estimate, err);
+	plume_status status = mesh_begin(&m, input, def, phase_below_deg, &estimate, err);
 	if (status == PLUME_OK && !(estimate.bytes <= m.max_memory))
 		status = limit_error(&m, &estimate);
 	if (status == PLUME_OK) {
@@ -2009,11 +2071,53 @@ static plume_status mesh_run(const mesh_input *input, const plume_mesh_def *def,
 	return status;
 }
 
+/// Meshes the input; where the vane's smallest angle outside junction faces
+/// falls short of PLUME_MESH_QUALITY_ANGLE_DEG, meshes it again phased
+/// (root_phase_step), with guides under 22, then 18, then 32 degrees to the
+/// next phased while none reaches the bound, and keeps the mesh with the
+/// highest smallest angle, the earliest on ties. Which guides gain from the
+/// phase depends on the feather (measured, docs/meshing.md: 22 degrees took
+/// the Streit-Heidrich flight over 20 at both edge lengths, 18 the
+/// Franco-Walter hawk at 2.5 mm, 32 raised the Franco-Walter filoplume and
+/// the Streit-Heidrich semiplume at 2.5 mm). Meshes that reach the bound are
+/// built once, as they were (the Figure 1 hawk at 5 mm, whose simulation
+/// tests/test_scene.c pins); a phased try that fails (over the memory limit,
+/// or overlapping faces) is passed over.
+static plume_status mesh_run(const mesh_input *input, const plume_mesh_def *def, plume_mesh **out,
+                             plume_mesh_report *report, plume_error *err)
+{
+	static const double phase_below_deg[] = {22.0, 18.0, 32.0};
+	const double bound = PLUME_MESH_QUALITY_ANGLE_DEG * pi / 180.0;
+	plume_mesh_report best, tried;
+	plume_status status = mesh_try(input, def, 0.0, out, &best, err);
+	for (size_t i = 0;
+	     status == PLUME_OK && best.vane_min_angle < bound && i < sizeof phase_below_deg / sizeof phase_below_deg[0];
+	     ++i) {
+		plume_mesh *phased = NULL;
+		plume_error scratch = {0};
+		plume_status phased_status = mesh_try(input, def, phase_below_deg[i], &phased, &tried, &scratch);
+		if (phased_status == PLUME_ERROR_MEMORY) {
+			plume_mesh_destroy(*out);
+			*out = NULL;
+			return plume_error_set(err, PLUME_ERROR_MEMORY, "%s", scratch.message);
+		}
+		if (phased_status == PLUME_OK && tried.vane_min_angle > best.vane_min_angle) {
+			plume_mesh_destroy(*out);
+			*out = phased;
+			best = tried;
+		} else
+			plume_mesh_destroy(phased);
+	}
+	if (status == PLUME_OK && report != NULL)
+		*report = best;
+	return status;
+}
+
 static plume_status mesh_estimate(const mesh_input *input, const plume_mesh_def *def, plume_mesh_estimate *out,
                                   plume_error *err)
 {
 	mesher m;
-	plume_status status = mesh_begin(&m, input, def, out, err);
+	plume_status status = mesh_begin(&m, input, def, 0.0, out, err);
 	mesh_end(&m);
 	return status;
 }

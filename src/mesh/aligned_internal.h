@@ -63,6 +63,13 @@ void mesh_centre_eval(const mesh_centre *centre, double sigma, plume_vec3 *p, pl
 /// True when the open polylines a and b (plane coordinates) properly cross.
 bool mesh_polylines_cross(const plume_vec3 *a, int a_count, const plume_vec3 *b, int b_count);
 
+/// Per face, the bit k set when corner k of a vane face lies between its barb
+/// edge and an edge on the vane's border (an edge of one vane face: against the
+/// rachis band, or on the outline): the angle between a guide and the rachis or
+/// the outline, a junction angle (plume_mesh_measure). NULL out of memory;
+/// plume_free it.
+unsigned char *mesh_junction_corners(const plume_mesh *mesh);
+
 /// plume_mesh_measure, or false when out of memory (the junction faces need the
 /// vane's edges sorted): the mesher fails then rather than report less.
 bool mesh_measure(const plume_mesh *mesh, plume_mesh_report *out);

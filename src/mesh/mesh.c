@@ -179,22 +179,47 @@ static bool on_vane_border(const plume_mesh *mesh, const long long *keys, int co
 	return lo < count && keys[lo] == key && (lo + 1 == count || keys[lo + 1] != key);
 }
 
+unsigned char *mesh_junction_corners(const plume_mesh *mesh)
+{
+	// The vane faces' edges, to tell the vane's border edges (used by one vane face).
+	long long *keys = plume_alloc(3 * (size_t)(mesh->face_count > 0 ? mesh->face_count : 1) * sizeof *keys);
+	unsigned char *corners = plume_calloc((size_t)(mesh->face_count > 0 ? mesh->face_count : 1), 1);
+	if (keys == NULL || corners == NULL) {
+		plume_free(keys);
+		plume_free(corners);
+		return NULL;
+	}
+	int key_count = 0;
+	for (int f = 0; f < mesh->face_count; ++f)
+		if (mesh->material[f] == PLUME_MATERIAL_VANE)
+			for (int k = 0; k < 3; ++k)
+				keys[key_count++] = edge_key(mesh, mesh->faces[3 * f + k], mesh->faces[3 * f + (k + 1) % 3]);
+	qsort(keys, (size_t)key_count, sizeof *keys, compare_keys);
+	for (int f = 0; f < mesh->face_count; ++f) {
+		const int *v = mesh->faces + 3 * f;
+		int barb = mesh->barb_edge[f];
+		if (mesh->material[f] != PLUME_MATERIAL_VANE || barb < 0)
+			continue;
+		// Corner k lies between local edges k (v[k], v[k + 1]) and k + 2: the one that is not the barb edge.
+		for (int k = 0; k < 3; ++k) {
+			int other = barb == k ? (k + 2) % 3 : barb == (k + 2) % 3 ? k : -1;
+			if (other >= 0 && on_vane_border(mesh, keys, key_count, v[other], v[(other + 1) % 3]))
+				corners[f] |= (unsigned char)(1u << k);
+		}
+	}
+	plume_free(keys);
+	return corners;
+}
+
 bool mesh_measure(const plume_mesh *mesh, plume_mesh_report *out)
 {
 	plume_mesh_report report = {
 	    .min_angle = mesh->face_count > 0 ? pi : 0.0, .aligned_fraction = 1.0, .vane_min_angle = pi};
 	const double quality = PLUME_MESH_QUALITY_ANGLE_DEG * pi / 180.0;
 	int vane_faces = 0, aligned = 0;
-	// The vane faces' edges, to tell the vane's border edges (used by one vane face).
-	long long *keys = plume_alloc(3 * (size_t)(mesh->face_count > 0 ? mesh->face_count : 1) * sizeof *keys);
-	int key_count = 0;
-	for (int f = 0; keys != NULL && f < mesh->face_count; ++f)
-		if (mesh->material[f] == PLUME_MATERIAL_VANE)
-			for (int k = 0; k < 3; ++k)
-				keys[key_count++] = edge_key(mesh, mesh->faces[3 * f + k], mesh->faces[3 * f + (k + 1) % 3]);
-	if (keys == NULL)
+	unsigned char *corners = mesh_junction_corners(mesh);
+	if (corners == NULL)
 		return false;
-	qsort(keys, (size_t)key_count, sizeof *keys, compare_keys);
 	// The rachis tip edge: the band's top row, where the two vanes' last guides are rooted.
 	const plume_vertex_group *tip = plume_mesh_find_group(mesh, "rachis_tip");
 	int tip_a = tip != NULL && tip->count == 2 ? tip->vertices[0] : -1;
@@ -227,11 +252,10 @@ bool mesh_measure(const plume_mesh *mesh, plume_mesh_report *out)
 			if (!(angles[k] < quality))
 				continue;
 			++small;
-			int other = barb == k ? (k + 2) % 3 : barb == (k + 2) % 3 ? k : -1;
 			int a = v[(k + 1) % 3], b = v[(k + 2) % 3];
 			if (barb < 0)
 				continue;
-			if (other >= 0 && on_vane_border(mesh, keys, key_count, v[other], v[(other + 1) % 3]))
+			if (corners[f] & (1u << k))
 				++junction;
 			else if (tip_a >= 0 && ((a == tip_a && b == tip_b) || (a == tip_b && b == tip_a)))
 				++junction;
@@ -243,7 +267,7 @@ bool mesh_measure(const plume_mesh *mesh, plume_mesh_report *out)
 		for (int k = 0; k < 3; ++k)
 			report.vane_min_angle = fmin(report.vane_min_angle, angles[k]);
 	}
-	plume_free(keys);
+	plume_free(corners);
 	report.aligned_fraction = vane_faces > 0 ? (double)aligned / vane_faces : 1.0;
 	*out = report;
 	return true;
