@@ -712,6 +712,35 @@ static double segment_distance(plume_vec2 p, plume_vec2 a, plume_vec2 b)
 	return hypot(a.x + t * dx - p.x, a.y + t * dy - p.y);
 }
 
+/// The edge length of mesh_two_guides.
+static const double TWO_GUIDES_EDGE = 0.004;
+
+/// Meshes two straight guides (points: root and tip of each) rooted on a straight
+/// rachis from (0, 0) to (0, 0.1) inside boundary, at e = TWO_GUIDES_EDGE with a 2 to
+/// 1 mm band.
+static plume_mesh *mesh_two_guides(plume_vec2 *boundary, int boundary_count, plume_vec2 points[4],
+                                   plume_mesh_report *report)
+{
+	plume_vec2 rachis[2] = {{0.0, 0.0}, {0.0, 0.1}};
+	int offsets[3] = {0, 2, 4};
+	plume_mesh_guides guides = {.boundary_count = boundary_count,
+	                            .boundary = boundary,
+	                            .rachis_count = 2,
+	                            .rachis = rachis,
+	                            .guide_count = 2,
+	                            .guide_offsets = offsets,
+	                            .guide_points = points};
+	plume_mesh_def def = plume_mesh_default_def();
+	def.edge_length = TWO_GUIDES_EDGE;
+	def.rachis_width_base = 0.002;
+	def.rachis_width_tip = 0.001;
+	plume_mesh *mesh = NULL;
+	plume_error err;
+	if (plume_mesh_from_guides(&guides, &def, &mesh, report, &err) != PLUME_OK)
+		fail_msg("%s", err.message);
+	return mesh;
+}
+
 /// Barbs at a shallow angle to the rachis (docs/meshing.md, "Root-phased
 /// steps"): straight barbs at 15 degrees to a straight rachis, rows 4 mm
 /// apart, so each guide lies h = 4 sin 15 = 1.04 mm from the next and the
@@ -733,26 +762,10 @@ static void test_shallow_barbs_phased(void **state)
 	plume_vec2 boundary[3] = {{-0.001, -0.002},
 	                          {reach * u.x + 0.05 * n.x, reach * u.y + 0.05 * n.y},
 	                          {reach * u.x + t * n.x, reach * u.y + t * n.y}};
-	plume_vec2 rachis[2] = {{0.0, 0.0}, {0.0, 0.1}};
 	plume_vec2 points[4] = {{0.0, 0.0}, {0.2 * u.x, 0.2 * u.y}, {0.0, 0.1}, {0.2 * u.x, 0.1 + 0.2 * u.y}};
-	int offsets[3] = {0, 2, 4};
-	plume_mesh_guides guides = {.boundary_count = 3,
-	                            .boundary = boundary,
-	                            .rachis_count = 2,
-	                            .rachis = rachis,
-	                            .guide_count = 2,
-	                            .guide_offsets = offsets,
-	                            .guide_points = points};
-	plume_mesh_def def = plume_mesh_default_def();
-	def.edge_length = 0.004;
-	def.rachis_width_base = 0.002;
-	def.rachis_width_tip = 0.001;
-	plume_mesh *mesh = NULL;
 	plume_mesh_report report;
-	plume_error err;
-	if (plume_mesh_from_guides(&guides, &def, &mesh, &report, &err) != PLUME_OK)
-		fail_msg("%s", err.message);
-	assert_aligned_mesh(mesh, &report, def.edge_length);
+	plume_mesh *mesh = mesh_two_guides(boundary, 3, points, &report);
+	assert_aligned_mesh(mesh, &report, TWO_GUIDES_EDGE);
 	print_message("vane min angle %.3f deg, %d junction faces\n", report.vane_min_angle * 180.0 / pi,
 	              report.excepted_count);
 	assert_true(report.vane_min_angle * 180.0 / pi >= PLUME_MESH_QUALITY_ANGLE_DEG);
@@ -782,31 +795,11 @@ static void test_short_guide_joined(void **state)
 	plume_vec2 plain[4] = {{-0.001, -0.002}, {0.02, -0.002}, {0.02, 0.13}, {-0.001, 0.13}};
 	plume_vec2 slotted[8] = {{-0.001, -0.002}, {0.02, -0.002}, low_out,       low, high,
 	                         high_out,         {0.02, 0.13},   {-0.001, 0.13}};
-	plume_vec2 rachis[2] = {{0.0, 0.0}, {0.0, 0.1}};
 	plume_vec2 points[4] = {{0.0, 0.01}, {0.06 * u.x, 0.01 + 0.06 * u.y}, {0.0, 0.08}, {0.06 * u.x, 0.08 + 0.06 * u.y}};
-	int offsets[3] = {0, 2, 4};
-	plume_mesh_guides guides = {.boundary_count = 4,
-	                            .boundary = plain,
-	                            .rachis_count = 2,
-	                            .rachis = rachis,
-	                            .guide_count = 2,
-	                            .guide_offsets = offsets,
-	                            .guide_points = points};
-	plume_mesh_def def = plume_mesh_default_def();
-	def.edge_length = 0.004;
-	def.rachis_width_base = 0.002;
-	def.rachis_width_tip = 0.001;
-	plume_mesh *mesh = NULL;
 	plume_mesh_report plain_report, report;
-	plume_error err;
-	if (plume_mesh_from_guides(&guides, &def, &mesh, &plain_report, &err) != PLUME_OK)
-		fail_msg("%s", err.message);
-	plume_mesh_destroy(mesh);
-	guides.boundary_count = 8;
-	guides.boundary = slotted;
-	if (plume_mesh_from_guides(&guides, &def, &mesh, &report, &err) != PLUME_OK)
-		fail_msg("%s", err.message);
-	assert_aligned_mesh(mesh, &report, def.edge_length);
+	plume_mesh_destroy(mesh_two_guides(plain, 4, points, &plain_report));
+	plume_mesh *mesh = mesh_two_guides(slotted, 8, points, &report);
+	assert_aligned_mesh(mesh, &report, TWO_GUIDES_EDGE);
 	print_message("vane min angle %.3f deg, %.3f deg without the slot\n", report.vane_min_angle * 180.0 / pi,
 	              plain_report.vane_min_angle * 180.0 / pi);
 	assert_true(report.vane_min_angle >= plain_report.vane_min_angle);

@@ -131,13 +131,15 @@ static double angle_between(double ax, double ay, double bx, double by)
 	return atan2(fabs(ax * by - ay * bx), ax * bx + ay * by);
 }
 
-/// Smallest interior angle of triangle q.
-static double smallest_corner(const plume_vec2 q[3])
+/// Smallest interior angle of triangle q but the corners whose bit is set in skip
+/// (bit k: corner k; pi when all are skipped).
+static double smallest_corner(const plume_vec2 q[3], unsigned skip)
 {
 	double best = pi;
 	for (int k = 0; k < 3; ++k) {
 		plume_vec2 o = q[k], a = q[(k + 1) % 3], b = q[(k + 2) % 3];
-		best = fmin(best, angle_between(a.x - o.x, a.y - o.y, b.x - o.x, b.y - o.y));
+		if (!(skip & (1u << k)))
+			best = fmin(best, angle_between(a.x - o.x, a.y - o.y, b.x - o.x, b.y - o.y));
 	}
 	return best;
 }
@@ -718,7 +720,7 @@ static double face_quality(const mesher *m, const int line[3], const int at[3])
 		plume_vec3 p = m->points[m->lines[line[k]].first + at[k]];
 		q[k] = (plume_vec2){p.x, p.y};
 	}
-	return smallest_corner(q);
+	return smallest_corner(q, 0);
 }
 
 static void emit_face(const mesher *m, strip_out *out, int la, int ia, int lb, int ib, int lc, int ic, int barb_edge)
@@ -1377,13 +1379,7 @@ static double moved_face_quality(const plume_mesh *mesh, int f, int v, plume_vec
 	double area2 = (q[1].x - q[0].x) * (q[2].y - q[0].y) - (q[1].y - q[0].y) * (q[2].x - q[0].x);
 	if (!(area2 > tolerance))
 		return -1.0;
-	double best = pi;
-	for (int k = 0; k < 3; ++k) {
-		plume_vec2 o = q[k], x = q[(k + 1) % 3], y = q[(k + 2) % 3];
-		if (!(junction & (1u << k)))
-			best = fmin(best, angle_between(x.x - o.x, x.y - o.y, y.x - o.x, y.y - o.y));
-	}
-	return best;
+	return smallest_corner(q, junction);
 }
 
 /// The point at arc length a along a trace, and its texture coordinates.
