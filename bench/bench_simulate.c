@@ -16,9 +16,9 @@
 // The scaling series runs every mesh size over the scene's first SCALING_DURATION
 // seconds, before the vane buckles, and fits CPU per step against vertex count. (The
 // buckling steps take many more Newton iterations and would measure the bifurcation, not
-// the solver's growth; on the finest meshes Newton does not get through it: at
-// e = 1.25 mm the run stops at t = 0.187 s, at 1.75 mm at 0.275 s; docs/simulation.md.) `bench_simulate quick` runs the 5 mm runs only, `bench_simulate all`
-// adds e = 1.25 mm (5,000 vertices) to the series.
+// the solver's growth; the whole runs at 1.75 and 1.25 mm take minutes and are in
+// docs/simulation.md, Speed.) `bench_simulate quick` runs the 5 mm runs only,
+// `bench_simulate all` adds e = 1.25 mm (5,000 vertices) to the series.
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>

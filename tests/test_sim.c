@@ -335,25 +335,31 @@ static void test_kkt_factor_reports_indefinite(void **state)
 	for (int v = 0; v < 2; ++v)
 		for (int d = 0; d < 3; ++d)
 			values[kkt.diagonal_slots[3 * v + d]] = 2.0;
-	assert_int_equal(plume_kkt_factor(&kkt, false, &shift, &err), PLUME_OK);
+	assert_int_equal(plume_kkt_factor(&kkt, false, 0, &shift, &err), PLUME_OK);
 	assert_true(shift == 0.0);
 	assert_int_equal(plume_kkt_solve(&kkt, rhs, NULL, x, &err), PLUME_OK);
 	for (int i = 0; i < 6; ++i)
 		assert_close(x[i], rhs[i] / 2.0, 1e-15);
 
-	values[kkt.diagonal_slots[3 * 1 + 2]] = -1.0; // mean |diagonal| 11/6
-	assert_int_equal(plume_kkt_factor(&kkt, false, &shift, &err), PLUME_ERROR_NUMERIC);
-	assert_non_null(strstr(err.message, "not positive definite"));
-	assert_int_equal(plume_kkt_factor(&kkt, true, &shift, &err), PLUME_OK);
-	assert_close(shift, 11.0 / 6.0, 1e-12); // 1e-10, 1e-9 ... 1 times the mean: the first past 1
-	assert_int_equal(plume_kkt_solve(&kkt, rhs, NULL, x, &err), PLUME_OK);
-	assert_close(x[5], 6.0 / (shift - 1.0), 1e-12);
+	// One negative pivot, mean |diagonal| 11/6: the ladder 1e-10, 1e-9, ... times the mean
+	// first passes 1 at 1 (11/6 added); started at 10, it stops there (110/6 added).
+	for (int first = 0; first <= 1; ++first) {
+		for (int i = 0; i < 6; ++i)
+			values[kkt.diagonal_slots[i]] = i == 5 ? -1.0 : 2.0;
+		assert_int_equal(plume_kkt_factor(&kkt, false, 0, &shift, &err), PLUME_ERROR_NUMERIC);
+		assert_non_null(strstr(err.message, "not positive definite"));
+		assert_int_equal(plume_kkt_factor(&kkt, true, first ? 10.0 : 0.0, &shift, &err), PLUME_OK);
+		assert_close(shift, first ? 10.0 : 1.0, 1e-12);
+		assert_int_equal(plume_kkt_solve(&kkt, rhs, NULL, x, &err), PLUME_OK);
+		assert_close(x[5], 6.0 / (shift * 11.0 / 6.0 - 1.0), 1e-12);
+		assert_close(x[0], 1.0 / (2.0 + shift * 11.0 / 6.0), 1e-12);
+	}
 
 	plume_kkt_zero(&kkt);
 	for (int v = 0; v < 2; ++v)
 		for (int d = 0; d < 3; ++d)
 			values[kkt.diagonal_slots[3 * v + d]] = v == 1 && d == 1 ? NAN : 2.0;
-	assert_int_equal(plume_kkt_factor(&kkt, false, &shift, &err), PLUME_ERROR_NUMERIC);
+	assert_int_equal(plume_kkt_factor(&kkt, false, 0, &shift, &err), PLUME_ERROR_NUMERIC);
 	plume_kkt_free(&kkt);
 }
 
@@ -380,7 +386,7 @@ static void test_kkt_factor_inertia(void **state)
 		// x1 ((-1 + 2) / 2 > 0 along x0 = x1): accepted. Trial 1: H_y0y0 = -1 is a tangent
 		// direction: refused.
 		values[kkt.diagonal_slots[trial]] = -1.0;
-		plume_status status = plume_kkt_factor(&kkt, false, &shift, &err);
+		plume_status status = plume_kkt_factor(&kkt, false, 0, &shift, &err);
 		if (trial == 1) {
 			assert_int_equal(status, PLUME_ERROR_NUMERIC);
 			assert_non_null(strstr(err.message, "tangent space"));

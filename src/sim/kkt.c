@@ -222,6 +222,13 @@ static void shift_positions(plume_kkt *kkt, double amount)
 		values[kkt->diagonal_slots[i]] += amount;
 }
 
+/// The smallest shift a ladder starts from: below it a shift is lost to rounding against
+/// the diagonal it is added to.
+static const double SMALLEST_SHIFT = 1e-10;
+/// The largest: beyond it the step is a gradient step shorter than anything the line
+/// search needs.
+static const double LARGEST_SHIFT = 1e2;
+
 /// rho_k over the largest diagonal entry of H at the constraint's free unknowns: large
 /// enough that H + C^T R C is positive definite whenever H is on the constraints' tangent
 /// space and that refinement converges in a few steps, small enough that the factored
@@ -255,7 +262,7 @@ static void load_positions(plume_kkt *kkt)
 	}
 }
 
-plume_status plume_kkt_factor(plume_kkt *kkt, bool allow_shift, double *shift, plume_error *err)
+plume_status plume_kkt_factor(plume_kkt *kkt, bool allow_shift, double first_shift, double *shift, plume_error *err)
 {
 	*shift = 0;
 	load_positions(kkt);
@@ -266,19 +273,20 @@ plume_status plume_kkt_factor(plume_kkt *kkt, bool allow_shift, double *shift, p
 		                       kkt->constraint_count > 0
 		                           ? "the Newton matrix is not positive definite on the constraints' tangent space"
 		                           : "the Newton matrix is not positive definite");
-	// Not positive definite on the positions (a free rigid motion in statics, or an
-	// indefinite constraint curvature term): Levenberg-style shifts, growing tenfold.
+	// Not positive definite on the positions (a free rigid motion in statics, a compressed
+	// barb's constraint curvature, a vane past its buckling load): Levenberg-style shifts,
+	// growing tenfold.
 	double base = mean_position_diagonal(kkt);
 	if (!(base > 0) || !isfinite(base))
 		base = 1;
 	double applied = 0;
-	for (double factor = 1e-10; factor <= 1e2; factor *= 10) {
+	for (double factor = fmax(first_shift, SMALLEST_SHIFT); factor <= LARGEST_SHIFT; factor *= 10) {
 		double wanted = factor * base;
 		shift_positions(kkt, wanted - applied);
 		applied = wanted;
 		load_positions(kkt);
 		if (plume_sparse_factor(&kkt->positions)) {
-			*shift = applied;
+			*shift = factor;
 			return PLUME_OK;
 		}
 	}

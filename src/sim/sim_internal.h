@@ -123,9 +123,12 @@ struct plume_sim {
 	plume_vec3 *previous;
 	plume_vec3 *predicted;
 	plume_vec3 *normals;
-	/// The last solve's exact Hessian was not positive definite on the constraints'
-	/// tangent space: the next solve starts projected (newton.c).
+	/// The last solve's exact Hessian could not be factored even shifted (or, without
+	/// constraints, gave an ascent step): the next solve starts projected (newton.c).
 	bool exact_hessian_failed;
+	/// The shift s (kkt.h) the last exact factorisation needed, 0 when it needed none: the
+	/// next one's ladder starts a decade below it (newton.c, factor_and_solve).
+	double exact_shift;
 	/// Time integration history (integrator.c) and the air's per-step state (air.c).
 	sim_integrator integrator;
 	sim_air air;
