@@ -188,6 +188,40 @@ static void test_figure1_full_amplitude_buckles_without_collapse(void **state)
 	assert_int_equal(plume_bytes_in_use(), 0);
 }
 
+/// Newton through the vane's buckling on a finer mesh (docs/simulation.md, Newton's method):
+/// the coarse fixture's 3 cm pull in 0.3 s at e = 3.5 mm with the default vane. Projecting
+/// an indefinite exact Hessian and correcting only the full step onto the barbs, the run
+/// stopped at t = 0.066 s (16 substeps of 50 iterations each); shifting the Hessian and
+/// correcting every trial of the line search, it completes (1 step retried, measured).
+static void test_newton_through_buckling_on_a_finer_mesh(void **state)
+{
+	(void)state;
+	char path[1024];
+	snprintf(path, sizeof path, "%s/tests/data/figure1-fast-pull-fine.json", PLUME_SOURCE_DIR);
+	plume_scene *scene = NULL;
+	plume_error err = {0};
+	if (plume_scene_load(path, NULL, &scene, &err) != PLUME_OK)
+		fail_msg("%s", err.message);
+	vane_watch watch = {INFINITY, 0};
+	plume_scene_summary summary;
+	if (plume_scene_run(scene, watch_vane, &watch, &summary, &err) != PLUME_OK)
+		fail_msg("%s", err.message);
+	printf("finer mesh: %d vertices, %d steps, %d Newton iterations (at most %d a step, %d retried), smallest vane "
+	       "stretch %.4g, barb strain %.3g, rachis tip %.5g m\n",
+	       summary.vertex_count, summary.steps, summary.newton_iterations, watch.most_iterations,
+	       summary.retried_steps, watch.min_stretch, summary.max_barb_strain, summary.rachis_tip_deflection);
+	assert_int_equal(summary.steps, 30);
+	assert_true(summary.retried_steps <= 2);
+	assert_true(summary.max_barb_strain < 1e-8);
+	assert_true(watch.min_stretch >= 0.6); // buckled, not collapsed in plane (0.69 measured)
+	// The rachis tip as on the coarse mesh (3.77 cm) and at e = 5 mm (3.92 cm in 1.1 s): 3.94 cm.
+	assert_true(summary.rachis_tip_deflection > 0.037 && summary.rachis_tip_deflection < 0.042);
+	free(final_positions);
+	final_positions = NULL;
+	plume_scene_destroy(scene);
+	assert_int_equal(plume_bytes_in_use(), 0);
+}
+
 static void test_handle_pose_interpolation(void **state)
 {
 	(void)state;
@@ -746,6 +780,7 @@ int main(void)
 	    cmocka_unit_test(test_bending_key),
 	    cmocka_unit_test(test_figure1_anisotropic_bends_the_rachis),
 	    cmocka_unit_test(test_figure1_full_amplitude_buckles_without_collapse),
+	    cmocka_unit_test(test_newton_through_buckling_on_a_finer_mesh),
 	    cmocka_unit_test(test_mesh_concatenate),
 	    cmocka_unit_test(test_one_entry_list_is_the_single_feather_scene),
 	    cmocka_unit_test(test_far_apart_feathers_do_not_interact),
