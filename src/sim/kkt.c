@@ -395,6 +395,11 @@ plume_status plume_kkt_solve(plume_kkt *kkt, const double *rhs, const double *mu
 	return PLUME_OK;
 }
 
+plume_status plume_kkt_solve_unrefined(plume_kkt *kkt, const double *rhs, double *solution, plume_error *err)
+{
+	return solve_regularised(kkt, rhs, NULL, solution, err);
+}
+
 void plume_kkt_multiply_add(const plume_kkt *kkt, const double *x, double *y)
 {
 	plume_sparse_multiply_add(&kkt->system, x, y);

@@ -183,7 +183,7 @@ static double merit(plume_sim *sim, const sim_problem *problem, const plume_vec3
 
 /// Second-order corrections (Nocedal & Wright 2006, section 18.3) at the trial point
 /// sim->trial: each is min |dx|_H such that c(y + dx) ~ 0 with the iteration's factors, one
-/// solve, applied up to CORRECTIONS times. Accepts the first corrected point whose merit is
+/// solve without refinement (kkt.h), applied up to CORRECTIONS times. Accepts the first corrected point whose merit is
 /// at most `threshold` into sim->trial (its merit in *accepted_merit).
 ///
 /// Why at every trial of the line search and not only the full step's: a step along
@@ -205,7 +205,10 @@ static bool corrected_trial(plume_sim *sim, const sim_problem *problem, const pl
 		memset(correction_rhs, 0, sizeof(double) * (size_t)n3);
 		for (int k = 0; k < m; ++k)
 			correction_rhs[n3 + k] = constraint_held(sim, k) ? 0 : -constraint_value(sim, sim->scratch, k, NULL, NULL);
-		if (plume_kkt_solve(&sim->kkt, correction_rhs, NULL, correction, err) != PLUME_OK)
+		double solve_start = omp_get_wtime();
+		plume_status status = plume_kkt_solve_unrefined(&sim->kkt, correction_rhs, correction, err);
+		report->seconds_solve += omp_get_wtime() - solve_start;
+		if (status != PLUME_OK)
 			return false;
 		apply_step(sim, sim->scratch, correction, 1, sim->scratch);
 		// The corrected point must be reached without passing through anything, too; it leaves
