@@ -208,8 +208,8 @@ static void test_newton_through_buckling_on_a_finer_mesh(void **state)
 		fail_msg("%s", err.message);
 	printf("finer mesh: %d vertices, %d steps, %d Newton iterations (at most %d a step, %d retried), smallest vane "
 	       "stretch %.4g, barb strain %.3g, rachis tip %.5g m\n",
-	       summary.vertex_count, summary.steps, summary.newton_iterations, watch.most_iterations,
-	       summary.retried_steps, watch.min_stretch, summary.max_barb_strain, summary.rachis_tip_deflection);
+	       summary.vertex_count, summary.steps, summary.newton_iterations, watch.most_iterations, summary.retried_steps,
+	       watch.min_stretch, summary.max_barb_strain, summary.rachis_tip_deflection);
 	assert_int_equal(summary.steps, 30);
 	assert_true(summary.retried_steps <= 2);
 	assert_true(summary.max_barb_strain < 1e-8);

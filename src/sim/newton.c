@@ -183,8 +183,9 @@ static double merit(plume_sim *sim, const sim_problem *problem, const plume_vec3
 
 /// Second-order corrections (Nocedal & Wright 2006, section 18.3) at the trial point
 /// sim->trial: each is min |dx|_H such that c(y + dx) ~ 0 with the iteration's factors, one
-/// solve without refinement (kkt.h), applied up to CORRECTIONS times. Accepts the first corrected point whose merit is
-/// at most `threshold` into sim->trial (its merit in *accepted_merit).
+/// solve without refinement (kkt.h), applied up to CORRECTIONS times. Accepts the first
+/// corrected point whose merit is at most `threshold` into sim->trial (its merit in
+/// *accepted_merit).
 ///
 /// Why at every trial of the line search and not only the full step's: a step along
 /// compressed barbs that buckle moves their vertices sideways, which lengthens every barb
