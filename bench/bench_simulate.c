@@ -18,7 +18,8 @@
 // buckling steps take many more Newton iterations and would measure the bifurcation, not
 // the solver's growth; the whole runs at 1.75 and 1.25 mm take minutes and are in
 // docs/simulation.md, Speed.) `bench_simulate quick` runs the 5 mm runs only,
-// `bench_simulate all` adds e = 1.25 mm (5,000 vertices) to the series.
+// `bench_simulate all` adds e = 1.25 mm (5,000 vertices) to the series, and
+// `bench_simulate buckling` runs the whole 1.1 s at every size, anisotropic and isotropic.
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>
@@ -114,6 +115,7 @@ typedef struct result {
 	double cpu;     ///< load, mesh and run
 	double run_cpu; ///< plume_scene_run alone
 	int iterations;
+	double rachis_tip; ///< the rachis tip's deflection at the end (m)
 	counters c;
 } result;
 
@@ -172,18 +174,24 @@ static int run(const char *name, double edge_length, double duration, result *ou
 	double run_start = process_cpu(), wall_start = wall_clock();
 	plume_status status = plume_scene_run(scene, NULL, NULL, &summary, &err);
 	double end = process_cpu(), wall = wall_clock() - wall_start;
-	*out =
-	    (result){summary.vertex_count, summary.steps, end - start, end - run_start, summary.newton_iterations, counted};
+	*out = (result){.vertices = summary.vertex_count,
+	                .steps = summary.steps,
+	                .cpu = end - start,
+	                .run_cpu = end - run_start,
+	                .iterations = summary.newton_iterations,
+	                .rachis_tip = summary.rachis_tip_deflection,
+	                .c = counted};
 	const counters *c = &out->c;
 	double iterations = summary.newton_iterations > 0 ? summary.newton_iterations : 1;
 	double per_iteration = out->run_cpu / iterations;
 	double per_factor = c->factorizations > 0 ? c->factor_cpu / (double)c->factorizations : 0;
 	printf("%-20s e = %4.2f mm %5d vertices %5d faces %4d constraints | %s %3d steps (%d retried) %5d iterations "
-	       "(%.2f a step) %6.2f s CPU (%.1f ms a step), %6.2f s wall, strain %.1e\n",
+	       "(%.2f a step) %6.2f s CPU (%.1f ms a step), %6.2f s wall, strain %.1e, rachis tip %.4f cm\n",
 	       name, 1000 * edge_length, summary.vertex_count, summary.face_count, summary.constraint_count,
 	       status == PLUME_OK ? "ok    " : "FAILED", summary.steps, summary.retried_steps, summary.newton_iterations,
 	       summary.steps > 0 ? (double)summary.newton_iterations / summary.steps : 0.0, out->run_cpu,
-	       summary.steps > 0 ? 1e3 * out->run_cpu / summary.steps : 0.0, wall, summary.max_barb_strain);
+	       summary.steps > 0 ? 1e3 * out->run_cpu / summary.steps : 0.0, wall, summary.max_barb_strain,
+	       100 * summary.rachis_tip_deflection);
 	printf("%-20s   per iteration %7.2f ms CPU; one factorisation %6.2f ms (fastest %6.2f ms); ratio %5.2f; "
 	       "%.2f factorisations and %.2f solves an iteration; factorisation %4.1f %% of the run at %.2f GFlop/s; "
 	       "solves %4.1f %%\n",
@@ -232,10 +240,28 @@ static double command_cpu(void)
 	return seconds;
 }
 
+/// `bench_simulate buckling`: the whole run, through the vane's buckling, anisotropic and
+/// isotropic, at every size, and the ratio of their rachis tips (docs/simulation.md, Speed;
+/// about 10 minutes on one core).
+static int buckling(const double *sizes, int count)
+{
+	int failures = 0;
+	for (int i = 0; i < count; ++i) {
+		result anisotropic, isotropic;
+		failures += run("figure1-anisotropic", sizes[i], 0, &anisotropic);
+		failures += run("figure1-isotropic", sizes[i], 0, &isotropic);
+		printf("e = %.2f mm: rachis tip %.4f cm, isotropic %.4f cm, ratio %.3f\n", 1000 * sizes[i],
+		       100 * anisotropic.rachis_tip, 100 * isotropic.rachis_tip, anisotropic.rachis_tip / isotropic.rachis_tip);
+	}
+	return failures == 0 ? 0 : 1;
+}
+
 int main(int argc, char **argv)
 {
 	bool quick = argc > 1 && argv[1][0] == 'q', all = argc > 1 && argv[1][0] == 'a';
 	static const double sizes[] = {0.005, 0.0025, 0.00175, 0.00125};
+	if (argc > 1 && argv[1][0] == 'b')
+		return buckling(sizes, 4);
 	int size_count = quick ? 1 : all ? 4 : 3;
 	result paper, results[4], isotropic;
 	int failures = run("figure1-anisotropic", 0.005, 0, &paper);
