@@ -192,7 +192,8 @@ static void test_figure1_full_amplitude_buckles_without_collapse(void **state)
 /// the coarse fixture's 3 cm pull in 0.3 s at e = 3.5 mm with the default vane. Projecting
 /// an indefinite exact Hessian and correcting only the full step onto the barbs, the run
 /// stopped at t = 0.066 s (16 substeps of 50 iterations each); shifting the Hessian and
-/// correcting every trial of the line search, it completes (1 step retried, measured).
+/// correcting every trial of the line search, it completes (no step retried, at most 50
+/// iterations in a step, measured).
 static void test_newton_through_buckling_on_a_finer_mesh(void **state)
 {
 	(void)state;

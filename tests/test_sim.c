@@ -335,7 +335,7 @@ static void test_kkt_factor_reports_indefinite(void **state)
 	for (int v = 0; v < 2; ++v)
 		for (int d = 0; d < 3; ++d)
 			values[kkt.diagonal_slots[3 * v + d]] = 2.0;
-	assert_int_equal(plume_kkt_factor(&kkt, false, 0, &shift, &err), PLUME_OK);
+	assert_int_equal(plume_kkt_factor(&kkt, 0, 0, &shift, &err), PLUME_OK);
 	assert_true(shift == 0.0);
 	assert_int_equal(plume_kkt_solve(&kkt, rhs, NULL, x, &err), PLUME_OK);
 	for (int i = 0; i < 6; ++i)
@@ -346,20 +346,25 @@ static void test_kkt_factor_reports_indefinite(void **state)
 	for (int first = 0; first <= 1; ++first) {
 		for (int i = 0; i < 6; ++i)
 			values[kkt.diagonal_slots[i]] = i == 5 ? -1.0 : 2.0;
-		assert_int_equal(plume_kkt_factor(&kkt, false, 0, &shift, &err), PLUME_ERROR_NUMERIC);
+		assert_int_equal(plume_kkt_factor(&kkt, 0, 0, &shift, &err), PLUME_ERROR_NUMERIC);
 		assert_non_null(strstr(err.message, "not positive definite"));
-		assert_int_equal(plume_kkt_factor(&kkt, true, first ? 10.0 : 0.0, &shift, &err), PLUME_OK);
+		assert_int_equal(plume_kkt_factor(&kkt, first ? 10.0 : 0.0, 1e2, &shift, &err), PLUME_OK);
 		assert_close(shift, first ? 10.0 : 1.0, 1e-12);
 		assert_int_equal(plume_kkt_solve(&kkt, rhs, NULL, x, &err), PLUME_OK);
 		assert_close(x[5], 6.0 / (shift * 11.0 / 6.0 - 1.0), 1e-12);
 		assert_close(x[0], 1.0 / (2.0 + shift * 11.0 / 6.0), 1e-12);
 	}
+	// A ladder that stops below the shift it needs fails.
+	for (int i = 0; i < 6; ++i)
+		values[kkt.diagonal_slots[i]] = i == 5 ? -1.0 : 2.0;
+	assert_int_equal(plume_kkt_factor(&kkt, 0, 0.1, &shift, &err), PLUME_ERROR_NUMERIC);
+	assert_non_null(strstr(err.message, "even after regularisation"));
 
 	plume_kkt_zero(&kkt);
 	for (int v = 0; v < 2; ++v)
 		for (int d = 0; d < 3; ++d)
 			values[kkt.diagonal_slots[3 * v + d]] = v == 1 && d == 1 ? NAN : 2.0;
-	assert_int_equal(plume_kkt_factor(&kkt, false, 0, &shift, &err), PLUME_ERROR_NUMERIC);
+	assert_int_equal(plume_kkt_factor(&kkt, 0, 0, &shift, &err), PLUME_ERROR_NUMERIC);
 	plume_kkt_free(&kkt);
 }
 
@@ -386,7 +391,7 @@ static void test_kkt_factor_inertia(void **state)
 		// x1 ((-1 + 2) / 2 > 0 along x0 = x1): accepted. Trial 1: H_y0y0 = -1 is a tangent
 		// direction: refused.
 		values[kkt.diagonal_slots[trial]] = -1.0;
-		plume_status status = plume_kkt_factor(&kkt, false, 0, &shift, &err);
+		plume_status status = plume_kkt_factor(&kkt, 0, 0, &shift, &err);
 		if (trial == 1) {
 			assert_int_equal(status, PLUME_ERROR_NUMERIC);
 			assert_non_null(strstr(err.message, "tangent space"));

@@ -225,9 +225,6 @@ static void shift_positions(plume_kkt *kkt, double amount)
 /// The smallest shift a ladder starts from: below it a shift is lost to rounding against
 /// the diagonal it is added to.
 static const double SMALLEST_SHIFT = 1e-10;
-/// The largest: beyond it the step is a gradient step shorter than anything the line
-/// search needs.
-static const double LARGEST_SHIFT = 1e2;
 
 /// rho_k over the largest diagonal entry of H at the constraint's free unknowns: large
 /// enough that H + C^T R C is positive definite whenever H is on the constraints' tangent
@@ -262,13 +259,13 @@ static void load_positions(plume_kkt *kkt)
 	}
 }
 
-plume_status plume_kkt_factor(plume_kkt *kkt, bool allow_shift, double first_shift, double *shift, plume_error *err)
+plume_status plume_kkt_factor(plume_kkt *kkt, double first_shift, double largest_shift, double *shift, plume_error *err)
 {
 	*shift = 0;
 	load_positions(kkt);
 	if (plume_sparse_factor(&kkt->positions))
 		return PLUME_OK;
-	if (!allow_shift)
+	if (!(largest_shift >= fmax(first_shift, SMALLEST_SHIFT)))
 		return plume_error_set(err, PLUME_ERROR_NUMERIC,
 		                       kkt->constraint_count > 0
 		                           ? "the Newton matrix is not positive definite on the constraints' tangent space"
@@ -280,7 +277,7 @@ plume_status plume_kkt_factor(plume_kkt *kkt, bool allow_shift, double first_shi
 	if (!(base > 0) || !isfinite(base))
 		base = 1;
 	double applied = 0;
-	for (double factor = fmax(first_shift, SMALLEST_SHIFT); factor <= LARGEST_SHIFT; factor *= 10) {
+	for (double factor = fmax(first_shift, SMALLEST_SHIFT); factor <= largest_shift; factor *= 10) {
 		double wanted = factor * base;
 		shift_positions(kkt, wanted - applied);
 		applied = wanted;

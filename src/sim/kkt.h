@@ -81,15 +81,16 @@ double *plume_kkt_values(plume_kkt *kkt);
 void plume_kkt_zero(plume_kkt *kkt);
 
 /// Factors the current values. A Hessian that is not positive definite on the free
-/// unknowns returns PLUME_ERROR_NUMERIC without allow_shift: with constraints, when
-/// H + C^T R C is not positive definite, which (rho_k being 1e6 times the diagonal of H at
-/// the constraint's ends) says that H is not positive definite on the tangent space of
-/// the constraints, the condition for a descent direction of the l1 merit (Nocedal &
-/// Wright, sections 16.2 and 18.3). With allow_shift it factors H + s d I instead, d the
-/// mean of H's diagonal and s the smallest of the ladder first_shift, 10 first_shift, ...,
-/// 1e2 that factors (first_shift below 1e-10 starts at 1e-10); *shift is that s (0 when
-/// H factored as it is).
-plume_status plume_kkt_factor(plume_kkt *kkt, bool allow_shift, double first_shift, double *shift, plume_error *err);
+/// unknowns (with constraints, when H + C^T R C is not positive definite, which, rho_k
+/// being 1e6 times the diagonal of H at the constraint's ends, says that H is not positive
+/// definite on the tangent space of the constraints, the condition for a descent
+/// direction of the l1 merit: Nocedal & Wright, sections 16.2 and 18.3) is shifted:
+/// H + s d I, d the mean of H's diagonal and s the smallest of the ladder first_shift,
+/// 10 first_shift, ... up to largest_shift that factors (first_shift below 1e-10 starts
+/// at 1e-10). *shift is that s, 0 when H factored as it is. PLUME_ERROR_NUMERIC when no
+/// s of the ladder factors (with largest_shift 0: when H does not).
+plume_status plume_kkt_factor(plume_kkt *kkt, double first_shift, double largest_shift, double *shift,
+                              plume_error *err);
 
 /// Solves K [dx; lambda] = rhs with the last factorisation: rhs and solution have
 /// dof_count + constraint_count entries. With constraints, iterative refinement against

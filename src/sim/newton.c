@@ -268,21 +268,33 @@ static plume_status newton_system(plume_sim *sim, const sim_problem *problem, bo
 	return PLUME_OK;
 }
 
+/// The largest shift (kkt.h) an exact Hessian takes; one that needs more is far from
+/// positive definite, and the projected matrix serves better. Measured (Newton iterations
+/// a step, wing-draft.json / Figure 1 at 2.5 mm / at 5 mm): up to 1e2, 8.60 / 6.67 / 4.00;
+/// 1e-3, 8.42 / 6.56 / 4.00; 1e-4, 7.94 / 6.37 / 3.98; 1e-5, 7.78 / 5.94 / 3.97; 1e-6,
+/// 7.66 / 6.25 / 4.12 (the projected fallback alone: 7.59 / stopped / 4.12).
+static const double EXACT_SHIFT_LIMIT = 1e-5;
+/// The projected matrix is positive semidefinite; a shift only settles free rigid motions
+/// (a statics problem with nothing held) and rounding.
+static const double PROJECTED_SHIFT_LIMIT = 1e2;
+
 /// Factors the assembled matrix and solves for the step. An exact Hessian that is not
 /// positive definite on the constraints' tangent space (a compressed barb's curvature, a
-/// vane past its buckling load) is shifted, H + s d I (kkt.h): the Levenberg-Marquardt
-/// step, which is also the trust-region step of some radius (Nocedal & Wright 2006,
-/// Theorem 4.1). Unlike a projected Hessian it keeps the directions that are soft soft and
-/// the one that is negative most eager, so Newton leaves the flat state of a vane past its
-/// buckling load in a few steps instead of crawling away from it (the lab's quadratic
-/// solver found the same, src/lab/quadratic.c). The ladder starts a decade below the last
-/// shift that worked: measured on Figure 1 at 2.5 mm, 896 factorisations were tried from
-/// 1e-10 each time, 542 from a hundredth of the last shift and 456 from a tenth, for the
-/// same 668 iterations; starting at the last shift itself took 1108.
+/// vane past its buckling load) is shifted, H + s d I (kkt.h), when a small shift does it:
+/// the Levenberg-Marquardt step, which is also the trust-region step of some radius
+/// (Nocedal & Wright 2006, Theorem 4.1). Unlike a projected Hessian it keeps the directions
+/// that are soft soft and the one that is negative most eager, so Newton leaves the flat
+/// state of a vane past its buckling load in a few steps instead of crawling away from it
+/// (the lab's quadratic solver found the same, src/lab/quadratic.c). The ladder starts a
+/// decade below the last shift that worked: measured on Figure 1 at 2.5 mm, 896
+/// factorisations were tried from 1e-10 each time, 542 from a hundredth of the last shift
+/// and 456 from a tenth, for the same 668 iterations; starting at the last shift itself
+/// took 1108.
 static plume_status factor_and_solve(plume_sim *sim, bool exact, plume_solve_report *report, plume_error *err)
 {
 	double t0 = omp_get_wtime(), shift;
-	plume_status status = plume_kkt_factor(&sim->kkt, true, exact ? 0.1 * sim->exact_shift : 0, &shift, err);
+	plume_status status = exact ? plume_kkt_factor(&sim->kkt, 0.1 * sim->exact_shift, EXACT_SHIFT_LIMIT, &shift, err)
+	                            : plume_kkt_factor(&sim->kkt, 0, PROJECTED_SHIFT_LIMIT, &shift, err);
 	report->seconds_factor += omp_get_wtime() - t0;
 	if (status != PLUME_OK)
 		return status;
@@ -361,8 +373,8 @@ static plume_status newton(plume_sim *sim, const sim_problem *problem, plume_sol
 		// succeeds on a matrix that is positive definite only to rounding can still give
 		// an ascent step. (With constraints its sign is no test, see above.)
 		if (exact && (status == PLUME_ERROR_NUMERIC || (m == 0 && status == PLUME_OK && slope >= 0))) {
-			// The exact Hessian could not be factored even shifted by 1e2 times its mean
-			// diagonal (kkt.h), or gave an ascent step: project. The exact one is tried again
+			// The exact Hessian needs more than EXACT_SHIFT_LIMIT times its mean diagonal to
+			// factor (kkt.h), or gave an ascent step: project. The exact one is tried again
 			// after a full step (projected Newton alone is linear, too slow on the lab's
 			// locked meshes), and the next solve starts projected.
 			exact = false;
