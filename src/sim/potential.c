@@ -101,9 +101,9 @@ static void evaluate_ff_faces(plume_sim *sim, const plume_vec3 *x, bool gradient
 	for (int e = 0; e < edges; ++e) {
 		plume_vec3 local[4];
 		gather(x, sim->ff_edge_vertices + 4 * e, 4, local);
-		sim->ff_edge_chi[e] = plume_dihedral_angle_derivatives(
-		    local, derivatives ? sim->ff_edge_gradient + 12 * (size_t)e : NULL,
-		    angle_hessians ? sim->ff_edge_hessian + 144 * (size_t)e : NULL);
+		sim->ff_edge_chi[e] =
+		    plume_dihedral_angle_derivatives(local, derivatives ? sim->ff_edge_gradient + 12 * (size_t)e : NULL,
+		                                     angle_hessians ? sim->ff_edge_hessian + 144 * (size_t)e : NULL);
 	}
 	int count = sim->ff_count;
 #pragma omp parallel for schedule(static) if (count >= 4096)
