@@ -22,8 +22,8 @@ static plume_status keep_positions(void *user, int step, double time, const plum
 	return PLUME_OK;
 }
 
-/// Runs a scene of tests/data; a vane shear modulus E_vw > 0 replaces the scene's.
-static plume_scene_summary run_scene(const char *name, double E_vw)
+/// Loads a scene of tests/data (the test fails on an error).
+static plume_scene *load_scene(const char *name)
 {
 	char path[1024];
 	snprintf(path, sizeof path, "%s/tests/data/%s", PLUME_SOURCE_DIR, name);
@@ -31,6 +31,14 @@ static plume_scene_summary run_scene(const char *name, double E_vw)
 	plume_error err = {0};
 	if (plume_scene_load(path, NULL, &scene, &err) != PLUME_OK)
 		fail_msg("%s", err.message);
+	return scene;
+}
+
+/// Runs a scene of tests/data; a vane shear modulus E_vw > 0 replaces the scene's.
+static plume_scene_summary run_scene(const char *name, double E_vw)
+{
+	plume_scene *scene = load_scene(name);
+	plume_error err = {0};
 	if (E_vw > 0)
 		scene->sim.materials[PLUME_MATERIAL_VANE].E_vw = E_vw;
 	plume_scene_summary summary;
@@ -134,12 +142,8 @@ static plume_status watch_vane(void *user, int step, double time, const plume_si
 static void test_figure1_full_amplitude_buckles_without_collapse(void **state)
 {
 	(void)state;
-	char path[1024];
-	snprintf(path, sizeof path, "%s/tests/data/figure1-coarse-anisotropic.json", PLUME_SOURCE_DIR);
-	plume_scene *scene = NULL;
+	plume_scene *scene = load_scene("figure1-coarse-anisotropic.json");
 	plume_error err = {0};
-	if (plume_scene_load(path, NULL, &scene, &err) != PLUME_OK)
-		fail_msg("%s", err.message);
 	plume_material vane = plume_material_vane();
 	scene->sim.materials[PLUME_MATERIAL_VANE].E_vw = vane.E_vw;
 	scene->sim.materials[PLUME_MATERIAL_VANE].compression_coefficient = vane.compression_coefficient;
@@ -197,12 +201,8 @@ static void test_figure1_full_amplitude_buckles_without_collapse(void **state)
 static void test_newton_through_buckling_on_a_finer_mesh(void **state)
 {
 	(void)state;
-	char path[1024];
-	snprintf(path, sizeof path, "%s/tests/data/figure1-fast-pull-fine.json", PLUME_SOURCE_DIR);
-	plume_scene *scene = NULL;
+	plume_scene *scene = load_scene("figure1-fast-pull-fine.json");
 	plume_error err = {0};
-	if (plume_scene_load(path, NULL, &scene, &err) != PLUME_OK)
-		fail_msg("%s", err.message);
 	vane_watch watch = {INFINITY, 0};
 	plume_scene_summary summary;
 	if (plume_scene_run(scene, watch_vane, &watch, &summary, &err) != PLUME_OK)

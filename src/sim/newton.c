@@ -114,13 +114,7 @@ static double add_constraints(plume_sim *sim, const plume_vec3 *x, double *gradi
 					double p = ((a % 3) == (b % 3) ? 1 : 0) - tv[a % 3] * tv[b % 3];
 					block[6 * a + b] = ((a < 3) == (b < 3) ? 1 : -1) * sim->lambda[k] * p / l;
 				}
-			const int *pair = sim->kkt.pair_slots + 21 * k; // upper triangle (kkt.h)
-			for (int a = 0; a < 6; ++a)
-				for (int b = a; b < 6; ++b, ++pair) {
-					int ra = 3 * vertices[a / 3] + a % 3, rb = 3 * vertices[b / 3] + b % 3;
-					if (!sim->fixed[ra] && !sim->fixed[rb])
-						values[*pair] += block[6 * a + b];
-				}
+			plume_sim_scatter_block(sim, values, vertices, 2, sim->kkt.pair_slots + 21 * k, 1, block);
 		}
 	}
 	double norm = 0;

@@ -128,10 +128,8 @@ static bool all_free(const plume_sim *sim, const int *vertices, int count)
 	return true;
 }
 
-/// Adds scale times a symmetric element block (n x n, n = 3 count) into the matrix through
-/// its upper slots (kkt.h), skipping held unknowns.
-static void scatter_block(const plume_sim *sim, double *values, const int *vertices, int count, const int *slots,
-                          double scale, const double *block)
+void plume_sim_scatter_block(const plume_sim *sim, double *values, const int *vertices, int count, const int *slots,
+                             double scale, const double *block)
 {
 	int n = 3 * count;
 	if (all_free(sim, vertices, count)) {
@@ -165,8 +163,8 @@ static void scatter_angle_curvature(plume_sim *sim, double *values)
 				weight[sim->ff_faces[f].edge[i]] += sim->ff_face_weight[3 * f + i];
 	for (int e = 0; e < sim->ff_edge_count; ++e)
 		if (weight[e] != 0)
-			scatter_block(sim, values, sim->ff_edge_vertices + 4 * e, 4, sim->kkt.edge_slots + 78 * (size_t)e,
-			              weight[e], sim->ff_edge_hessian + 144 * (size_t)e);
+			plume_sim_scatter_block(sim, values, sim->ff_edge_vertices + 4 * e, 4, sim->kkt.edge_slots + 78 * (size_t)e,
+			                        weight[e], sim->ff_edge_hessian + 144 * (size_t)e);
 }
 
 static void scatter_gradient(double *gradient, const int *vertices, int count, const double *local)
@@ -207,7 +205,8 @@ double plume_sim_potential(plume_sim *sim, const sim_problem *problem, const plu
 		if (want_gradient)
 			scatter_gradient(gradient, vertices, 3, sim->face_gradient + 9 * f);
 		if (hessian)
-			scatter_block(sim, values, vertices, 3, sim->kkt.face_slots + 45 * f, 1, sim->face_hessian + 81 * f);
+			plume_sim_scatter_block(sim, values, vertices, 3, sim->kkt.face_slots + 45 * f, 1,
+			                        sim->face_hessian + 81 * f);
 	}
 	int size = plume_sim_bending_size(sim), dofs = 3 * size, upper = plume_kkt_upper_size(size);
 	for (int e = 0; sim->def.bending && e < plume_sim_bending_count(sim); ++e) {
@@ -217,8 +216,8 @@ double plume_sim_potential(plume_sim *sim, const sim_problem *problem, const plu
 		if (want_gradient)
 			scatter_gradient(gradient, vertices, size, sim->hinge_gradient + (size_t)dofs * e);
 		if (hessian)
-			scatter_block(sim, values, vertices, size, sim->kkt.bending_slots + (size_t)upper * e, 1,
-			              sim->hinge_hessian + block);
+			plume_sim_scatter_block(sim, values, vertices, size, sim->kkt.bending_slots + (size_t)upper * e, 1,
+			                        sim->hinge_hessian + block);
 	}
 	if (hessian && !project && sim->def.bending && sim->def.bending_model != PLUME_BENDING_PAPER_HINGE)
 		scatter_angle_curvature(sim, values);
@@ -257,7 +256,7 @@ double plume_sim_potential(plume_sim *sim, const sim_problem *problem, const plu
 			for (int a = 0; a < 3; ++a)
 				gradient[3 * i + a] += local_gradient[a];
 		if (hessian)
-			scatter_block(sim, values, &i, 1, sim->kkt.vertex_slots + 6 * i, 1, block);
+			plume_sim_scatter_block(sim, values, &i, 1, sim->kkt.vertex_slots + 6 * i, 1, block);
 	}
 
 	if (contact && plume_contact_any(sim)) {

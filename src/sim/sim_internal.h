@@ -148,6 +148,12 @@ struct plume_sim {
 double plume_sim_potential(plume_sim *sim, const sim_problem *problem, const plume_vec3 *x, double *gradient,
                            bool hessian, bool project);
 
+/// Adds scale times a symmetric element block (n x n, n = 3 count, row-major) into the KKT
+/// matrix's values through the element's upper slots (kkt.h), skipping held unknowns and
+/// absent (negative) vertices.
+void plume_sim_scatter_block(const plume_sim *sim, double *values, const int *vertices, int count, const int *slots,
+                             double scale, const double *block);
+
 /// The bending elements of the sim's model: how many, vertices per element (4 for a
 /// hinge, 6 for a fundamental-form face, -1 entries for absent neighbours), the byte
 /// stride between their vertex lists, element e's vertices and its energy at x.
