@@ -334,7 +334,7 @@ static void test_kkt_factor_reports_indefinite(void **state)
 	plume_kkt_zero(&kkt);
 	for (int v = 0; v < 2; ++v)
 		for (int d = 0; d < 3; ++d)
-			values[kkt.diagonal_slots[3 * v + d]] = 2.0;
+			values[kkt.system.diagonal[3 * v + d]] = 2.0;
 	assert_int_equal(plume_kkt_factor(&kkt, 0, 0, &shift, &err), PLUME_OK);
 	assert_true(shift == 0.0);
 	assert_int_equal(plume_kkt_solve(&kkt, rhs, NULL, x, &err), PLUME_OK);
@@ -345,7 +345,7 @@ static void test_kkt_factor_reports_indefinite(void **state)
 	// first passes 1 at 1 (11/6 added); started at 10, it stops there (110/6 added).
 	for (int first = 0; first <= 1; ++first) {
 		for (int i = 0; i < 6; ++i)
-			values[kkt.diagonal_slots[i]] = i == 5 ? -1.0 : 2.0;
+			values[kkt.system.diagonal[i]] = i == 5 ? -1.0 : 2.0;
 		assert_int_equal(plume_kkt_factor(&kkt, 0, 0, &shift, &err), PLUME_ERROR_NUMERIC);
 		assert_non_null(strstr(err.message, "not positive definite"));
 		assert_int_equal(plume_kkt_factor(&kkt, first ? 10.0 : 0.0, 1e2, &shift, &err), PLUME_OK);
@@ -356,14 +356,14 @@ static void test_kkt_factor_reports_indefinite(void **state)
 	}
 	// A ladder that stops below the shift it needs fails.
 	for (int i = 0; i < 6; ++i)
-		values[kkt.diagonal_slots[i]] = i == 5 ? -1.0 : 2.0;
+		values[kkt.system.diagonal[i]] = i == 5 ? -1.0 : 2.0;
 	assert_int_equal(plume_kkt_factor(&kkt, 0, 0.1, &shift, &err), PLUME_ERROR_NUMERIC);
 	assert_non_null(strstr(err.message, "even after regularisation"));
 
 	plume_kkt_zero(&kkt);
 	for (int v = 0; v < 2; ++v)
 		for (int d = 0; d < 3; ++d)
-			values[kkt.diagonal_slots[3 * v + d]] = v == 1 && d == 1 ? NAN : 2.0;
+			values[kkt.system.diagonal[3 * v + d]] = v == 1 && d == 1 ? NAN : 2.0;
 	assert_int_equal(plume_kkt_factor(&kkt, 0, 0, &shift, &err), PLUME_ERROR_NUMERIC);
 	plume_kkt_free(&kkt);
 }
@@ -384,13 +384,13 @@ static void test_kkt_factor_inertia(void **state)
 		plume_kkt_zero(&kkt);
 		for (int v = 0; v < 2; ++v)
 			for (int d = 0; d < 3; ++d)
-				values[kkt.diagonal_slots[3 * v + d]] = 2.0;
+				values[kkt.system.diagonal[3 * v + d]] = 2.0;
 		values[kkt.constraint_slots[0]] = -1.0;
 		values[kkt.constraint_slots[3]] = 1.0;
 		// Trial 0: H_x0x0 = -1 makes H indefinite, but the tangent space sees x0 only with
 		// x1 ((-1 + 2) / 2 > 0 along x0 = x1): accepted. Trial 1: H_y0y0 = -1 is a tangent
 		// direction: refused.
-		values[kkt.diagonal_slots[trial]] = -1.0;
+		values[kkt.system.diagonal[trial]] = -1.0;
 		plume_status status = plume_kkt_factor(&kkt, 0, 0, &shift, &err);
 		if (trial == 1) {
 			assert_int_equal(status, PLUME_ERROR_NUMERIC);
@@ -491,6 +491,74 @@ static void test_shared_edge_bending_matches_finite_differences(void **state)
 	plume_mesh_destroy(mesh);
 }
 
+/// y = A x for the grid Laplacian plus the identity, A = 5 I - (the four neighbours), on
+/// an m x m grid (unknown i = m r + c), written from the stencil.
+static void grid_operator(int m, const double *x, double *y)
+{
+	for (int r = 0; r < m; ++r)
+		for (int c = 0; c < m; ++c) {
+			int i = m * r + c;
+			y[i] = 5 * x[i] - (r > 0 ? x[i - m] : 0) - (r + 1 < m ? x[i + m] : 0) - (c > 0 ? x[i - 1] : 0) -
+			       (c + 1 < m ? x[i + 1] : 0);
+		}
+}
+
+/// The grid matrix through plume_sparse, factored, solved and multiplied; returns whether
+/// CHOLMOD chose its supernodal factorisation.
+static bool check_grid_system(int m)
+{
+	int n = m * m;
+	plume_sparse_entry *entries = malloc(sizeof *entries * 3 * (size_t)n);
+	double *x = malloc(sizeof(double) * (size_t)n), *b = malloc(sizeof(double) * (size_t)n);
+	double *y = calloc((size_t)n, sizeof(double));
+	assert_true(entries && x && b && y);
+	int count = 0;
+	for (int i = 0; i < n; ++i) {
+		entries[count++] = (plume_sparse_entry){i, i};
+		if (i % m + 1 < m)
+			entries[count++] = (plume_sparse_entry){i + 1, i};
+		if (i + m < n)
+			entries[count++] = (plume_sparse_entry){i + m, i};
+	}
+	plume_sparse matrix;
+	plume_error err = {0};
+	assert_int_equal(plume_sparse_init(&matrix, n, entries, (size_t)count, true, "the grid", &err), PLUME_OK);
+	double *values = matrix.matrix->x;
+	for (int i = 0; i < n; ++i) {
+		values[matrix.diagonal[i]] = 5;
+		if (i % m + 1 < m)
+			values[plume_sparse_find(&matrix, i + 1, i)] = -1; // either order finds the entry
+		if (i + m < n)
+			values[plume_sparse_find(&matrix, i, i + m)] = -1;
+		x[i] = sin(0.37 * i) + 0.1 * i / n;
+	}
+	// The stored triangle is the one the factorisation reads in place (sim/sparse.h).
+	bool supernodal = matrix.factor->is_super;
+	assert_int_equal(matrix.matrix->stype, supernodal ? -1 : 1);
+	grid_operator(m, x, b);
+	plume_sparse_multiply_add(&matrix, x, y);
+	for (int i = 0; i < n; ++i)
+		assert_true(fabs(y[i] - b[i]) <= 1e-12 * 6);
+	assert_true(plume_sparse_factor(&matrix));
+	memcpy(matrix.rhs->x, b, sizeof(double) * (size_t)n);
+	assert_true(plume_sparse_solve(&matrix));
+	const double *solved = matrix.solution->x;
+	for (int i = 0; i < n; ++i)
+		assert_true(fabs(solved[i] - x[i]) <= 1e-12);
+	plume_sparse_free(&matrix);
+	free(entries), free(x), free(b), free(y);
+	return supernodal;
+}
+
+static void test_sparse_simplicial_and_supernodal(void **state)
+{
+	(void)state;
+	// A small grid factors simplicially, a large one supernodally (CHOLMOD_AUTO); both
+	// solve A x = b to rounding (A is well conditioned: its eigenvalues lie in [1, 9]).
+	assert_false(check_grid_system(6));
+	assert_true(check_grid_system(120));
+}
+
 /// Factors a 3 x 3 diagonal matrix 2000 times; returns non-NULL when every one succeeded,
 /// and then the calling thread's OpenMP limit must be what it was (the next test).
 static void *factor_repeatedly(void *unused)
@@ -571,6 +639,7 @@ int main(void)
 	    cmocka_unit_test(test_kkt_factor_reports_indefinite),
 	    cmocka_unit_test(test_shared_edge_bending_matches_finite_differences),
 	    cmocka_unit_test(test_factorisation_restores_openmp_levels),
+	    cmocka_unit_test(test_sparse_simplicial_and_supernodal),
 	    cmocka_unit_test(test_kkt_factor_inertia),
 	    cmocka_unit_test(test_bad_definitions),
 	};

@@ -409,15 +409,14 @@ static bool factor_newton_matrix(plume_quadratic *m)
 		return true;
 	}
 	double *values = m->system.matrix->x;
-	const int *p = m->system.matrix->p;
+	const int *slots = m->system.diagonal;
 	int n = m->free_count;
-	// The diagonal is the last entry of each upper-triangle column.
 	for (int j = 0; j < n; ++j)
-		m->diagonal[j] = values[p[j + 1] - 1];
+		m->diagonal[j] = values[slots[j]];
 	double mu = m->shift > 0.0 ? 0.01 * m->shift : 1e-10;
 	for (; mu <= 1e4; mu *= 10.0) {
 		for (int j = 0; j < n; ++j)
-			values[p[j + 1] - 1] = m->diagonal[j] + mu * fabs(m->diagonal[j]);
+			values[slots[j]] = m->diagonal[j] + mu * fabs(m->diagonal[j]);
 		if (plume_sparse_factor(&m->system)) {
 			m->shift = mu;
 			return true;

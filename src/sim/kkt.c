@@ -112,7 +112,6 @@ static plume_status build(plume_kkt *kkt, int vertex_count, int face_count, cons
 	const plume_sparse *matrix = &kkt->system;
 
 	size_t vertices = (size_t)(vertex_count > 0 ? vertex_count : 1);
-	kkt->diagonal_slots = plume_alloc(sizeof(int) * 3 * vertices);
 	kkt->vertex_slots = plume_alloc(sizeof(int) * 6 * vertices);
 	kkt->face_slots = plume_alloc(sizeof(int) * 45 * (size_t)(face_count > 0 ? face_count : 1));
 	int block = plume_kkt_upper_size(bending_size);
@@ -125,13 +124,11 @@ static plume_status build(plume_kkt *kkt, int vertex_count, int face_count, cons
 	kkt->augment_slots = plume_alloc(sizeof(int) * 21 * constraints);
 	kkt->rho = plume_alloc(sizeof(double) * constraints);
 	kkt->position_slots = plume_alloc(sizeof(int) * (size_t)(position_entries > 0 ? position_entries : 1));
-	if (!kkt->diagonal_slots || !kkt->vertex_slots || !kkt->face_slots || !kkt->bending_slots || !kkt->edge_slots ||
-	    !kkt->constraint_slots || !kkt->pair_slots || !kkt->augment_slots || !kkt->rho || !kkt->position_slots) {
+	if (!kkt->vertex_slots || !kkt->face_slots || !kkt->bending_slots || !kkt->edge_slots || !kkt->constraint_slots ||
+	    !kkt->pair_slots || !kkt->augment_slots || !kkt->rho || !kkt->position_slots) {
 		plume_kkt_free(kkt);
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory allocating the solver's slot maps");
 	}
-	for (int i = 0; i < kkt->dof_count; ++i)
-		kkt->diagonal_slots[i] = plume_sparse_find(matrix, i, i);
 	for (int v = 0; v < vertex_count; ++v)
 		fill_upper_slots(matrix, &v, 1, kkt->vertex_slots + 6 * v);
 	for (int f = 0; f < face_count; ++f)
@@ -187,7 +184,6 @@ void plume_kkt_free(plume_kkt *kkt)
 	plume_free(kkt->position_slots);
 	plume_free(kkt->augment_slots);
 	plume_free(kkt->rho);
-	plume_free(kkt->diagonal_slots);
 	plume_free(kkt->vertex_slots);
 	plume_free(kkt->face_slots);
 	plume_free(kkt->bending_slots);
@@ -211,7 +207,7 @@ static double mean_position_diagonal(const plume_kkt *kkt)
 	const double *values = kkt->system.matrix->x;
 	double sum = 0;
 	for (int i = 0; i < kkt->dof_count; ++i)
-		sum += fabs(values[kkt->diagonal_slots[i]]);
+		sum += fabs(values[kkt->system.diagonal[i]]);
 	return kkt->dof_count > 0 ? sum / kkt->dof_count : 1;
 }
 
@@ -219,7 +215,7 @@ static void shift_positions(plume_kkt *kkt, double amount)
 {
 	double *values = kkt->system.matrix->x;
 	for (int i = 0; i < kkt->dof_count; ++i)
-		values[kkt->diagonal_slots[i]] += amount;
+		values[kkt->system.diagonal[i]] += amount;
 }
 
 /// The smallest shift a ladder starts from: below it a shift is lost to rounding against
@@ -249,7 +245,7 @@ static void load_positions(plume_kkt *kkt)
 		for (int a = 0; a < 6; ++a) {
 			c[a] = stored[kkt->constraint_slots[6 * k + a]];
 			if (c[a] != 0)
-				diagonal = fmax(diagonal, fabs(stored[kkt->diagonal_slots[3 * vertices[a / 3] + a % 3]]));
+				diagonal = fmax(diagonal, fabs(stored[kkt->system.diagonal[3 * vertices[a / 3] + a % 3]]));
 		}
 		double rho = kkt->rho[k] = AUGMENTATION * (diagonal > 0 ? diagonal : 1);
 		const int *slots = kkt->augment_slots + 21 * k;

@@ -31,7 +31,8 @@
 
 typedef struct plume_kkt {
 	/// K, stored (upper triangle, natural order, values rewritten every iteration): the
-	/// callers add into its slots.
+	/// callers add into its slots; system.diagonal[i] is the slot of position unknown i's
+	/// diagonal entry.
 	plume_sparse system;
 	/// H + C^T R C over the position unknowns, factored.
 	plume_sparse positions;
@@ -47,7 +48,6 @@ typedef struct plume_kkt {
 	int *edge_slots;       ///< 78 per shared edge (4 vertices)
 	int bending_size;      ///< k: 4 (hinge) or 6 (fundamental-form face)
 	int *vertex_slots;     ///< 6 per vertex
-	int *diagonal_slots;   ///< 1 per position unknown: its diagonal entry
 	int *constraint_slots; ///< 6 per constraint: its row of C
 	int *pair_slots;       ///< 21 per constraint: the 6x6 position block of its two vertices
 	double *refine;        ///< scratch for iterative refinement (3 x size)

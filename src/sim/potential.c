@@ -268,7 +268,7 @@ double plume_sim_potential(plume_sim *sim, const sim_problem *problem, const plu
 	if (hessian)
 		for (int i = 0; i < 3 * n; ++i)
 			if (sim->fixed[i])
-				values[sim->kkt.diagonal_slots[i]] = 1;
+				values[sim->kkt.system.diagonal[i]] = 1;
 	return isfinite(energy) ? energy : NAN;
 }
 

@@ -35,12 +35,15 @@ typedef struct plume_sparse {
 	/// the position of unknown i.
 	int *permutation;
 	int *inverse;
-	/// P A P^T, upper triangle (stype 1), CSC with sorted rows, factored in its natural
-	/// order: CHOLMOD's simplicial factorisation of a matrix it must permute copies and
-	/// transposes it twice per call (10 % of a factorisation on Figure 1); this one it
-	/// reads in place. The caller writes the values, at plume_sparse_find's slots; row
-	/// and column k are unknown permutation[k].
+	/// P A P^T, one triangle, CSC with sorted rows, factored in its natural order: the
+	/// triangle the factorisation reads in place, the upper one (stype 1) for CHOLMOD's
+	/// simplicial factorisation and for a stored-only matrix, the lower one (stype -1)
+	/// for its supernodal one. (Given a matrix it must permute, the simplicial code copies
+	/// and transposes it twice per call, 10 % of a factorisation on Figure 1; given the
+	/// other triangle, either code transposes it once.) The caller writes the values, at
+	/// plume_sparse_find's slots; row and column k are unknown permutation[k].
 	cholmod_sparse *matrix;
+	int *diagonal;          ///< per unknown i, the slot of A(i, i), or -1 when it is not in the pattern
 	cholmod_factor *factor; ///< NULL for a stored-only matrix
 	/// Right-hand side (the caller writes it) and solution, in the caller's order; the
 	/// same permuted, and CHOLMOD's workspace, kept between solves.
