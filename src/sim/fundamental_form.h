@@ -123,8 +123,9 @@ void plume_ff_face_link(plume_ff_face *face, int i, int edge, const int stencil[
 
 /// The face's energy from the interior edges' angles (chi, one per edge) and gradients (12
 /// per edge, the edge's stencil order), with its gradient (18) and Gauss-Newton Hessian
-/// J^T M J (324), either may be NULL, and weight[i], the weight of edge i's angle Hessian
-/// in the face's exact Hessian (0 on the boundary):
+/// J^T M J (324, row-major: only its upper triangle, row r and columns c >= r, is
+/// written, the part the solver reads), either may be NULL, and weight[i], the weight of
+/// edge i's angle Hessian in the face's exact Hessian (0 on the boundary):
 ///   plume_ff_face_energy's Hessian = J^T M J + sum_i weight[i] Hess chi_{edge[i]}.
 /// Every interior edge of the face must be linked.
 double plume_ff_face_energy_from_edges(const plume_ff_face *face, const double *chi, const double *gradients,
