@@ -43,16 +43,6 @@ void plume_pair_list_free(plume_pair_list *list)
 
 static double component(plume_vec3 v, int axis) { return axis == 0 ? v.x : axis == 1 ? v.y : v.z; }
 
-static plume_aabb merge(plume_aabb a, plume_aabb b)
-{
-	plume_aabb m;
-	m.lower = plume_v3(a.lower.x < b.lower.x ? a.lower.x : b.lower.x, a.lower.y < b.lower.y ? a.lower.y : b.lower.y,
-	                   a.lower.z < b.lower.z ? a.lower.z : b.lower.z);
-	m.upper = plume_v3(a.upper.x > b.upper.x ? a.upper.x : b.upper.x, a.upper.y > b.upper.y ? a.upper.y : b.upper.y,
-	                   a.upper.z > b.upper.z ? a.upper.z : b.upper.z);
-	return m;
-}
-
 static int overlap(const plume_aabb *a, const plume_aabb *b)
 {
 	return a->lower.x <= b->upper.x && b->lower.x <= a->upper.x && a->lower.y <= b->upper.y &&
@@ -159,7 +149,7 @@ static int build_node(bvh_build *build, int begin, int end)
 	}
 	plume_aabb bounds = {build->items[begin].centre, build->items[begin].centre};
 	for (int i = begin + 1; i < end; ++i)
-		bounds = merge(bounds, (plume_aabb){build->items[i].centre, build->items[i].centre});
+		bounds = plume_aabb_merge(bounds, (plume_aabb){build->items[i].centre, build->items[i].centre});
 	plume_vec3 extent = plume_v3_sub(bounds.upper, bounds.lower);
 	int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : extent.y >= extent.z ? 1 : 2;
 	int middle = begin + (end - begin) / 2;
@@ -170,7 +160,7 @@ static int build_node(bvh_build *build, int begin, int end)
 	node->left = left;
 	node->right = right;
 	node->item = -1;
-	node->box = merge(build->nodes[left].box, build->nodes[right].box);
+	node->box = plume_aabb_merge(build->nodes[left].box, build->nodes[right].box);
 	return index;
 }
 
@@ -226,7 +216,7 @@ void plume_bvh_refit(plume_bvh *bvh, const plume_aabb *boxes)
 			PLUME_ASSERT(valid_box(boxes[node->item]));
 			node->box = boxes[node->item];
 		} else {
-			node->box = merge(bvh->nodes[node->left].box, bvh->nodes[node->right].box);
+			node->box = plume_aabb_merge(bvh->nodes[node->left].box, bvh->nodes[node->right].box);
 		}
 	}
 }

@@ -11,6 +11,18 @@ typedef struct plume_aabb {
 	plume_vec3 upper;
 } plume_aabb;
 
+/// The smallest box holding a and b, by comparisons (one minsd / maxsd per bound: libm's
+/// fmin and fmax are calls, with their NaN rules, which GCC does not inline).
+static inline plume_aabb plume_aabb_merge(plume_aabb a, plume_aabb b)
+{
+	plume_aabb m;
+	m.lower = plume_v3(a.lower.x < b.lower.x ? a.lower.x : b.lower.x, a.lower.y < b.lower.y ? a.lower.y : b.lower.y,
+	                   a.lower.z < b.lower.z ? a.lower.z : b.lower.z);
+	m.upper = plume_v3(a.upper.x > b.upper.x ? a.upper.x : b.upper.x, a.upper.y > b.upper.y ? a.upper.y : b.upper.y,
+	                   a.upper.z > b.upper.z ? a.upper.z : b.upper.z);
+	return m;
+}
+
 /// A growable list of index pairs, owned by the caller (plume_pair_list_free).
 typedef struct plume_pair_list {
 	int count;

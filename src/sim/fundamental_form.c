@@ -173,9 +173,9 @@ static void mirror_upper(double hessian[324])
 }
 
 // Energy 1/2 dchi^T M dchi, gradient (M dchi)^T J and the Gauss-Newton Hessian J^T M J
-// (its upper triangle) from the three edges' views (J: the stencil gradients of the scaled angle changes,
-// 3 x 18), and each edge's weight (M dchi)_i s_i sign_i: the exact Hessian is
-// J^T M J + sum_i weight_i Hess chi_i (plume_ff_face_energy_from_edges).
+// (its upper triangle) from the three edges' views (J: the stencil gradients of the
+// scaled angle changes, 3 x 18), and each edge's weight (M dchi)_i s_i sign_i: the exact
+// Hessian is J^T M J + sum_i weight_i Hess chi_i (plume_ff_face_energy_from_edges).
 static double combine(const plume_ff_face *face, const edge_view view[3], double gradient[18], double hessian[324],
                       double weight[3])
 {
