@@ -4,8 +4,8 @@
 // stored (its values assembled, multiplied, never factored).
 //
 // Simplicial or supernodal is CHOLMOD's choice per pattern (CHOLMOD_AUTO: supernodal
-// when the factor's flops per entry make dense kernels pay, from about e = 2.5 mm on
-// Figure 1's meshes); the supernodal kernels run in the BLAS, OpenBLAS on Debian
+// when the factor's flops per entry make dense kernels pay, on every Figure 1 mesh
+// from e = 5 mm on, perf shows); the supernodal kernels run in the BLAS, OpenBLAS on Debian
 // (scripts/deps.sh), held to one thread so that the bits never depend on the thread
 // count (docs/simulation.md, "Linear algebra"). The fill-reducing ordering (the
 // cheapest of AMD and two nested dissections, chosen once per pattern) is applied to
