@@ -9,7 +9,11 @@
 // scalar c (an edge length or a projection onto the edge) times m = n / |n|^2 for a face
 // normal n, so the exact Hessian is the sum of m (dc)^T + c dm with
 // dm = (I - 2 n^ n^T) dn / |n|^2 and dn a cross-product matrix (Tamstorf & Grinspun 2013
-// derive the same Hessian in another form). No Gauss-Newton approximation.
+// derive the same Hessian in another form). No Gauss-Newton approximation. It is built by
+// 3 x 3 vertex blocks, each face's over its own three vertices (the wings share no face, so
+// their block is zero): half the time of the dense 3 x 12 form it replaced, whose zeroed
+// temporaries and strided mirror stores made the angle's Hessian the largest item of the
+// fundamental-form assembly.
 #include "sim/bending.h"
 
 #include <math.h>
@@ -31,49 +35,15 @@ double plume_bending_modulus(double along, double across, double beta)
 
 double plume_dihedral_angle(const plume_vec3 x[4]) { return plume_dihedral_angle_derivatives(x, NULL, NULL); }
 
-// Adds the 3x3 block s [v]x (the matrix of u -> s v x u) into the 3 x 12 matrix D at vertex k.
-static void add_cross_block(double D[36], int k, const double v[3], double s)
+/// dm/dx_j for m = n / |n|^2, where dn/dx_j = [a]x (the matrix of u -> a x u):
+/// (I - 2 n n^T / |n|^2) [a]x / |n|^2 = ([a]x - 2 n (n x a)^T / |n|^2) / |n|^2, row-major.
+static void normal_over_square_block(const double n[3], double inverse_square, const double a[3], double q[9])
 {
-	// [v]x = [[0, -vz, vy], [vz, 0, -vx], [-vy, vx, 0]]
-	D[0 * 12 + 3 * k + 1] += -s * v[2];
-	D[0 * 12 + 3 * k + 2] += s * v[1];
-	D[1 * 12 + 3 * k + 0] += s * v[2];
-	D[1 * 12 + 3 * k + 2] += -s * v[0];
-	D[2 * 12 + 3 * k + 0] += -s * v[1];
-	D[2 * 12 + 3 * k + 1] += s * v[0];
-}
-
-// dm/dx (3 x 12) for m = n / |n|^2 given dn/dx (3 x 12).
-static void normal_over_square_derivative(const double n[3], const double dn[36], double dm[36])
-{
-	// One division, not two per entry: 144 divisions an edge were a sixth of the angle's Hessian.
-	double inverse = 1.0 / (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-	for (int a = 0; a < 3; ++a) {
-		for (int c = 0; c < 12; ++c) {
-			// (I - 2 n n^T / |n|^2) dn / |n|^2
-			double ndn = n[0] * dn[c] + n[1] * dn[12 + c] + n[2] * dn[24 + c];
-			dm[12 * a + c] = (dn[12 * a + c] - 2.0 * n[a] * ndn * inverse) * inverse;
-		}
-	}
-}
-
-// Gradient of s = (x_y - x_z) . e^ over the 12 coordinates (e = x1 - x0), added with
-// factor sign into ds.
-static void add_projection_gradient(double ds[12], int y, int z, const double *p, const double ehat[3], double length,
-                                    double sign)
-{
-	double d[3], along = 0.0;
-	for (int a = 0; a < 3; ++a) {
-		d[a] = p[3 * y + a] - p[3 * z + a];
-		along += d[a] * ehat[a];
-	}
-	for (int a = 0; a < 3; ++a) {
-		double perpendicular = (d[a] - along * ehat[a]) / length; // (I - e^ e^T) d / |e|
-		ds[3 * y + a] += sign * ehat[a];
-		ds[3 * z + a] -= sign * ehat[a];
-		ds[3 * 1 + a] += sign * perpendicular;
-		ds[3 * 0 + a] -= sign * perpendicular;
-	}
+	double na[3] = {n[1] * a[2] - n[2] * a[1], n[2] * a[0] - n[0] * a[2], n[0] * a[1] - n[1] * a[0]};
+	double cross[9] = {0, -a[2], a[1], a[2], 0, -a[0], -a[1], a[0], 0};
+	for (int r = 0; r < 3; ++r)
+		for (int c = 0; c < 3; ++c)
+			q[3 * r + c] = (cross[3 * r + c] - 2.0 * n[r] * na[c] * inverse_square) * inverse_square;
 }
 
 double plume_dihedral_angle_derivatives(const plume_vec3 x[4], double gradient[12], double hessian[144])
@@ -100,82 +70,96 @@ double plume_dihedral_angle_derivatives(const plume_vec3 x[4], double gradient[1
 	if (!gradient && !hessian)
 		return angle;
 
-	double p[12], n[2][3], m[2][3], ehat[3];
+	// Face f (A: wing x2, B: wing x3) holds vertices 0, 1 and its wing w = 2 + f.
+	double p[12], n[2][3], m[2][3], ehat[3], square[2] = {nA2, nB2};
 	for (int i = 0; i < 4; ++i)
 		vec_of(x[i], p + 3 * i);
 	vec_of(nA, n[0]);
 	vec_of(nB, n[1]);
 	vec_of(ehat_v, ehat);
-	for (int a = 0; a < 3; ++a) {
-		m[0][a] = n[0][a] / nA2;
-		m[1][a] = n[1][a] / nB2;
+	// Coefficients c[f][i] of m_f in the gradient of vertex i (zero at the other face's wing).
+	double c[2][3];
+	for (int f = 0; f < 2; ++f) {
+		const double *w = p + 3 * (2 + f);
+		double from1 = 0.0, from0 = 0.0; // (w - x1) . e^, (w - x0) . e^
+		for (int a = 0; a < 3; ++a) {
+			// A division, not a product with 1 / |n|^2: the gradient's bits are those it always
+			// had (scenes solved to their roundoff floor stay where they were).
+			m[f][a] = n[f][a] / square[f];
+			from1 += (w[a] - p[3 + a]) * ehat[a];
+			from0 += (w[a] - p[a]) * ehat[a];
+		}
+		c[f][0] = from1;
+		c[f][1] = -from0;
+		c[f][2] = length;
 	}
-	// Coefficients c[f][i] of m_f in the gradient of vertex i, and their gradients dc.
-	double c[2][4], dc[2][4][12];
-	memset(dc, 0, sizeof dc);
-	double pA0 = 0.0, pA1 = 0.0, pB0 = 0.0, pB1 = 0.0;
-	for (int a = 0; a < 3; ++a) {
-		pA0 += (p[6 + a] - p[3 + a]) * ehat[a]; // (x2 - x1) . e^
-		pA1 += (p[6 + a] - p[a]) * ehat[a];     // (x2 - x0) . e^
-		pB0 += (p[9 + a] - p[3 + a]) * ehat[a]; // (x3 - x1) . e^
-		pB1 += (p[9 + a] - p[a]) * ehat[a];     // (x3 - x0) . e^
-	}
-	c[0][0] = pA0;
-	c[0][1] = -pA1;
-	c[0][2] = length;
-	c[0][3] = 0.0;
-	c[1][0] = pB0;
-	c[1][1] = -pB1;
-	c[1][2] = 0.0;
-	c[1][3] = length;
 	if (gradient) {
-		for (int i = 0; i < 4; ++i)
-			for (int a = 0; a < 3; ++a)
-				gradient[3 * i + a] = c[0][i] * m[0][a] + c[1][i] * m[1][a];
+		for (int a = 0; a < 3; ++a) {
+			gradient[a] = c[0][0] * m[0][a] + c[1][0] * m[1][a];
+			gradient[3 + a] = c[0][1] * m[0][a] + c[1][1] * m[1][a];
+			gradient[6 + a] = c[0][2] * m[0][a];
+			gradient[9 + a] = c[1][2] * m[1][a];
+		}
 	}
 	if (!hessian)
 		return angle;
 
-	add_projection_gradient(dc[0][0], 2, 1, p, ehat, length, 1.0);
-	add_projection_gradient(dc[0][1], 2, 0, p, ehat, length, -1.0);
-	add_projection_gradient(dc[1][0], 3, 1, p, ehat, length, 1.0);
-	add_projection_gradient(dc[1][1], 3, 0, p, ehat, length, -1.0);
-	for (int a = 0; a < 3; ++a) {
-		// d|e| = e^ . (dx1 - dx0)
-		dc[0][2][3 + a] = ehat[a];
-		dc[0][2][a] = -ehat[a];
-		dc[1][3][3 + a] = ehat[a];
-		dc[1][3][a] = -ehat[a];
+	// The Hessian's 3x3 block (i, j) is the sum over the faces holding both vertices of
+	// m_f (dc_f[i]/dx_j)^T + c_f[i] dm_f/dx_j. With the wing's offset perpendicular to
+	// the edge, u_f = (I - e^ e^T)(w - x0) / |e| (the same from x1), the coefficients'
+	// gradients (rows i = 0, 1, wing; columns j = 0, 1, wing) are
+	//   c_f[0] = (w - x1) . e^:  -u_f,       u_f - e^,  e^
+	//   c_f[1] = -(w - x0) . e^: u_f + e^,  -u_f,      -e^
+	//   c_f[2] = |e|:            -e^,        e^,        0
+	// and dn_f/dx_j = [a_j]x with, for n_A = (x2 - x0) x (x2 - x1), a = x2 - x1,
+	// -(x2 - x0), e, and for n_B = (x3 - x1) x (x3 - x0), a = -(x3 - x1), x3 - x0, -e.
+	// The two wings share no face: block (2, 3) is zero.
+	double dc[2][3][3][3], q[2][3][9];
+	for (int f = 0; f < 2; ++f) {
+		const double *w = p + 3 * (2 + f);
+		double sign = f == 0 ? 1.0 : -1.0, u[3], a[3][3], along = 0.0;
+		for (int k = 0; k < 3; ++k)
+			along += (w[k] - p[k]) * ehat[k];
+		for (int k = 0; k < 3; ++k) {
+			u[k] = (w[k] - p[k] - along * ehat[k]) / length;
+			a[0][k] = sign * (w[k] - p[3 + k]);
+			a[1][k] = -sign * (w[k] - p[k]);
+			a[2][k] = sign * (p[3 + k] - p[k]);
+			dc[f][0][0][k] = -u[k];
+			dc[f][0][1][k] = u[k] - ehat[k];
+			dc[f][0][2][k] = ehat[k];
+			dc[f][1][0][k] = u[k] + ehat[k];
+			dc[f][1][1][k] = -u[k];
+			dc[f][1][2][k] = -ehat[k];
+			dc[f][2][0][k] = -ehat[k];
+			dc[f][2][1][k] = ehat[k];
+			dc[f][2][2][k] = 0.0;
+		}
+		for (int j = 0; j < 3; ++j)
+			normal_over_square_block(n[f], 1.0 / square[f], a[j], q[f][j]);
 	}
-	// dn/dx: n_A = (x2 - x0) x (x2 - x1) gives [x2 - x1]x at x0, -[x2 - x0]x at x1, [e]x at x2;
-	// n_B = (x3 - x1) x (x3 - x0) gives -[x3 - x1]x at x0, [x3 - x0]x at x1, -[e]x at x3.
-	double dn[2][36], dm[2][36];
-	memset(dn, 0, sizeof dn);
-	double x21[3], x20[3], x31[3], x30[3];
-	for (int a = 0; a < 3; ++a) {
-		x21[a] = p[6 + a] - p[3 + a];
-		x20[a] = p[6 + a] - p[a];
-		x31[a] = p[9 + a] - p[3 + a];
-		x30[a] = p[9 + a] - p[a];
-	}
-	double e[3] = {p[3] - p[0], p[4] - p[1], p[5] - p[2]};
-	add_cross_block(dn[0], 0, x21, 1.0);
-	add_cross_block(dn[0], 1, x20, -1.0);
-	add_cross_block(dn[0], 2, e, 1.0);
-	add_cross_block(dn[1], 0, x31, -1.0);
-	add_cross_block(dn[1], 1, x30, 1.0);
-	add_cross_block(dn[1], 3, e, -1.0);
-	normal_over_square_derivative(n[0], dn[0], dm[0]);
-	normal_over_square_derivative(n[1], dn[1], dm[1]);
-	// The exact Hessian is symmetric: its upper triangle, mirrored.
+	// Blocks with i <= j, written with their mirror (j, i); a diagonal block's upper
+	// triangle is mirrored too, so the Hessian is exactly symmetric.
+	static const int slot_in_face[2][4] = {{0, 1, 2, -1}, {0, 1, -1, 2}};
 	for (int i = 0; i < 4; ++i) {
-		for (int a = 0; a < 3; ++a) {
-			int r = 3 * i + a;
-			for (int col = r; col < 12; ++col) {
-				double h = m[0][a] * dc[0][i][col] + c[0][i] * dm[0][12 * a + col] + m[1][a] * dc[1][i][col] +
-				           c[1][i] * dm[1][12 * a + col];
-				hessian[12 * r + col] = hessian[12 * col + r] = h;
+		for (int j = i; j < 4; ++j) {
+			double block[9] = {0};
+			for (int f = 0; f < 2; ++f) {
+				int fi = slot_in_face[f][i], fj = slot_in_face[f][j];
+				if (fi < 0 || fj < 0)
+					continue;
+				const double *g = dc[f][fi][fj], *qj = q[f][fj];
+				for (int r = 0; r < 3; ++r)
+					for (int col = 0; col < 3; ++col)
+						block[3 * r + col] += m[f][r] * g[col] + c[f][fi] * qj[3 * r + col];
 			}
+			for (int r = 0; r < 3; ++r)
+				for (int col = 0; col < 3; ++col) {
+					if (i == j && col < r)
+						continue;
+					hessian[12 * (3 * i + r) + 3 * j + col] = hessian[12 * (3 * j + col) + 3 * i + r] =
+					    block[3 * r + col];
+				}
 		}
 	}
 	return angle;
