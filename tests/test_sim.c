@@ -337,7 +337,7 @@ static void test_kkt_factor_reports_indefinite(void **state)
 			values[kkt.system.diagonal[3 * v + d]] = 2.0;
 	assert_int_equal(plume_kkt_factor(&kkt, 0, 0, &shift, &err), PLUME_OK);
 	assert_true(shift == 0.0);
-	assert_int_equal(plume_kkt_solve(&kkt, rhs, NULL, x, &err), PLUME_OK);
+	assert_int_equal(plume_kkt_solve(&kkt, rhs, NULL, 1e-14, x, &err), PLUME_OK);
 	for (int i = 0; i < 6; ++i)
 		assert_close(x[i], rhs[i] / 2.0, 1e-15);
 
@@ -350,7 +350,7 @@ static void test_kkt_factor_reports_indefinite(void **state)
 		assert_non_null(strstr(err.message, "not positive definite"));
 		assert_int_equal(plume_kkt_factor(&kkt, first ? 10.0 : 0.0, 1e2, &shift, &err), PLUME_OK);
 		assert_close(shift, first ? 10.0 : 1.0, 1e-12);
-		assert_int_equal(plume_kkt_solve(&kkt, rhs, NULL, x, &err), PLUME_OK);
+		assert_int_equal(plume_kkt_solve(&kkt, rhs, NULL, 1e-14, x, &err), PLUME_OK);
 		assert_close(x[5], 6.0 / (shift * 11.0 / 6.0 - 1.0), 1e-12);
 		assert_close(x[0], 1.0 / (2.0 + shift * 11.0 / 6.0), 1e-12);
 	}
@@ -399,7 +399,7 @@ static void test_kkt_factor_inertia(void **state)
 		}
 		assert_int_equal(status, PLUME_OK);
 		double rhs[7] = {1, 2, 3, 4, 5, 6, 0.5}, x[7];
-		assert_int_equal(plume_kkt_solve(&kkt, rhs, NULL, x, &err), PLUME_OK);
+		assert_int_equal(plume_kkt_solve(&kkt, rhs, NULL, 1e-14, x, &err), PLUME_OK);
 		assert_close(x[3] - x[0], 0.5, 1e-14);  // the linearised constraint, to rounding
 		assert_close(-x[0] - x[6], 1.0, 1e-12); // H dx + C^T lambda = rhs on x0
 	}

@@ -319,9 +319,8 @@ static plume_status solve_regularised(plume_kkt *kkt, const double *rhs, const d
 }
 
 /// At most this many refinement steps (each one solve); refinement stops earlier once
-/// the backward error is below REFINEMENT_TOLERANCE or stops falling.
+/// the backward error is below the caller's tolerance or stops falling.
 enum { REFINEMENT_STEPS = 8 };
-static const double REFINEMENT_TOLERANCE = 1e-14;
 
 /// residual = rhs - K x and the componentwise backward error
 /// max_i |residual_i| / (|K| |x| + |rhs|)_i (Arioli, Demmel & Duff 1989): the relative
@@ -364,8 +363,8 @@ static double backward_error(const plume_kkt *kkt, const double *rhs, const doub
 	return worst;
 }
 
-plume_status plume_kkt_solve(plume_kkt *kkt, const double *rhs, const double *multipliers, double *solution,
-                             plume_error *err)
+plume_status plume_kkt_solve(plume_kkt *kkt, const double *rhs, const double *multipliers, double tolerance,
+                             double *solution, plume_error *err)
 {
 	plume_status status = solve_regularised(kkt, rhs, multipliers, solution, err);
 	if (status != PLUME_OK || kkt->constraint_count == 0)
@@ -377,7 +376,7 @@ plume_status plume_kkt_solve(plume_kkt *kkt, const double *rhs, const double *mu
 	double previous = INFINITY;
 	for (int step = 0;; ++step) {
 		double error = backward_error(kkt, rhs, solution, residual, scale);
-		if (step == REFINEMENT_STEPS || error <= REFINEMENT_TOLERANCE || !(error < 0.5 * previous))
+		if (step == REFINEMENT_STEPS || error <= tolerance || !(error < 0.5 * previous))
 			break;
 		previous = error;
 		if ((status = solve_regularised(kkt, residual, NULL, correction, err)) != PLUME_OK)
