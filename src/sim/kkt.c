@@ -273,7 +273,11 @@ plume_status plume_kkt_factor(plume_kkt *kkt, double first_shift, double largest
 	if (!(base > 0) || !isfinite(base))
 		base = 1;
 	double applied = 0;
-	for (double factor = fmax(first_shift, SMALLEST_SHIFT); factor <= largest_shift; factor *= 10) {
+	// Decades up to the limit; a product that rounds just above the limit is still its rung
+	// (1e-6 * 10 is 1.0000000000000001e-05, and the 1e-5 rung was skipped). Measured with
+	// that rung (factorisations, Newton iterations): Figure 1 at 2.5 mm 1030 / 604 ->
+	// 1017 / 597, at 5 mm 458 / 396 -> 456 / 397, wing-draft.json 1365 / 779 -> 1383 / 778.
+	for (double factor = fmax(first_shift, SMALLEST_SHIFT); factor <= largest_shift * (1 + 1e-12); factor *= 10) {
 		double wanted = factor * base;
 		shift_positions(kkt, wanted - applied);
 		applied = wanted;
