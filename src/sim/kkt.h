@@ -87,8 +87,9 @@ void plume_kkt_zero(plume_kkt *kkt);
 /// direction of the l1 merit: Nocedal & Wright, sections 16.2 and 18.3) is shifted:
 /// H + s d I, d the mean of H's diagonal and s the smallest of the ladder first_shift,
 /// 10 first_shift, ... up to largest_shift (the last rung) that factors (first_shift at or
-/// below 1e-10 starts at 1e-10 and climbs by hundredfold rungs). *shift is that s, 0 when H factored as it is.
-/// PLUME_ERROR_NUMERIC when no s of the ladder factors (with largest_shift 0: when H does not).
+/// below 1e-10 starts at 1e-10 and climbs by hundredfold rungs). *shift is that s, 0 when
+/// H factored as it is. PLUME_ERROR_NUMERIC when no s of the ladder factors (with
+/// largest_shift 0: when H does not).
 plume_status plume_kkt_factor(plume_kkt *kkt, double first_shift, double largest_shift, double *shift,
                               plume_error *err);
 
