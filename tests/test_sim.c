@@ -354,6 +354,16 @@ static void test_kkt_factor_reports_indefinite(void **state)
 		assert_close(x[5], 6.0 / (shift * 11.0 / 6.0 - 1.0), 1e-12);
 		assert_close(x[0], 1.0 / (2.0 + shift * 11.0 / 6.0), 1e-12);
 	}
+	// The limit is the last rung whatever the rungs before it: in decades from 0.1 times it
+	// (what Newton passes after a ladder ran out; 0.1 * 1e-5 * 10 rounds above 1e-5) and in
+	// hundredfold rungs from nothing (1e-6, then 1e-4 clamped), a pivot of -1.5e-5 against
+	// the mean |diagonal| 10/6 needs s > 9e-6.
+	for (int first = 0; first <= 1; ++first) {
+		for (int i = 0; i < 6; ++i)
+			values[kkt.system.diagonal[i]] = i == 5 ? -1.5e-5 : 2.0;
+		assert_int_equal(plume_kkt_factor(&kkt, first ? 0.1 * 1e-5 : 0.0, 1e-5, &shift, &err), PLUME_OK);
+		assert_true(shift == 1e-5);
+	}
 	// A ladder that stops below the shift it needs fails.
 	for (int i = 0; i < 6; ++i)
 		values[kkt.system.diagonal[i]] = i == 5 ? -1.0 : 2.0;

@@ -273,8 +273,8 @@ plume_status plume_kkt_factor(plume_kkt *kkt, double first_shift, double largest
 	// 1e-10 to 1e-5 in decades: six factorisations for nothing). Measured (factorisations,
 	// Newton iterations), decades against this: Figure 1 at 5 mm 456 / 397 -> 442 / 397, at
 	// 2.5 mm 1017 / 597 -> 946 / 596, wing-draft.json 1383 / 778 -> 1246 / 774,
-	// coat-settle.json 126 / 95 -> 121 / 95. (In decades, 1e-6 * 10 rounded above 1e-5 and
-	// skipped the last rung; the rungs are clamped to the limit now.)
+	// coat-settle.json 126 / 95 -> 121 / 95. (In decades from 0.1 * 1e-5, the second rung
+	// rounded above 1e-5 and was skipped; the rungs are clamped to the limit now.)
 	double base = mean_position_diagonal(kkt);
 	if (!(base > 0) || !isfinite(base))
 		base = 1;
