@@ -316,7 +316,7 @@ static const double STEP_BACKWARD_ERROR = 1e-9;
 /// and 456 from a tenth, for the same 668 iterations; starting at the last shift itself
 /// took 1108. A ladder that ran out leaves the limit as the last shift, so the next
 /// exact Hessian, if it does not factor as it is, tries 0.1 and 1 times the limit instead
-/// of six rungs from 1e-10: measured (factorisations, Newton iterations), Figure 1 at 5 mm
+/// of the whole ladder from 1e-10 (then six decades): measured (factorisations, Newton iterations), Figure 1 at 5 mm
 /// 468 / 397 -> 458 / 396, at 2.5 mm 1176 / 597 -> 1030 / 604, wing-draft.json
 /// 1519 / 778 -> 1365 / 779, coat-settle.json 138 / 96 -> 120 / 94; swing.json and
 /// bird-flap.json never run out (the same bits).
