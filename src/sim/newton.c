@@ -101,8 +101,7 @@ static double lagrangian_residual(plume_sim *sim, const plume_vec3 *x, const dou
 	return norm;
 }
 
-/// Adds the constraint rows (C) and the constraints' curvature to the assembled matrix.
-static void add_constraint_rows(plume_sim *sim, const plume_vec3 *x, bool exact)
+void plume_sim_add_constraint_rows(plume_sim *sim, const plume_vec3 *x, bool exact)
 {
 	double *values = plume_kkt_values(&sim->kkt);
 	for (int k = 0; k < sim->constraint_count; ++k) {
@@ -264,7 +263,7 @@ static plume_status newton_system(plume_sim *sim, const sim_problem *problem, bo
 			g[i] = 0;
 	*residual = lagrangian_residual(sim, sim->x, g, sim->rhs);
 	if (hessian)
-		add_constraint_rows(sim, sim->x, exact);
+		plume_sim_add_constraint_rows(sim, sim->x, exact);
 	report->seconds_assembly += omp_get_wtime() - t0;
 	return PLUME_OK;
 }

@@ -163,6 +163,12 @@ int plume_sim_bending_stride(const plume_sim *sim);
 const int *plume_sim_bending_vertices(const plume_sim *sim, int e);
 double plume_sim_bending_energy(const plume_sim *sim, const plume_vec3 *x, int e);
 
+/// Adds the constraint rows C at x and, where the multiplier is nonzero, the constraints'
+/// curvature sum lambda_k Hess c_k to the assembled matrix: with plume_sim_potential's exact
+/// block, the Hessian of the Lagrangian. Without `exact`, only barbs in tension (lambda > 0)
+/// add their curvature (positive semidefinite; a compressed barb's is indefinite).
+void plume_sim_add_constraint_rows(plume_sim *sim, const plume_vec3 *x, bool exact);
+
 /// Adds C^T lambda, the constraint forces of the current multipliers, to forces (3 n).
 void plume_sim_add_constraint_forces(const plume_sim *sim, const plume_vec3 *x, double *forces);
 
