@@ -377,7 +377,7 @@ static plume_status newton(plume_sim *sim, const sim_problem *problem, plume_sol
 	double previous_closest = INFINITY;
 	// The last iterate's residual over its tolerance, q, and Newton's last measure of its
 	// quadratic convergence, C in q_{k+1} = C q_k^2, from two iterates a full step apart.
-	double previous_ratio = 0, contraction = 0;
+	double previous_ratio = 0, contraction = 0, last_residual = 0;
 	// Whether the exact Hessian ran out of shifts since the last full step: the exact one is
 	// then tried again only after the full step after that. Traced on Figure 1 at 2.5 mm,
 	// the next exact attempt ran out too about half the time (three more factorisations
@@ -408,6 +408,7 @@ static plume_status newton(plume_sim *sim, const sim_problem *problem, plume_sol
 		if (full_step && previous_ratio > 0)
 			contraction = ratio / (previous_ratio * previous_ratio);
 		previous_ratio = ratio;
+		last_residual = residual;
 		report->energy = phi;
 		report->gradient_norm = free_norm2(sim, sim->residual);
 		report->max_barb_strain = plume_sim_max_barb_strain(sim, x);
@@ -533,9 +534,14 @@ static plume_status newton(plume_sim *sim, const sim_problem *problem, plume_sol
 		}
 	}
 	report->max_barb_strain = plume_sim_max_barb_strain(sim, x);
+	// How far from converged, in the terms of the test above: a step that stalls a few times
+	// above its tolerance with its barbs feasible (a vane at an unstable equilibrium, docs/
+	// simulation.md, Speed) reads differently from one that is far off.
 	return plume_error_set(err, PLUME_ERROR_NUMERIC,
-	                       "Newton did not converge in %d iterations (gradient norm %.3g N, barb strain %.3g)",
-	                       report->newton_iterations, report->gradient_norm, report->max_barb_strain);
+	                       "Newton did not converge in %d iterations (largest force residual %.3g N, %.3g times "
+	                       "its tolerance; gradient norm %.3g N; barb strain %.3g, tolerance %.0e)",
+	                       report->newton_iterations, last_residual, previous_ratio, report->gradient_norm,
+	                       report->max_barb_strain, STRAIN_TOLERANCE);
 }
 
 plume_status plume_sim_newton(plume_sim *sim, const sim_problem *problem, plume_solve_report *report, plume_error *err)
