@@ -619,7 +619,8 @@ static bool is_stub(const double *lengths, int count, int i, double e)
 /// a millimetre long, and guides cut where random barbs cross leave stubs at
 /// the base. The strip between a stub and its neighbour, e away along the
 /// rachis, is a fan of slivers from the stub's tip whatever the walk does. The
-/// vane then starts (ends) further in; a vane keeps two guides at least; the
+/// vane then starts (ends) further in; a vane keeps two guides at least (a
+/// stub among two is cut back instead: cut_back_lone_stubs); the
 /// stubs' points stay in the pool. Returns 1 when any guide was left out, 0
 /// when none, -1 out of memory.
 static int drop_short_end_guides(mesher *m)
@@ -1121,6 +1122,83 @@ static int settle_strips(mesher *m)
 	plume_free(strip_seen);
 	plume_free(edge_seen);
 	return faces;
+}
+
+/// Smallest angle of the strips that have line l as a guide (pi when none),
+/// walked dry; -1 when one of them does not walk through. Strips with a guide
+/// left out (drop_short_end_guides) are no longer strips.
+static double line_strips_quality(const mesher *m, int l)
+{
+	double smallest = pi;
+	for (int s = 0; s < m->strip_count; ++s) {
+		const mesh_strip *strip = m->strip_list + s;
+		if ((strip->a != l && strip->b != l) || !m->lines[strip->a].present || !m->lines[strip->b].present)
+			continue;
+		strip_out dry = {NULL, 0, pi};
+		int i, k;
+		if (!strip_is_simple(m, strip, &i, &k) || !walk_strip(m, strip, &dry, &i, &k))
+			return -1.0;
+		smallest = fmin(smallest, dry.smallest);
+	}
+	return smallest;
+}
+
+/// A vane reduced to two guides keeps an end stub (drop_short_end_guides),
+/// and the strip between the stub and its neighbour is a fan of slivers from
+/// the stub's tip: the Streit-Heidrich bristle's right vane is a 3.5 mm barb
+/// and, 4.7 mm up the rachis, a 0.38 mm one, whose strip at 5 mm has an angle
+/// of 4.3 degrees. Such a stub is cut back to its root when that raises the
+/// smallest angle of its strips: the vane then ends at that rachis vertex, a
+/// fan from it over the neighbour's vertices (43 degrees there), as a guide
+/// cut to its root by settle_strips does. Returns 1 when a stub was cut.
+static int cut_back_lone_stubs(mesher *m)
+{
+	int cut = 0;
+	for (int side = 0; side < 2; ++side) {
+		int order[3], count = 0; // the vane's present guides, up to three
+		for (int r = 0; r < m->row_count && count < 3; ++r)
+			if (m->lines[line_index(m, side, r)].present)
+				order[count++] = line_index(m, side, r);
+		if (count != 2)
+			continue;
+		for (int end = 0; end < 2; ++end) {
+			int stub = order[end], other = order[1 - end];
+			mesh_line *line = m->lines + stub;
+			double lengths[2] = {line_length(m, line), line_length(m, m->lines + other)};
+			if (line->count < 2 || line->join_line >= 0 || line->join_target || !is_stub(lengths, 2, 0, m->e))
+				continue;
+			double before = line_strips_quality(m, stub);
+			int kept = line->count;
+			line->count = 1;
+			double after = line_strips_quality(m, stub);
+			if (after > before) {
+				m->trimmed += kept - 1;
+				cut = 1;
+				break; // the vane's other guide is no stub then: the fan has its vertices
+			}
+			line->count = kept;
+		}
+	}
+	return cut;
+}
+
+/// A guide that is no side of any strip (a vane of one guide) makes no face:
+/// it is left out, so that the mesh has no vertex outside its faces. Returns
+/// false out of memory.
+static bool drop_lone_guides(mesher *m)
+{
+	bool *in_strip = plume_calloc(2 * (size_t)m->row_count, sizeof *in_strip);
+	if (in_strip == NULL)
+		return false;
+	for (int s = 0; s < m->strip_count; ++s)
+		in_strip[m->strip_list[s].a] = in_strip[m->strip_list[s].b] = true;
+	for (int l = 0; l < 2 * m->row_count; ++l)
+		if (m->lines[l].present && !in_strip[l]) {
+			m->lines[l].present = false;
+			m->lines[l].count = m->lines[l].full = 0;
+		}
+	plume_free(in_strip);
+	return true;
 }
 
 /// Once the strips are walked, cutting guides where they cross can leave new
@@ -1935,8 +2013,12 @@ static plume_status assemble(mesher *m, plume_mesh **out, plume_mesh_report *rep
 	int dropped = drop_short_end_guides(m);
 	if (dropped < 0)
 		return plume_error_set(m->err, PLUME_ERROR_MEMORY, "out of memory checking the guides' ends");
+	if (cut_back_lone_stubs(m) > 0)
+		dropped = 1;
 	if (dropped > 0)
 		vane_faces = forget_dropped_strips(m);
+	if (!drop_lone_guides(m))
+		return plume_error_set(m->err, PLUME_ERROR_MEMORY, "out of memory checking the guides' ends");
 	plume_mesh *mesh = NULL, *joined_mesh = NULL;
 	plume_mesh_report measured, joined_measure;
 	plume_status status = build_mesh(m, vane_faces, &mesh, &measured);
