@@ -277,10 +277,10 @@ static const quality_row quality_rows[] = {
     {"franco-walter/figure6b.json", 5e-3, 20.0, 1},
     {"franco-walter/figure6b.json", 2.5e-3, 20.0, 0},
     {"franco-walter/filoplume.json", 5e-3, 20.0, 1},
-    {"franco-walter/filoplume.json", 2.5e-3, 18.66, 1},
+    {"franco-walter/filoplume.json", 2.5e-3, 20.0, 1},
     {"franco-walter/hawk.json", 5e-3, 20.0, 0},
     {"franco-walter/hawk.json", 2.5e-3, 20.0, 1},
-    {"franco-walter/peacock.json", 5e-3, 8.17, 7},
+    {"franco-walter/peacock.json", 5e-3, 10.83, 7},
     {"franco-walter/peacock.json", 2.5e-3, 3.39, 8},
     {"franco-walter/pigeon-primary.json", 5e-3, 20.0, 3},
     {"franco-walter/pigeon-primary.json", 2.5e-3, 20.0, 5},
@@ -295,13 +295,13 @@ static const quality_row quality_rows[] = {
     {"streit-heidrich/down.json", 5e-3, 20.0, 1},
     {"streit-heidrich/down.json", 2.5e-3, 20.0, 1},
     {"streit-heidrich/filoplume.json", 5e-3, 20.0, 5},
-    {"streit-heidrich/filoplume.json", 2.5e-3, 5.64, 7},
+    {"streit-heidrich/filoplume.json", 2.5e-3, 6.90, 6},
     {"streit-heidrich/flight.json", 5e-3, 20.0, 29},
     {"streit-heidrich/flight.json", 2.5e-3, 20.0, 68},
     {"streit-heidrich/peacock.json", 5e-3, 5.93, 78},
     {"streit-heidrich/peacock.json", 2.5e-3, 0.23, 149},
     {"streit-heidrich/semiplume.json", 5e-3, 20.0, 4},
-    {"streit-heidrich/semiplume.json", 2.5e-3, 8.31, 9},
+    {"streit-heidrich/semiplume.json", 2.5e-3, 11.07, 10},
     {"zhang-kanai/figure10-asymmetry-020.json", 5e-3, 20.0, 0},
     {"zhang-kanai/figure10-asymmetry-020.json", 2.5e-3, 20.0, 0},
     {"zhang-kanai/figure10-asymmetry-040.json", 5e-3, 20.0, 0},
@@ -364,12 +364,13 @@ static void test_example_quality(void **state)
 	}
 	print_message("%d of %d example meshes reach %.0f degrees outside junction faces\n", meeting,
 	              (int)(sizeof quality_rows / sizeof quality_rows[0]), PLUME_MESH_QUALITY_ANGLE_DEG);
-	// 47 built by GCC and by Clang (45 before the bristle's lone stub was cut back, 39 by GCC
-	// before the root-phased tries): the Streit-Heidrich
+	// 48 built by GCC and by Clang (47 before sliding left the rachis tip's corner out, 45
+	// before the bristle's lone stub was cut back, 39 by GCC before the root-phased tries): the
+	// Streit-Heidrich
 	// generator's growth turns last-bit differences between the two compilers into different
 	// feathers (different face counts), not always the same 45. The rows above hold the lower
 	// floor of the two builds and the higher junction count.
-	assert_true(meeting >= 47);
+	assert_true(meeting >= 48);
 	assert_int_equal(plume_bytes_in_use(), before);
 }
 
