@@ -24,9 +24,10 @@
 // of faces under 25 degrees slide along their guides (slide_vertices), so that
 // vane faces keep their smallest angle at 20 degrees or more outside the
 // junctions where a guide meets the rachis or the outline at a shallow angle
-// (plume_mesh_measure). A mesh that falls short is built again, up to three
+// (plume_mesh_measure). A mesh that falls short is built again, up to six
 // times, with root-phased steps on the guides rooted close to the next
-// (root_phase_step), and the best is kept (mesh_run).
+// (root_phase_step) and with guides that converge on the next thinned
+// (thin_converging_guides), and the best is kept (mesh_run).
 //
 // A step that would make an inverted or degenerate triangle (two guides
 // touching) is never taken: both guides are cut there and every strip is
@@ -78,6 +79,12 @@ typedef struct mesh_strip {
 	bool shared_end;
 } mesh_strip;
 
+/// How a try places and keeps guides (mesh_run).
+typedef struct mesh_variant {
+	double phase_below_deg; ///< mesher.phase_below_deg
+	double thin_gap;        ///< mesher.thin_gap
+} mesh_variant;
+
 typedef struct mesher {
 	const mesh_input *input;
 	double e;
@@ -100,6 +107,9 @@ typedef struct mesher {
 	/// next get root-phased steps (root_phase_step) and sliding leaves junction
 	/// angles out of what it raises.
 	double phase_below_deg;
+	/// 0 in the first tries; in the thinned ones (mesh_run), a guide is cut where it
+	/// comes closer than this many edge lengths to the next guide (thin_converging_guides).
+	double thin_gap;
 	plume_error *err;
 } mesher;
 
@@ -654,6 +664,52 @@ static int drop_short_end_guides(mesher *m)
 	plume_free(order);
 	plume_free(lengths);
 	return dropped;
+}
+
+/// Distance in the plane from p to the polyline of a placed guide.
+static double line_distance(const mesher *m, const mesh_line *line, plume_vec3 p)
+{
+	double best = INFINITY;
+	const plume_vec3 *q = m->points + line->first;
+	for (int j = 0; j + 1 < line->count; ++j) {
+		double dx = q[j + 1].x - q[j].x, dy = q[j + 1].y - q[j].y, l2 = dx * dx + dy * dy;
+		double t = l2 > 0.0 ? ((p.x - q[j].x) * dx + (p.y - q[j].y) * dy) / l2 : 0.0;
+		t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
+		double ex = q[j].x + t * dx - p.x, ey = q[j].y + t * dy - p.y;
+		best = fmin(best, ex * ex + ey * ey);
+	}
+	return sqrt(best);
+}
+
+/// Thinned tries (mesh_run): where a guide comes closer than thin_gap e to
+/// the guide of the next row, the strip between them is a row of flat faces
+/// (two vertices s apart on one guide and the third h away on the other: at
+/// most atan(2 h / s), under 20 degrees below h = 0.18 s) that no placement
+/// along the guides lifts (docs/meshing.md, "Guides closer than about 0.09
+/// e"). The guide is cut there, at its first vertex past the second that is
+/// that close, so that its two strips become one, twice as wide, beyond it; its
+/// tip then lies beside the next guide, where join_short_guides may join it.
+/// The next guide is kept whole: guides converging in a fan lose every other
+/// one, not all but the last.
+static void thin_converging_guides(mesher *m)
+{
+	for (int side = 0; side < 2; ++side) {
+		bool keeper = false;
+		for (int r = 0; r + 1 < m->row_count; ++r) {
+			mesh_line *line = m->lines + line_index(m, side, r), *next = m->lines + line_index(m, side, r + 1);
+			if (keeper || !line->present || !next->present || line->count < 3 || next->count < 2) {
+				keeper = false;
+				continue;
+			}
+			for (int i = 2; i + 1 < line->count; ++i)
+				if (line_distance(m, next, m->points[line->first + i]) < m->thin_gap * m->e) {
+					m->trimmed += line->count - (i + 1);
+					line->count = i + 1;
+					keeper = true;
+					break;
+				}
+		}
+	}
 }
 
 // ---------------------------------------------------------------------------
@@ -2101,14 +2157,15 @@ static void count_mesh(const mesher *m, plume_mesh_estimate *out)
 }
 
 /// Places the rows (refusing past the limit before allocating them) and counts the rest.
-static plume_status mesh_begin(mesher *m, const mesh_input *input, const plume_mesh_def *def, double phase_below_deg,
+static plume_status mesh_begin(mesher *m, const mesh_input *input, const plume_mesh_def *def, mesh_variant variant,
                                plume_mesh_estimate *estimate, plume_error *err)
 {
 	*m = (mesher){.input = input,
 	              .e = def->edge_length,
 	              .include_calamus = def->include_calamus,
 	              .max_memory = (double)(def->max_memory > 0 ? def->max_memory : PLUME_DEFAULT_MAX_MEMORY),
-	              .phase_below_deg = phase_below_deg,
+	              .phase_below_deg = variant.phase_below_deg,
+	              .thin_gap = variant.thin_gap,
 	              .err = err};
 	plume_status status = place_rows(m);
 	if (status != PLUME_OK)
@@ -2128,12 +2185,12 @@ static void mesh_end(mesher *m)
 	plume_free(m->boxes);
 }
 
-static plume_status mesh_try(const mesh_input *input, const plume_mesh_def *def, double phase_below_deg,
-                             plume_mesh **out, plume_mesh_report *report, plume_error *err)
+static plume_status mesh_try(const mesh_input *input, const plume_mesh_def *def, mesh_variant variant, plume_mesh **out,
+                             plume_mesh_report *report, plume_error *err)
 {
 	mesher m;
 	plume_mesh_estimate estimate;
-	plume_status status = mesh_begin(&m, input, def, phase_below_deg, &estimate, err);
+	plume_status status = mesh_begin(&m, input, def, variant, &estimate, err);
 	if (status == PLUME_OK && !(estimate.bytes <= m.max_memory))
 		status = limit_error(&m, &estimate);
 	if (status == PLUME_OK) {
@@ -2151,6 +2208,8 @@ static plume_status mesh_try(const mesh_input *input, const plume_mesh_def *def,
 				             : plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory placing guide vertices");
 	if (status == PLUME_OK && drop_short_end_guides(&m) < 0)
 		status = plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory checking the guides' ends");
+	if (status == PLUME_OK && m.thin_gap > 0.0)
+		thin_converging_guides(&m);
 	if (status == PLUME_OK && !(collect_strips(&m) && build_index(&m)))
 		status = plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory");
 	if (status == PLUME_OK)
@@ -2159,18 +2218,6 @@ static plume_status mesh_try(const mesh_input *input, const plume_mesh_def *def,
 	return status;
 }
 
-/// Meshes the input; where the vane's smallest angle outside junction faces
-/// falls short of PLUME_MESH_QUALITY_ANGLE_DEG, meshes it again phased
-/// (root_phase_step), with guides under 22, then 18, then 32 degrees to the
-/// next phased while none reaches the bound, and keeps the mesh with the
-/// highest smallest angle, the earliest on ties. Which guides gain from the
-/// phase depends on the feather (measured, docs/meshing.md: 22 degrees took
-/// the Streit-Heidrich flight over 20 at both edge lengths, 18 the
-/// Franco-Walter hawk at 2.5 mm, 32 raised the Franco-Walter filoplume and
-/// the Streit-Heidrich semiplume at 2.5 mm). Meshes that reach the bound are
-/// built once, as they were (the Figure 1 hawk at 5 mm, whose simulation
-/// tests/test_scene.c pins); a phased try that fails (over the memory limit,
-/// or overlapping faces) is passed over.
 /// Junction faces are excepted from the quality bound because the feather's
 /// shape sets their angles; a try may not buy its smallest angle with more of
 /// them than this share of a vane of 100 faces or more (Streit-Heidrich
@@ -2184,19 +2231,35 @@ static bool junctions_are_few(const plume_mesh *mesh, const plume_mesh_report *r
 	return vane < 100 || report->excepted_count <= 0.04 * vane;
 }
 
+/// Meshes the input; where the vane's smallest angle outside junction faces
+/// falls short of PLUME_MESH_QUALITY_ANGLE_DEG, meshes it again phased
+/// (root_phase_step), with guides under 22, then 18, then 32 degrees to the
+/// next phased, then thinned (thin_converging_guides: guides cut where they
+/// come within 0.15 e of the next) unphased and phased at 22 and 32 degrees,
+/// while none reaches the bound, and keeps the mesh with the highest smallest
+/// angle, the earliest on ties, whose junction faces are few
+/// (junctions_are_few). Which guides gain from the phase depends on the
+/// feather (measured, docs/meshing.md: 22 degrees took the Streit-Heidrich
+/// flight over 20 at both edge lengths, 18 the Franco-Walter hawk at 2.5 mm, 32
+/// raised the Franco-Walter filoplume and the Streit-Heidrich semiplume at
+/// 2.5 mm; thinning raised both peacocks and the semiplume at 2.5 mm, each
+/// with another phase). Meshes that reach the bound are built once, as they
+/// were (the Figure 1 hawk at 5 mm, whose simulation tests/test_scene.c pins);
+/// a try that fails (over the memory limit, or overlapping faces) is passed
+/// over.
 static plume_status mesh_run(const mesh_input *input, const plume_mesh_def *def, plume_mesh **out,
                              plume_mesh_report *report, plume_error *err)
 {
-	static const double phase_below_deg[] = {22.0, 18.0, 32.0};
+	static const mesh_variant variants[] = {{22.0, 0.0}, {18.0, 0.0},  {32.0, 0.0},
+	                                        {0.0, 0.15}, {22.0, 0.15}, {32.0, 0.15}};
 	const double bound = PLUME_MESH_QUALITY_ANGLE_DEG * pi / 180.0;
 	plume_mesh_report best, tried;
-	plume_status status = mesh_try(input, def, 0.0, out, &best, err);
-	for (size_t i = 0;
-	     status == PLUME_OK && best.vane_min_angle < bound && i < sizeof phase_below_deg / sizeof phase_below_deg[0];
+	plume_status status = mesh_try(input, def, (mesh_variant){0.0, 0.0}, out, &best, err);
+	for (size_t i = 0; status == PLUME_OK && best.vane_min_angle < bound && i < sizeof variants / sizeof variants[0];
 	     ++i) {
 		plume_mesh *phased = NULL;
 		plume_error scratch = {0};
-		plume_status phased_status = mesh_try(input, def, phase_below_deg[i], &phased, &tried, &scratch);
+		plume_status phased_status = mesh_try(input, def, variants[i], &phased, &tried, &scratch);
 		if (phased_status == PLUME_ERROR_MEMORY) {
 			plume_mesh_destroy(*out);
 			*out = NULL;
@@ -2219,7 +2282,7 @@ static plume_status mesh_estimate(const mesh_input *input, const plume_mesh_def 
                                   plume_error *err)
 {
 	mesher m;
-	plume_status status = mesh_begin(&m, input, def, 0.0, out, err);
+	plume_status status = mesh_begin(&m, input, def, (mesh_variant){0.0, 0.0}, out, err);
 	mesh_end(&m);
 	return status;
 }
