@@ -2218,27 +2218,13 @@ static plume_status mesh_try(const mesh_input *input, const plume_mesh_def *def,
 	return status;
 }
 
-/// Junction faces are excepted from the quality bound because the feather's
-/// shape sets their angles; a try may not buy its smallest angle with more of
-/// them than this share of a vane of 100 faces or more (Streit-Heidrich
-/// semiplume at 2.5 mm built by Clang: a phased try at 12.9 degrees with 11
-/// junction faces of 240, against 8.3 with 6 of 206 at the first).
-static bool junctions_are_few(const plume_mesh *mesh, const plume_mesh_report *report)
-{
-	int vane = 0;
-	for (int f = 0; f < mesh->face_count; ++f)
-		vane += mesh->material[f] == PLUME_MATERIAL_VANE;
-	return vane < 100 || report->excepted_count <= 0.04 * vane;
-}
-
 /// Meshes the input; where the vane's smallest angle outside junction faces
 /// falls short of PLUME_MESH_QUALITY_ANGLE_DEG, meshes it again phased
 /// (root_phase_step), with guides under 22, then 18, then 32 degrees to the
 /// next phased, then thinned (thin_converging_guides: guides cut where they
 /// come within 0.15 e of the next) unphased and phased at 22 and 32 degrees,
 /// while none reaches the bound, and keeps the mesh with the highest smallest
-/// angle, the earliest on ties, whose junction faces are few
-/// (junctions_are_few). Which guides gain from the phase depends on the
+/// angle, the earliest on ties. Which guides gain from the phase depends on the
 /// feather (measured, docs/meshing.md: 22 degrees took the Streit-Heidrich
 /// flight over 20 at both edge lengths, 18 the Franco-Walter hawk at 2.5 mm, 32
 /// raised the Franco-Walter filoplume and the Streit-Heidrich semiplume at
@@ -2265,8 +2251,7 @@ static plume_status mesh_run(const mesh_input *input, const plume_mesh_def *def,
 			*out = NULL;
 			return plume_error_set(err, PLUME_ERROR_MEMORY, "%s", scratch.message);
 		}
-		if (phased_status == PLUME_OK && tried.vane_min_angle > best.vane_min_angle &&
-		    junctions_are_few(phased, &tried)) {
+		if (phased_status == PLUME_OK && tried.vane_min_angle > best.vane_min_angle) {
 			plume_mesh_destroy(*out);
 			*out = phased;
 			best = tried;
