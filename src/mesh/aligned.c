@@ -2243,20 +2243,20 @@ static plume_status mesh_run(const mesh_input *input, const plume_mesh_def *def,
 	plume_status status = mesh_try(input, def, (mesh_variant){0.0, 0.0}, out, &best, err);
 	for (size_t i = 0; status == PLUME_OK && best.vane_min_angle < bound && i < sizeof variants / sizeof variants[0];
 	     ++i) {
-		plume_mesh *phased = NULL;
+		plume_mesh *candidate = NULL;
 		plume_error scratch = {0};
-		plume_status phased_status = mesh_try(input, def, variants[i], &phased, &tried, &scratch);
-		if (phased_status == PLUME_ERROR_MEMORY) {
+		plume_status tried_status = mesh_try(input, def, variants[i], &candidate, &tried, &scratch);
+		if (tried_status == PLUME_ERROR_MEMORY) {
 			plume_mesh_destroy(*out);
 			*out = NULL;
 			return plume_error_set(err, PLUME_ERROR_MEMORY, "%s", scratch.message);
 		}
-		if (phased_status == PLUME_OK && tried.vane_min_angle > best.vane_min_angle) {
+		if (tried_status == PLUME_OK && tried.vane_min_angle > best.vane_min_angle) {
 			plume_mesh_destroy(*out);
-			*out = phased;
+			*out = candidate;
 			best = tried;
 		} else
-			plume_mesh_destroy(phased);
+			plume_mesh_destroy(candidate);
 	}
 	if (status == PLUME_OK && report != NULL)
 		*report = best;
