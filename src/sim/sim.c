@@ -260,6 +260,58 @@ static int pair_face_edges(const plume_mesh *mesh, int **out)
 	return pair_count;
 }
 
+/// True when two rest lengths, one measured in the reference plane and one in the 3D rest
+/// shape, are the same up to rounding: the rest shape there is the reference moved rigidly.
+static bool same_length(double plane, double rest) { return fabs(rest - plane) <= 1e-12 * plane; }
+
+/// A material length between two vertices: the 3D rest shape's (a curved feather is at rest
+/// in its curved shape), or the reference plane's where they are the same up to rounding,
+/// so that a flat feather's lengths are the reference's bit for bit.
+static double rest_length(const plume_mesh *mesh, int a, int b)
+{
+	plume_vec2 p = mesh->reference[a], q = mesh->reference[b];
+	double plane = hypot(q.x - p.x, q.y - p.y);
+	double rest = plume_v3_length(plume_v3_sub(mesh->rest[b], mesh->rest[a]));
+	return same_length(plane, rest) ? plane : rest;
+}
+
+/// The face's rest triangle laid flat in the feather plane: its side lengths are those of
+/// the 3D rest shape, and it lies on the reference triangle along the face's barb edge
+/// (edge 0 of a rachis face), turned as the reference is, so that the barb angle holds.
+/// A Streit-Heidrich or Zhang-Kanai feather is at rest in its curved shape; measured in
+/// the plane, its membrane started strained (a held Streit-Heidrich semiplume, with no
+/// gravity, fell to a principal stretch of 0.88 in one step). Where the rest triangle is
+/// the reference moved rigidly (every Franco-Walter feather) it is the reference exactly.
+static void rest_triangle(const plume_mesh *mesh, int f, plume_vec2 out[3])
+{
+	const int *v = mesh->faces + 3 * f;
+	bool flat = true;
+	for (int k = 0; k < 3; ++k) {
+		out[k] = mesh->reference[v[k]];
+		plume_vec2 p = mesh->reference[v[k]], q = mesh->reference[v[(k + 1) % 3]];
+		flat &= same_length(hypot(q.x - p.x, q.y - p.y),
+		                    plume_v3_length(plume_v3_sub(mesh->rest[v[(k + 1) % 3]], mesh->rest[v[k]])));
+	}
+	plume_vec2 r0 = out[0], r1 = out[1], r2 = out[2];
+	double twice_area = (r1.x - r0.x) * (r2.y - r0.y) - (r2.x - r0.x) * (r1.y - r0.y);
+	if (flat || !(twice_area != 0)) // a degenerate reference: the element's check reports it
+		return;
+	int k = mesh->barb_edge[f] >= 0 ? mesh->barb_edge[f] : 0;
+	int a = v[k], b = v[(k + 1) % 3], c = v[(k + 2) % 3];
+	plume_vec3 ab = plume_v3_sub(mesh->rest[b], mesh->rest[a]), ac = plume_v3_sub(mesh->rest[c], mesh->rest[a]);
+	double length = plume_v3_length(ab);
+	plume_vec3 u = plume_v3_scale(ab, 1 / length);
+	double along = plume_v3_dot(ac, u);
+	double across = plume_v3_length(plume_v3_sub(ac, plume_v3_scale(u, along)));
+	plume_vec2 p = mesh->reference[a], q = mesh->reference[b], r = mesh->reference[c];
+	double dx = q.x - p.x, dy = q.y - p.y, plane = hypot(dx, dy);
+	plume_vec2 d = {dx / plane, dy / plane}, n = {-d.y, d.x};
+	double side = dx * (r.y - p.y) - dy * (r.x - p.x) >= 0 ? 1 : -1; // keeps the reference's orientation
+	out[k] = p;
+	out[(k + 1) % 3] = (plume_vec2){p.x + length * d.x, p.y + length * d.y};
+	out[(k + 2) % 3] = (plume_vec2){p.x + along * d.x + side * across * n.x, p.y + along * d.y + side * across * n.y};
+}
+
 // The paper's hinges (sim/bending.h): one per plain two-face edge.
 static plume_status build_hinges(plume_sim *sim, const plume_mesh *mesh, const int *pairs, int pair_count,
                                  plume_error *err)
@@ -312,7 +364,8 @@ static plume_status build_ff_faces(plume_sim *sim, const plume_mesh *mesh, const
 		const int *v = mesh->faces + 3 * f;
 		// Edge k of the face is opposite vertex (k + 2) % 3.
 		int vertices[6] = {v[0], v[1], v[2], across[3 * f + 1], across[3 * f + 2], across[3 * f]};
-		plume_vec2 reference[3] = {mesh->reference[v[0]], mesh->reference[v[1]], mesh->reference[v[2]]};
+		plume_vec2 reference[3];
+		rest_triangle(mesh, f, reference);
 		plume_vec3 rest[6];
 		for (int i = 0; i < 6; ++i)
 			rest[i] = vertices[i] >= 0 ? mesh->rest[vertices[i]] : plume_v3(0, 0, 0);
@@ -354,8 +407,8 @@ static plume_status build_ff_faces(plume_sim *sim, const plume_mesh *mesh, const
 		double modulus[2];
 		for (int k = 0; k < 2; ++k) {
 			int f = side[k] / 3;
-			const int *v = mesh->faces + 3 * f;
-			plume_vec2 reference[3] = {mesh->reference[v[0]], mesh->reference[v[1]], mesh->reference[v[2]]};
+			plume_vec2 reference[3];
+			rest_triangle(mesh, f, reference);
 			double along, across_modulus;
 			bending_moduli(sim->def.materials + mesh->material[f], &along, &across_modulus);
 			modulus[k] =
@@ -390,8 +443,8 @@ static plume_status build_elements(plume_sim *sim, const plume_mesh *mesh, plume
 	for (int f = 0; f < faces; ++f) {
 		const plume_material *material = sim->def.materials + mesh->material[f];
 		const int *vertices = mesh->faces + 3 * f;
-		plume_vec2 reference[3] = {mesh->reference[vertices[0]], mesh->reference[vertices[1]],
-		                           mesh->reference[vertices[2]]};
+		plume_vec2 reference[3];
+		rest_triangle(mesh, f, reference);
 		double voigt[9];
 		face_voigt(material, mesh->barb_angle[f], voigt);
 		if (!plume_membrane_element_init(sim->membranes + f, vertices, reference, material->thickness, voigt,
@@ -519,16 +572,12 @@ plume_status plume_sim_create(const plume_mesh *mesh, const plume_sim_def *def, 
 	memcpy(sim->face_material, mesh->material, (size_t)mesh->face_count);
 	for (int i = 0; i < mesh->vertex_count; ++i)
 		sim->x[i] = sim->rest[i] = mesh->rest[i];
-	// Barb lengths are material lengths: measured in the reference plane.
-	for (int k = 0; k < sim->constraint_count; ++k) {
-		plume_vec2 a = mesh->reference[sim->constraint_vertices[2 * k]],
-		           b = mesh->reference[sim->constraint_vertices[2 * k + 1]];
-		sim->constraint_length[k] = hypot(b.x - a.x, b.y - a.y);
-	}
-	for (int k = 0; k < sim->barb_edge_count; ++k) {
-		plume_vec2 a = mesh->reference[sim->barb_edges[2 * k]], b = mesh->reference[sim->barb_edges[2 * k + 1]];
-		sim->barb_length[k] = hypot(b.x - a.x, b.y - a.y);
-	}
+	// Barb lengths are material lengths: the rest shape's (rest_length).
+	for (int k = 0; k < sim->constraint_count; ++k)
+		sim->constraint_length[k] =
+		    rest_length(mesh, sim->constraint_vertices[2 * k], sim->constraint_vertices[2 * k + 1]);
+	for (int k = 0; k < sim->barb_edge_count; ++k)
+		sim->barb_length[k] = rest_length(mesh, sim->barb_edges[2 * k], sim->barb_edges[2 * k + 1]);
 	if (def->planar)
 		for (int i = 0; i < mesh->vertex_count; ++i)
 			sim->fixed[3 * i + 2] = 1;
