@@ -326,6 +326,20 @@ static const quality_row quality_rows[] = {
     {"zhang-kanai/figure9-tip-rounded.json", 2.5e-3, 20.0, 0},
 };
 
+/// Meshes examples/SPEC (a feather or guides spec) at edge length e, as `plume mesh` does.
+static plume_mesh *example_mesh(const char *spec, double e, plume_mesh_report *report)
+{
+	char path[640];
+	snprintf(path, sizeof path, "%s/examples/%s", PLUME_SOURCE_DIR, spec);
+	plume_mesh_spec_options options = plume_mesh_spec_default_options();
+	options.edge_length = e;
+	plume_mesh *mesh = NULL;
+	plume_error err;
+	if (plume_mesh_spec_read(path, &options, &mesh, report, &err) != PLUME_OK)
+		fail_msg("%s: %s", spec, err.message);
+	return mesh;
+}
+
 static void test_example_quality(void **state)
 {
 	(void)state;
@@ -333,15 +347,8 @@ static void test_example_quality(void **state)
 	int meeting = 0;
 	for (size_t i = 0; i < sizeof quality_rows / sizeof quality_rows[0]; ++i) {
 		const quality_row *row = quality_rows + i;
-		char path[640];
-		snprintf(path, sizeof path, "%s/examples/%s", PLUME_SOURCE_DIR, row->spec);
-		plume_mesh_spec_options options = plume_mesh_spec_default_options();
-		options.edge_length = row->edge_length;
-		plume_mesh *mesh = NULL;
 		plume_mesh_report report;
-		plume_error err;
-		if (plume_mesh_spec_read(path, &options, &mesh, &report, &err) != PLUME_OK)
-			fail_msg("%s: %s", row->spec, err.message);
+		plume_mesh *mesh = example_mesh(row->spec, row->edge_length, &report);
 		assert_valid_mesh(mesh);
 		assert_true(report.aligned_fraction == 1.0);
 		int vane = 0;
@@ -839,17 +846,10 @@ static void test_lone_stub_cut_back(void **state)
 {
 	(void)state;
 	int64_t before = plume_bytes_in_use();
-	char path[640];
-	snprintf(path, sizeof path, "%s/examples/streit-heidrich/bristle.json", PLUME_SOURCE_DIR);
 	const double edges[2] = {5e-3, 2.5e-3};
 	for (int i = 0; i < 2; ++i) {
-		plume_mesh_spec_options options = plume_mesh_spec_default_options();
-		options.edge_length = edges[i];
-		plume_mesh *mesh = NULL;
 		plume_mesh_report report;
-		plume_error err;
-		if (plume_mesh_spec_read(path, &options, &mesh, &report, &err) != PLUME_OK)
-			fail_msg("%s", err.message);
+		plume_mesh *mesh = example_mesh("streit-heidrich/bristle.json", edges[i], &report);
 		assert_valid_mesh(mesh);
 		print_message("e = %g: vane min angle %.2f deg, guides %d + %d\n", edges[i], report.vane_min_angle * 180.0 / pi,
 		              report.guide_count[0], report.guide_count[1]);

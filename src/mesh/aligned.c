@@ -1180,23 +1180,38 @@ static int settle_strips(mesher *m)
 	return faces;
 }
 
-/// Smallest angle of the strips that have line l as a guide (pi when none),
-/// walked dry; -1 when one of them does not walk through. Strips with a guide
-/// left out (drop_short_end_guides) are no longer strips.
-static double line_strips_quality(const mesher *m, int l)
+/// Smallest angle of the faces of the listed strips (-1 entries skipped) as
+/// walked, or -1 when one of them is not simple or does not walk through.
+static double strips_quality(const mesher *m, const int *strips, int count)
 {
 	double smallest = pi;
-	for (int s = 0; s < m->strip_count; ++s) {
-		const mesh_strip *strip = m->strip_list + s;
-		if ((strip->a != l && strip->b != l) || !m->lines[strip->a].present || !m->lines[strip->b].present)
+	for (int j = 0; j < count; ++j) {
+		if (strips[j] < 0)
 			continue;
 		strip_out dry = {NULL, 0, pi};
 		int i, k;
+		const mesh_strip *strip = m->strip_list + strips[j];
 		if (!strip_is_simple(m, strip, &i, &k) || !walk_strip(m, strip, &dry, &i, &k))
 			return -1.0;
 		smallest = fmin(smallest, dry.smallest);
 	}
 	return smallest;
+}
+
+/// Smallest angle of the strips that have line l as a guide (pi when none),
+/// walked dry; -1 when one of them does not walk through. Strips with a guide
+/// left out (drop_short_end_guides) are no longer strips.
+static double line_strips_quality(const mesher *m, int l)
+{
+	int strips[3], count = 0; // below, above, and the tip's: a guide is a side of three at most
+	for (int s = 0; s < m->strip_count; ++s) {
+		const mesh_strip *strip = m->strip_list + s;
+		if ((strip->a == l || strip->b == l) && m->lines[strip->a].present && m->lines[strip->b].present) {
+			assert(count < 3);
+			strips[count++] = s;
+		}
+	}
+	return strips_quality(m, strips, count);
 }
 
 /// A vane reduced to two guides keeps an end stub (drop_short_end_guides),
@@ -1337,24 +1352,6 @@ static int strip_beside(const mesher *m, const strip_table *table, int side, int
 {
 	int low = d < 0 ? r - 1 : r;
 	return low >= 0 && low + 1 < m->row_count ? table->above[line_index(m, side, low)] : -1;
-}
-
-/// Smallest angle of the faces of the listed strips (-1 entries skipped) as
-/// walked, or -1 when one of them is not simple or does not walk through.
-static double strips_quality(const mesher *m, const int *strips, int count)
-{
-	double smallest = pi;
-	for (int j = 0; j < count; ++j) {
-		if (strips[j] < 0)
-			continue;
-		strip_out dry = {NULL, 0, pi};
-		int i, k;
-		const mesh_strip *strip = m->strip_list + strips[j];
-		if (!strip_is_simple(m, strip, &i, &k) || !walk_strip(m, strip, &dry, &i, &k))
-			return -1.0;
-		smallest = fmin(smallest, dry.smallest);
-	}
-	return smallest;
 }
 
 /// True when segment pq properly crosses a guide of the side's rows r - 4 to
