@@ -303,15 +303,17 @@ static const double PROJECTED_SHIFT_LIMIT = 1e2;
 /// entries are off by this relative amount, an inexact Newton step (Dembo, Eisenstat &
 /// Steihaug 1982) with forcing term about 1e-4. Newton's convergence test measures the
 /// true residual and the barbs' strain at every iterate, so the tolerance of a step
-/// changes how fast Newton gets there, not where it stops. From the multipliers' guess the first solve is usually
-/// within it (about 1e-5-1e-6, kkt.h), so most steps take one solve, where 1e-9 took a refinement step more. Measured
-/// against 1e-9, 2026-11-28 (Newton iterations; largest difference of the last frame): Figure 1 at 5 mm 396 / 396,
-/// 7e-12 m, 2.21 -> 1.16 solves an iteration; at 2.5 mm 596 / 598, 8e-12 m; swing.json 1015 / 1013, 1.5e-10 m;
-/// wing-draft.json 772 / 772, 2e-12 m; bird-flap.json 886 / 886, 7e-11 m; coat-settle.json 83 / 81, 1.1e-10 m;
-/// falling.json 615 / 617, 1.75e-7 m, where a Newton tolerance ten times tighter moves
-/// the last frame by 3.1e-6 m: the step's error stays well inside the solver's own.
-/// The solves' time fell by 20-50 % on every scene. (Since 2026-11-25 it was 1e-9, one
-/// refinement step; before that 1e-14, two or three.)
+/// changes how fast Newton gets there, not where it stops. From the multipliers' guess
+/// the first solve is usually within it (about 1e-5-1e-6, kkt.h), so most steps take one
+/// solve, where 1e-9 took a refinement step more. Measured against 1e-9, 2026-11-28
+/// (Newton iterations; largest difference of the last frame): Figure 1 at 5 mm
+/// 396 / 396, 7e-12 m, 2.21 -> 1.16 solves an iteration; at 2.5 mm 596 / 598, 8e-12 m;
+/// swing.json 1015 / 1013, 1.5e-10 m; wing-draft.json 772 / 772, 2e-12 m; bird-flap.json
+/// 886 / 886, 7e-11 m; coat-settle.json 83 / 81, 1.1e-10 m; falling.json 615 / 617,
+/// 1.75e-7 m, where a Newton tolerance ten times tighter moves the last frame by
+/// 3.1e-6 m: the step's error stays well inside the solver's own. The solves' time fell
+/// by 20-50 % on every scene. (Since 2026-11-25 it was 1e-9, one refinement step; before
+/// that 1e-14, two or three.)
 static const double STEP_BACKWARD_ERROR = 1e-4;
 
 /// Factors the assembled matrix and solves for the step. An exact Hessian that is not
