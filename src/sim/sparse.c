@@ -134,7 +134,7 @@ plume_status plume_sparse_init(plume_sparse *s, int n, plume_sparse_entry *entri
 	// [2] of its entries. Its defaults (4, 16, 48 / 0.8, 0.1, 0.05) leave the supernodes
 	// of a shell's 3-unknown vertex blocks small, and each small one costs a BLAS call and
 	// a scalar scatter of its update into its parent. With these, the fastest
-	// factorisation of Figure 1's matrix, measured in one sitting: 1.09 -> 0.87 ms at
+	// factorisation of Figure 1's matrix, measured in one sitting: 1.08 -> 0.87 ms at
 	// e = 5 mm, 7.0 -> 6.1 ms at 2.5 mm, 19.0 -> 17.5 ms at 1.75 mm, 82 -> 64 ms at 1.25 mm
 	// (docs/simulation.md, Supernodes). More (32, 64, 128 / 0.9, 0.3, 0.2) was slower
 	// again from 1.75 mm on, and the solves read the stored zeros too (the 5 mm factor
