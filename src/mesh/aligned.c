@@ -1203,15 +1203,17 @@ static double strips_quality(const mesher *m, const int *strips, int count)
 /// left out (drop_short_end_guides) are no longer strips.
 static double line_strips_quality(const mesher *m, int l)
 {
-	int strips[3], count = 0; // below, above, and the tip's: a guide is a side of three at most
+	double smallest = pi;
 	for (int s = 0; s < m->strip_count; ++s) {
 		const mesh_strip *strip = m->strip_list + s;
-		if ((strip->a == l || strip->b == l) && m->lines[strip->a].present && m->lines[strip->b].present) {
-			assert(count < 3);
-			strips[count++] = s;
-		}
+		if ((strip->a != l && strip->b != l) || !m->lines[strip->a].present || !m->lines[strip->b].present)
+			continue;
+		double quality = strips_quality(m, &s, 1);
+		if (quality < 0)
+			return -1.0;
+		smallest = fmin(smallest, quality);
 	}
-	return strips_quality(m, strips, count);
+	return smallest;
 }
 
 /// A vane reduced to two guides keeps an end stub (drop_short_end_guides),

@@ -174,9 +174,12 @@ static void apply_step(const plume_sim *sim, const plume_vec3 *x, const double *
 }
 
 /// Merit of the line search: the potential plus mu times the constraint violation.
-static double merit(plume_sim *sim, const sim_problem *problem, const plume_vec3 *x, double mu)
+/// The l1 merit phi + mu |c|_1 at x; its potential phi in *potential when not NULL.
+static double merit(plume_sim *sim, const sim_problem *problem, const plume_vec3 *x, double mu, double *potential)
 {
 	double phi = plume_sim_potential(sim, problem, x, NULL, false, false);
+	if (potential != NULL)
+		*potential = phi;
 	return sim->constraint_count > 0 ? phi + mu * constraint_norm1(sim, x) : phi;
 }
 
@@ -222,8 +225,8 @@ static bool corrected_trial(plume_sim *sim, const sim_problem *problem, const pl
 			if (!(bound >= 1))
 				return false;
 		}
-		double potential = plume_sim_potential(sim, problem, sim->scratch, NULL, false, false);
-		double corrected = potential + mu * constraint_norm1(sim, sim->scratch);
+		double potential;
+		double corrected = merit(sim, problem, sim->scratch, mu, &potential);
 		if (isfinite(corrected) && corrected <= threshold) {
 			memcpy(sim->trial, sim->scratch, bytes);
 			*accepted_merit = corrected;
@@ -515,7 +518,7 @@ static plume_status newton(plume_sim *sim, const sim_problem *problem, plume_sol
 			break; // CCD allows no motion at all (a pair that starts in contact): no step to take
 		for (int backtrack = 0; backtrack < MAX_BACKTRACKS && !accepted; ++backtrack) {
 			apply_step(sim, x, step, alpha, sim->trial);
-			double trial = merit(sim, problem, sim->trial, mu);
+			double trial = merit(sim, problem, sim->trial, mu, NULL);
 			if (isfinite(trial) && trial <= current + 1e-4 * alpha * fmin(slope, 0)) {
 				accepted = true;
 				accepted_merit = trial;

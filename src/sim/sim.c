@@ -264,14 +264,25 @@ static int pair_face_edges(const plume_mesh *mesh, int **out)
 /// shape, are the same up to rounding: the rest shape there is the reference moved rigidly.
 static bool same_length(double plane, double rest) { return fabs(rest - plane) <= 1e-12 * plane; }
 
+/// The distance of vertices a and b in the reference plane.
+static double plane_length(const plume_mesh *mesh, int a, int b)
+{
+	plume_vec2 p = mesh->reference[a], q = mesh->reference[b];
+	return hypot(q.x - p.x, q.y - p.y);
+}
+
+/// The distance of vertices a and b in the 3D rest shape.
+static double shape_length(const plume_mesh *mesh, int a, int b)
+{
+	return plume_v3_length(plume_v3_sub(mesh->rest[b], mesh->rest[a]));
+}
+
 /// A material length between two vertices: the 3D rest shape's (a curved feather is at rest
 /// in its curved shape), or the reference plane's where they are the same up to rounding,
 /// so that a flat feather's lengths are the reference's bit for bit.
 static double rest_length(const plume_mesh *mesh, int a, int b)
 {
-	plume_vec2 p = mesh->reference[a], q = mesh->reference[b];
-	double plane = hypot(q.x - p.x, q.y - p.y);
-	double rest = plume_v3_length(plume_v3_sub(mesh->rest[b], mesh->rest[a]));
+	double plane = plane_length(mesh, a, b), rest = shape_length(mesh, a, b);
 	return same_length(plane, rest) ? plane : rest;
 }
 
@@ -288,9 +299,8 @@ static void rest_triangle(const plume_mesh *mesh, int f, plume_vec2 out[3])
 	bool flat = true;
 	for (int k = 0; k < 3; ++k) {
 		out[k] = mesh->reference[v[k]];
-		plume_vec2 p = mesh->reference[v[k]], q = mesh->reference[v[(k + 1) % 3]];
-		flat &= same_length(hypot(q.x - p.x, q.y - p.y),
-		                    plume_v3_length(plume_v3_sub(mesh->rest[v[(k + 1) % 3]], mesh->rest[v[k]])));
+		int next = v[(k + 1) % 3];
+		flat &= same_length(plane_length(mesh, v[k], next), shape_length(mesh, v[k], next));
 	}
 	plume_vec2 r0 = out[0], r1 = out[1], r2 = out[2];
 	double twice_area = (r1.x - r0.x) * (r2.y - r0.y) - (r2.x - r0.x) * (r1.y - r0.y);
