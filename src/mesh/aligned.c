@@ -24,10 +24,11 @@
 // of faces under 25 degrees slide along their guides (slide_vertices), so that
 // vane faces keep their smallest angle at 20 degrees or more outside the
 // junctions where a guide meets the rachis or the outline at a shallow angle
-// (plume_mesh_measure). A mesh that falls short is built again, up to six
+// (plume_mesh_measure). A mesh that falls short is built again, up to eight
 // times, with root-phased steps on the guides rooted close to the next
-// (root_phase_step) and with guides that converge on the next thinned
-// (thin_converging_guides), and the best is kept (mesh_run).
+// (root_phase_step), with guides that converge on the next thinned
+// (thin_converging_guides) and with guides that run along the outline cut back
+// (trim_outline_tails), and the best that keeps the vane is kept (mesh_run).
 //
 // A step that would make an inverted or degenerate triangle (two guides
 // touching) is never taken: both guides are cut there and every strip is
@@ -83,6 +84,7 @@ typedef struct mesh_strip {
 typedef struct mesh_variant {
 	double phase_below_deg; ///< mesher.phase_below_deg
 	double thin_gap;        ///< mesher.thin_gap
+	bool trim_tails;        ///< mesher.trim_tails
 } mesh_variant;
 
 typedef struct mesher {
@@ -110,6 +112,9 @@ typedef struct mesher {
 	/// 0 in the first tries; in the thinned ones (mesh_run), a guide is cut where it
 	/// comes closer than this many edge lengths to the next guide (thin_converging_guides).
 	double thin_gap;
+	/// false in the first tries; in the later ones, guides that run along the outline past
+	/// their neighbour's tip are cut back (trim_outline_tails).
+	bool trim_tails;
 	plume_error *err;
 } mesher;
 
@@ -767,22 +772,35 @@ typedef struct strip_out {
 	plume_mesh *mesh; ///< NULL: only count and check
 	int faces;
 	double smallest; ///< smallest angle of the faces so far (walk positions), radians
+	/// Smallest angle but the junction corners (mesh_junction_corners: between a
+	/// face's barb edge and the strip's bottom or closing edge), radians: what
+	/// plume_mesh_measure holds to the quality bound.
+	double open;
+	double area; ///< the faces' area so far, m^2
 } strip_out;
 
+/// A strip_out that only counts and checks.
+static strip_out dry_out(void) { return (strip_out){NULL, 0, pi, pi, 0.0}; }
+
 /// Smallest interior angle of face (line[k], at[k]), k = 0, 1, 2, in the plane.
-static double face_quality(const mesher *m, const int line[3], const int at[3])
+/// Adds face (line[k], at[k]), k = 0, 1, 2, to out's smallest angles (junction
+/// corners: the bits of junction) and area, in the plane.
+static void face_quality(const mesher *m, const int line[3], const int at[3], unsigned junction, strip_out *out)
 {
 	plume_vec2 q[3];
 	for (int k = 0; k < 3; ++k) {
 		plume_vec3 p = m->points[m->lines[line[k]].first + at[k]];
 		q[k] = (plume_vec2){p.x, p.y};
 	}
-	return smallest_corner(q, 0);
+	out->smallest = fmin(out->smallest, smallest_corner(q, 0));
+	out->open = fmin(out->open, smallest_corner(q, junction));
+	out->area += 0.5 * fabs((q[1].x - q[0].x) * (q[2].y - q[0].y) - (q[1].y - q[0].y) * (q[2].x - q[0].x));
 }
 
-static void emit_face(const mesher *m, strip_out *out, int la, int ia, int lb, int ib, int lc, int ic, int barb_edge)
+static void emit_face(const mesher *m, strip_out *out, int la, int ia, int lb, int ib, int lc, int ic, int barb_edge,
+                      unsigned junction)
 {
-	out->smallest = fmin(out->smallest, face_quality(m, (const int[3]){la, lb, lc}, (const int[3]){ia, ib, ic}));
+	face_quality(m, (const int[3]){la, lb, lc}, (const int[3]){ia, ib, ic}, junction, out);
 	if (out->mesh != NULL) {
 		plume_mesh *mesh = out->mesh;
 		int f = out->faces;
@@ -1058,11 +1076,16 @@ static bool walk_strip(const mesher *m, const mesh_strip *strip, strip_out *out,
 			return false;
 		}
 		bool take_a = ok_a && (!ok_b || dist2(A[i + 1], B[k]) <= dist2(A[i], B[k + 1]));
+		// Junction corners: where the face's barb edge meets the bottom edge (A_0, B_0), on
+		// the rachis, or the closing edge (A_ma, B_nb), on the outline.
+		bool bottom = i == 0 && k == 0;
 		if (take_a) {
-			emit_face(m, out, strip->a, i, strip->a, i + 1, strip->b, k, 0);
+			bool closing = !shared && i + 1 == ma && k == nb;
+			emit_face(m, out, strip->a, i, strip->a, i + 1, strip->b, k, 0, (bottom ? 1u : 0u) | (closing ? 2u : 0u));
 			++i;
 		} else {
-			emit_face(m, out, strip->a, i, strip->b, k + 1, strip->b, k, 1);
+			bool closing = !shared && i == ma && k + 1 == nb;
+			emit_face(m, out, strip->a, i, strip->b, k + 1, strip->b, k, 1, (closing ? 2u : 0u) | (bottom ? 4u : 0u));
 			++k;
 		}
 	}
@@ -1158,7 +1181,7 @@ static int settle_strips(mesher *m)
 				continue;
 			if (strip->shared_end && (a->count != a->full || b->count != b->full))
 				strip->shared_end = false; // a cut guide no longer reaches the shared tip
-			strip_out dry = {NULL, 0, pi};
+			strip_out dry = dry_out();
 			int i, k;
 			if (strip_is_simple(m, strip, &i, &k) && walk_strip(m, strip, &dry, &i, &k)) {
 				seen[0] = a->count;
@@ -1180,40 +1203,53 @@ static int settle_strips(mesher *m)
 	return faces;
 }
 
+/// Walks the listed strips dry (-1 entries skipped) into total (smallest
+/// angles, area); false when one of them is not simple or does not walk through.
+static bool walk_strips(const mesher *m, const int *strips, int count, strip_out *total)
+{
+	*total = dry_out();
+	for (int j = 0; j < count; ++j) {
+		if (strips[j] < 0)
+			continue;
+		int i, k;
+		const mesh_strip *strip = m->strip_list + strips[j];
+		if (!strip_is_simple(m, strip, &i, &k) || !walk_strip(m, strip, total, &i, &k))
+			return false;
+	}
+	return true;
+}
+
 /// Smallest angle of the faces of the listed strips (-1 entries skipped) as
 /// walked, or -1 when one of them is not simple or does not walk through.
 static double strips_quality(const mesher *m, const int *strips, int count)
 {
-	double smallest = pi;
-	for (int j = 0; j < count; ++j) {
-		if (strips[j] < 0)
-			continue;
-		strip_out dry = {NULL, 0, pi};
-		int i, k;
-		const mesh_strip *strip = m->strip_list + strips[j];
-		if (!strip_is_simple(m, strip, &i, &k) || !walk_strip(m, strip, &dry, &i, &k))
-			return -1.0;
-		smallest = fmin(smallest, dry.smallest);
-	}
-	return smallest;
+	strip_out total;
+	return walk_strips(m, strips, count, &total) ? total.smallest : -1.0;
 }
 
-/// Smallest angle of the strips that have line l as a guide (pi when none),
-/// walked dry; -1 when one of them does not walk through. Strips with a guide
-/// left out (drop_short_end_guides) are no longer strips.
-static double line_strips_quality(const mesher *m, int l)
+/// The strips that have line l as a guide, walked dry into total (nothing:
+/// pi, pi, 0); false when one of them does not walk through. Strips with a
+/// guide left out (drop_short_end_guides) are no longer strips.
+static bool walk_line_strips(const mesher *m, int l, strip_out *total)
 {
-	double smallest = pi;
+	*total = dry_out();
 	for (int s = 0; s < m->strip_count; ++s) {
 		const mesh_strip *strip = m->strip_list + s;
 		if ((strip->a != l && strip->b != l) || !m->lines[strip->a].present || !m->lines[strip->b].present)
 			continue;
-		double quality = strips_quality(m, &s, 1);
-		if (quality < 0)
-			return -1.0;
-		smallest = fmin(smallest, quality);
+		int i, k;
+		if (!strip_is_simple(m, strip, &i, &k) || !walk_strip(m, strip, total, &i, &k))
+			return false;
 	}
-	return smallest;
+	return true;
+}
+
+/// Smallest angle of the strips that have line l as a guide (pi when none),
+/// walked dry; -1 when one of them does not walk through.
+static double line_strips_quality(const mesher *m, int l)
+{
+	strip_out total;
+	return walk_line_strips(m, l, &total) ? total.smallest : -1.0;
 }
 
 /// A vane reduced to two guides keeps an end stub (drop_short_end_guides),
@@ -1255,6 +1291,90 @@ static int cut_back_lone_stubs(mesher *m)
 	return cut;
 }
 
+/// True when line l is a side of a strip whose two guides end in one vertex.
+static bool in_shared_end_strip(const mesher *m, int l)
+{
+	for (int s = 0; s < m->strip_count; ++s)
+		if (m->strip_list[s].shared_end && (m->strip_list[s].a == l || m->strip_list[s].b == l))
+			return true;
+	return false;
+}
+
+/// True when segment pq properly crosses a guide of the side's rows r - 4 to
+/// r + 4 other than row r.
+static bool crosses_nearby(const mesher *m, int side, int r, plume_vec3 p, plume_vec3 q)
+{
+	for (int d = -4; d <= 4; ++d) {
+		const mesh_line *line = r + d >= 0 && r + d < m->row_count ? m->lines + line_index(m, side, r + d) : NULL;
+		if (d != 0 && line != NULL && line->present && line->count >= 2 &&
+		    first_crossing(m, line, 0, line->count - 2, p, q) >= 0)
+			return true;
+	}
+	return false;
+}
+
+/// True when the closing edge of a strip of line l (from one guide's last vertex
+/// to the other's) crosses a guide of the rows near either guide.
+static bool closing_edges_cross(const mesher *m, int l)
+{
+	for (int s = 0; s < m->strip_count; ++s) {
+		const mesh_strip *strip = m->strip_list + s;
+		if (strip->a != l && strip->b != l)
+			continue;
+		strip_view view = view_strip(m, strip);
+		plume_vec3 p = view.A[view.ma], q = view.B[view.nb];
+		for (int j = 0; j < 2; ++j) {
+			int line = j == 0 ? strip->a : strip->b;
+			if (crosses_nearby(m, line / m->row_count, line % m->row_count, p, q))
+				return true;
+		}
+	}
+	return false;
+}
+
+/// Where a guide reaches the outline before its neighbour, their strip closes
+/// with a fan from the guide's tip over the neighbour's last vertices; when the
+/// neighbour runs along the outline there, those faces are slivers that no
+/// placement along the guides lifts (the Streit-Heidrich semiplume at 2.5 mm:
+/// 18 degrees, a guide 0.5 mm inside a 6 mm stretch of outline). The
+/// neighbour's tail is cut back, vertex by vertex, while that raises the
+/// smallest angle of its strips outside junction corners (strip_out.open) from
+/// under the quality bound, and the vane loses at most TAIL_AREA e^2 of area
+/// for the guide: the outline then runs through the cut guide's new tip. A
+/// guide keeps two vertices. Returns 1 when a guide was cut.
+static int trim_outline_tails(mesher *m)
+{
+	static const double TAIL_AREA = 0.3;
+	const double bound = PLUME_MESH_QUALITY_ANGLE_DEG * pi / 180.0;
+	int cut = 0;
+	for (int l = 0; l < 2 * m->row_count; ++l) {
+		mesh_line *line = m->lines + l;
+		strip_out whole, best;
+		if (!line->present || line->count <= 2 || line->join_line >= 0 || line->join_target ||
+		    in_shared_end_strip(m, l) || !walk_line_strips(m, l, &whole) || !(whole.open < bound))
+			continue;
+		best = whole;
+		int whole_count = line->count, kept = whole_count;
+		for (int count = whole_count - 1; count >= 2; --count) {
+			line->count = count;
+			strip_out tried;
+			if (!walk_line_strips(m, l, &tried) || whole.area - tried.area > TAIL_AREA * m->e * m->e ||
+			    closing_edges_cross(m, l))
+				break;
+			if (tried.open > best.open) {
+				best = tried;
+				kept = count;
+			}
+		}
+		line->count = kept;
+		if (kept < whole_count) {
+			m->trimmed += whole_count - kept;
+			cut = 1;
+		}
+	}
+	return cut;
+}
+
 /// A guide that is no side of any strip (a vane of one guide) makes no face:
 /// it is left out, so that the mesh has no vertex outside its faces. Returns
 /// false out of memory.
@@ -1285,7 +1405,7 @@ static int forget_dropped_strips(mesher *m)
 		mesh_strip strip = m->strip_list[s];
 		if (!m->lines[strip.a].present || !m->lines[strip.b].present)
 			continue;
-		strip_out dry = {NULL, 0, pi};
+		strip_out dry = dry_out();
 		int i, k;
 		bool ok = walk_strip(m, &strip, &dry, &i, &k);
 		assert(ok);
@@ -1354,19 +1474,6 @@ static int strip_beside(const mesher *m, const strip_table *table, int side, int
 {
 	int low = d < 0 ? r - 1 : r;
 	return low >= 0 && low + 1 < m->row_count ? table->above[line_index(m, side, low)] : -1;
-}
-
-/// True when segment pq properly crosses a guide of the side's rows r - 4 to
-/// r + 4 other than row r.
-static bool crosses_nearby(const mesher *m, int side, int r, plume_vec3 p, plume_vec3 q)
-{
-	for (int d = -4; d <= 4; ++d) {
-		const mesh_line *line = r + d >= 0 && r + d < m->row_count ? m->lines + line_index(m, side, r + d) : NULL;
-		if (d != 0 && line != NULL && line->present && line->count >= 2 &&
-		    first_crossing(m, line, 0, line->count - 2, p, q) >= 0)
-			return true;
-	}
-	return false;
 }
 
 /// Angle (radians) between the directions from o to p and from o to q.
@@ -1991,7 +2098,9 @@ static plume_status build_mesh(mesher *m, int vane_faces, plume_mesh **out, plum
 		}
 	int face = 0;
 	plume_status status = emit_rachis(m, mesh, &face);
-	strip_out emitted = {mesh, face, pi};
+	strip_out emitted = dry_out();
+	emitted.mesh = mesh;
+	emitted.faces = face;
 	for (int s = 0; s < m->strip_count && status == PLUME_OK; ++s) {
 		int i, k;
 		bool ok = walk_strip(m, m->strip_list + s, &emitted, &i, &k);
@@ -2080,6 +2189,8 @@ static plume_status assemble(mesher *m, plume_mesh **out, plume_mesh_report *rep
 		return plume_error_set(m->err, PLUME_ERROR_MEMORY, "out of memory checking the guides' ends");
 	if (cut_back_lone_stubs(m) > 0)
 		dropped = 1;
+	if (m->trim_tails && trim_outline_tails(m) > 0)
+		dropped = 1;
 	if (dropped > 0)
 		vane_faces = forget_dropped_strips(m);
 	if (!drop_lone_guides(m))
@@ -2165,6 +2276,7 @@ static plume_status mesh_begin(mesher *m, const mesh_input *input, const plume_m
 	              .max_memory = (double)(def->max_memory > 0 ? def->max_memory : PLUME_DEFAULT_MAX_MEMORY),
 	              .phase_below_deg = variant.phase_below_deg,
 	              .thin_gap = variant.thin_gap,
+	              .trim_tails = variant.trim_tails,
 	              .err = err};
 	plume_status status = place_rows(m);
 	if (status != PLUME_OK)
@@ -2217,29 +2329,54 @@ static plume_status mesh_try(const mesh_input *input, const plume_mesh_def *def,
 	return status;
 }
 
+/// A later try (mesh_run) must keep this fraction of the first try's vane area.
+/// Thinning guides shortens the vane where its guides converge: the
+/// Franco-Walter peacock's notch at its tip loses 1.5 % of the vane at a gap of
+/// 0.4 e. Where a vane is a few guides wide, a thinned try can keep a fraction
+/// of it (the Streit-Heidrich down at 2.5 mm: 17-31 %; the Streit-Heidrich
+/// peacock: 53 % at 0.5 e). Phased tries move vertices along the guides' ends:
+/// the down keeps 97.4 % then.
+static const double MESH_VARIANT_AREA = 0.95;
+
+/// The vane faces' area in the plane, m^2.
+static double vane_area(const plume_mesh *mesh)
+{
+	double area = 0.0;
+	for (int f = 0; f < mesh->face_count; ++f) {
+		if (mesh->material[f] != PLUME_MATERIAL_VANE)
+			continue;
+		plume_vec2 p = mesh->reference[mesh->faces[3 * f]], q = mesh->reference[mesh->faces[3 * f + 1]],
+		           r = mesh->reference[mesh->faces[3 * f + 2]];
+		area += 0.5 * fabs((q.x - p.x) * (r.y - p.y) - (q.y - p.y) * (r.x - p.x));
+	}
+	return area;
+}
+
 /// Meshes the input; where the vane's smallest angle outside junction faces
 /// falls short of PLUME_MESH_QUALITY_ANGLE_DEG, meshes it again phased
 /// (root_phase_step), with guides under 22, then 18, then 32 degrees to the
 /// next phased, then thinned (thin_converging_guides: guides cut where they
 /// come within 0.15 e of the next) unphased and phased at 22 and 32 degrees,
-/// while none reaches the bound, and keeps the mesh with the highest smallest
-/// angle, the earliest on ties. Which guides gain from the phase depends on the
-/// feather (measured, docs/meshing.md: 22 degrees took the Streit-Heidrich
-/// flight over 20 at both edge lengths, 18 the Franco-Walter hawk at 2.5 mm, 32
-/// raised the Franco-Walter filoplume and the Streit-Heidrich semiplume at
-/// 2.5 mm; thinning raised both peacocks and the semiplume at 2.5 mm, each
-/// with another phase). Meshes that reach the bound are built once, as they
-/// were (the Figure 1 hawk at 5 mm, whose simulation tests/test_scene.c pins);
-/// a try that fails (over the memory limit, or overlapping faces) is passed
-/// over.
+/// thinned at 0.4 e, and thinned at 0.15 e phased at 32 degrees with tails
+/// along the outline cut back (trim_outline_tails), while none reaches the
+/// bound, and keeps the mesh with the highest smallest angle, the earliest on
+/// ties, among those that keep MESH_VARIANT_AREA of the first try's vane. Which guides gain from the phase depends on
+/// the feather (measured, docs/meshing.md: 22 degrees took the Streit-Heidrich flight over 20 at both edge lengths, 18
+/// the Franco-Walter hawk at 2.5 mm, 32 raised the Franco-Walter filoplume and the Streit-Heidrich semiplume at 2.5 mm;
+/// thinning raised both peacocks and the semiplume at 2.5 mm, each with another phase; the gap of 0.4 e took the
+/// Franco-Walter peacock at 5 mm over 20, cutting tails the Streit-Heidrich semiplume at 2.5 mm). Meshes that reach the
+/// bound are built once, as they were (the Figure 1 hawk at 5 mm, whose simulation tests/test_scene.c pins); a try that
+/// fails (over the memory limit, or overlapping faces) is passed over.
 static plume_status mesh_run(const mesh_input *input, const plume_mesh_def *def, plume_mesh **out,
                              plume_mesh_report *report, plume_error *err)
 {
-	static const mesh_variant variants[] = {{22.0, 0.0}, {18.0, 0.0},  {32.0, 0.0},
-	                                        {0.0, 0.15}, {22.0, 0.15}, {32.0, 0.15}};
+	static const mesh_variant variants[] = {{22.0, 0.0, false}, {18.0, 0.0, false},  {32.0, 0.0, false},
+	                                        {0.0, 0.15, false}, {22.0, 0.15, false}, {32.0, 0.15, false},
+	                                        {0.0, 0.4, false},  {32.0, 0.15, true}};
 	const double bound = PLUME_MESH_QUALITY_ANGLE_DEG * pi / 180.0;
 	plume_mesh_report best, tried;
-	plume_status status = mesh_try(input, def, (mesh_variant){0.0, 0.0}, out, &best, err);
+	plume_status status = mesh_try(input, def, (mesh_variant){0.0, 0.0, false}, out, &best, err);
+	double first_area = status == PLUME_OK ? vane_area(*out) : 0.0;
 	for (size_t i = 0; status == PLUME_OK && best.vane_min_angle < bound && i < sizeof variants / sizeof variants[0];
 	     ++i) {
 		plume_mesh *candidate = NULL;
@@ -2250,7 +2387,8 @@ static plume_status mesh_run(const mesh_input *input, const plume_mesh_def *def,
 			*out = NULL;
 			return plume_error_set(err, PLUME_ERROR_MEMORY, "%s", scratch.message);
 		}
-		if (tried_status == PLUME_OK && tried.vane_min_angle > best.vane_min_angle) {
+		if (tried_status == PLUME_OK && tried.vane_min_angle > best.vane_min_angle &&
+		    vane_area(candidate) >= MESH_VARIANT_AREA * first_area) {
 			plume_mesh_destroy(*out);
 			*out = candidate;
 			best = tried;
@@ -2266,7 +2404,7 @@ static plume_status mesh_estimate(const mesh_input *input, const plume_mesh_def 
                                   plume_error *err)
 {
 	mesher m;
-	plume_status status = mesh_begin(&m, input, def, (mesh_variant){0.0, 0.0}, out, err);
+	plume_status status = mesh_begin(&m, input, def, (mesh_variant){0.0, 0.0, false}, out, err);
 	mesh_end(&m);
 	return status;
 }
