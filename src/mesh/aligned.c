@@ -2352,21 +2352,24 @@ static double vane_area(const plume_mesh *mesh)
 	return area;
 }
 
-/// Meshes the input; where the vane's smallest angle outside junction faces
-/// falls short of PLUME_MESH_QUALITY_ANGLE_DEG, meshes it again phased
-/// (root_phase_step), with guides under 22, then 18, then 32 degrees to the
-/// next phased, then thinned (thin_converging_guides: guides cut where they
-/// come within 0.15 e of the next) unphased and phased at 22 and 32 degrees,
-/// thinned at 0.4 e, and thinned at 0.15 e phased at 32 degrees with tails
-/// along the outline cut back (trim_outline_tails), while none reaches the
-/// bound, and keeps the mesh with the highest smallest angle, the earliest on
-/// ties, among those that keep MESH_VARIANT_AREA of the first try's vane. Which guides gain from the phase depends on
-/// the feather (measured, docs/meshing.md: 22 degrees took the Streit-Heidrich flight over 20 at both edge lengths, 18
-/// the Franco-Walter hawk at 2.5 mm, 32 raised the Franco-Walter filoplume and the Streit-Heidrich semiplume at 2.5 mm;
-/// thinning raised both peacocks and the semiplume at 2.5 mm, each with another phase; the gap of 0.4 e took the
-/// Franco-Walter peacock at 5 mm over 20, cutting tails the Streit-Heidrich semiplume at 2.5 mm). Meshes that reach the
-/// bound are built once, as they were (the Figure 1 hawk at 5 mm, whose simulation tests/test_scene.c pins); a try that
-/// fails (over the memory limit, or overlapping faces) is passed over.
+/// Meshes the input; where the vane's smallest angle outside junction faces falls
+/// short of PLUME_MESH_QUALITY_ANGLE_DEG, meshes it again phased (root_phase_step),
+/// with guides under 22, then 18, then 32 degrees to the next phased, then thinned
+/// (thin_converging_guides: guides cut where they come within 0.15 e of the next)
+/// unphased and phased at 22 and 32 degrees, thinned at 0.4 e, and thinned at 0.15
+/// e phased at 32 degrees with tails along the outline cut back
+/// (trim_outline_tails), while none reaches the bound, and keeps the mesh with the
+/// highest smallest angle, the earliest on ties, among those that keep
+/// MESH_VARIANT_AREA of the first try's vane. Which guides gain from the phase
+/// depends on the feather (measured, docs/meshing.md: 22 degrees took the
+/// Streit-Heidrich flight over 20 at both edge lengths, 18 the Franco-Walter hawk
+/// at 2.5 mm, 32 raised the Franco-Walter filoplume and the Streit-Heidrich
+/// semiplume at 2.5 mm; thinning raised both peacocks and the semiplume at 2.5 mm,
+/// each with another phase; the gap of 0.4 e took the Franco-Walter peacock at 5 mm
+/// over 20, cutting tails the Streit-Heidrich semiplume at 2.5 mm). Meshes that
+/// reach the bound are built once, as they were (the Figure 1 hawk at 5 mm, whose
+/// simulation tests/test_scene.c pins); a try that fails (over the memory limit, or
+/// overlapping faces) is passed over.
 static plume_status mesh_run(const mesh_input *input, const plume_mesh_def *def, plume_mesh **out,
                              plume_mesh_report *report, plume_error *err)
 {
