@@ -1493,6 +1493,11 @@ static int join_candidate(const mesher *m, const strip_table *table, int side, i
 	const mesh_line *line = m->lines + line_index(m, side, r), *other = m->lines + line_index(m, side, r + d);
 	if (!other->present || other->join_line >= 0)
 		return -1;
+	// Past the join, the other guide's vertices are in no strip of this one: they need a
+	// strip on its far side (the next guide's, or the tip's), or they would belong to no
+	// face (a vane thinned to its last two guides, measured in test_outline_tail_cut).
+	if (strip_beside(m, table, side, r + d, d) < 0 && !table->at_tip[line_index(m, side, r + d)])
+		return -1;
 	plume_vec3 tip = m->points[line->first + line->count - 1], before = m->points[line->first + line->count - 2];
 	double best = m->e * m->e;
 	int found = -1;
