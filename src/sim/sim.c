@@ -854,6 +854,7 @@ plume_status plume_sim_solve_static(plume_sim *sim, plume_solve_report *report, 
 	// Load stepping: the handles' motion split into 1, 2, 4 ... increments.
 	for (int halvings = 0; halvings <= sim->def.solver.max_substep_halvings; ++halvings) {
 		int substeps = 1 << halvings;
+		sim->retrying = halvings > 0;
 		if (halvings > 0)
 			memcpy(sim->x, sim->saved_x, bytes);
 		total.substeps = substeps;
@@ -870,6 +871,7 @@ plume_status plume_sim_solve_static(plume_sim *sim, plume_solve_report *report, 
 		if (status != PLUME_ERROR_NUMERIC)
 			break;
 	}
+	sim->retrying = false;
 	total.max_barb_strain = plume_sim_max_barb_strain(sim, sim->x);
 	if (status == PLUME_OK) {
 		finish_handles(sim);
@@ -906,6 +908,7 @@ plume_status plume_sim_step(plume_sim *sim, plume_solve_report *report, plume_er
 	for (int halvings = 0; halvings <= sim->def.solver.max_substep_halvings; ++halvings) {
 		int substeps = 1 << halvings;
 		double h = sim->def.time_step / substeps;
+		sim->retrying = halvings > 0;
 		memcpy(sim->x, sim->saved_x, bytes);
 		memcpy(sim->v, sim->saved_v, bytes);
 		plume_integrator_restore(&sim->integrator, sim->vertex_count);
@@ -931,6 +934,7 @@ plume_status plume_sim_step(plume_sim *sim, plume_solve_report *report, plume_er
 		if (status != PLUME_ERROR_NUMERIC)
 			break;
 	}
+	sim->retrying = false;
 	if (status != PLUME_OK) {
 		memcpy(sim->x, sim->saved_x, bytes);
 		memcpy(sim->v, sim->saved_v, bytes);

@@ -126,6 +126,9 @@ struct plume_sim {
 	/// The last solve's exact Hessian could not be factored even shifted (or, without
 	/// constraints, gave an ascent step): the next solve starts projected (newton.c).
 	bool exact_hessian_failed;
+	/// Set while a failed step is retried in substeps: Newton keeps the exact Hessian after
+	/// a shortened step instead of taking a projected one (newton.c).
+	bool retrying;
 	/// The shift s (kkt.h) the last exact factorisation needed, 0 when it needed none: the
 	/// next one's ladder starts a decade below it (newton.c, factor_and_solve).
 	double exact_shift;
