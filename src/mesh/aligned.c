@@ -146,6 +146,12 @@ static double angle_between(double ax, double ay, double bx, double by)
 	return atan2(fabs(ax * by - ay * bx), ax * bx + ay * by);
 }
 
+/// Twice the signed area of plane triangle abc (positive counter-clockwise).
+static double twice_area(plume_vec2 a, plume_vec2 b, plume_vec2 c)
+{
+	return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+}
+
 /// Smallest interior angle of triangle q but the corners whose bit is set in skip
 /// (bit k: corner k; pi when all are skipped).
 static double smallest_corner(const plume_vec2 q[3], unsigned skip)
@@ -782,10 +788,9 @@ typedef struct strip_out {
 /// A strip_out that only counts and checks.
 static strip_out dry_out(void) { return (strip_out){NULL, 0, pi, pi, 0.0}; }
 
-/// Smallest interior angle of face (line[k], at[k]), k = 0, 1, 2, in the plane.
 /// Adds face (line[k], at[k]), k = 0, 1, 2, to out's smallest angles (junction
 /// corners: the bits of junction) and area, in the plane.
-static void face_quality(const mesher *m, const int line[3], const int at[3], unsigned junction, strip_out *out)
+static void measure_face(const mesher *m, const int line[3], const int at[3], unsigned junction, strip_out *out)
 {
 	plume_vec2 q[3];
 	for (int k = 0; k < 3; ++k) {
@@ -794,13 +799,13 @@ static void face_quality(const mesher *m, const int line[3], const int at[3], un
 	}
 	out->smallest = fmin(out->smallest, smallest_corner(q, 0));
 	out->open = fmin(out->open, smallest_corner(q, junction));
-	out->area += 0.5 * fabs((q[1].x - q[0].x) * (q[2].y - q[0].y) - (q[1].y - q[0].y) * (q[2].x - q[0].x));
+	out->area += 0.5 * fabs(twice_area(q[0], q[1], q[2]));
 }
 
 static void emit_face(const mesher *m, strip_out *out, int la, int ia, int lb, int ib, int lc, int ic, int barb_edge,
                       unsigned junction)
 {
-	face_quality(m, (const int[3]){la, lb, lc}, (const int[3]){ia, ib, ic}, junction, out);
+	measure_face(m, (const int[3]){la, lb, lc}, (const int[3]){ia, ib, ic}, junction, out);
 	if (out->mesh != NULL) {
 		plume_mesh *mesh = out->mesh;
 		int f = out->faces;
@@ -1203,19 +1208,21 @@ static int settle_strips(mesher *m)
 	return faces;
 }
 
+/// Walks one strip dry into total; false when it is not simple or does not walk through.
+static bool walk_dry(const mesher *m, const mesh_strip *strip, strip_out *total)
+{
+	int i, k;
+	return strip_is_simple(m, strip, &i, &k) && walk_strip(m, strip, total, &i, &k);
+}
+
 /// Walks the listed strips dry (-1 entries skipped) into total (smallest
 /// angles, area); false when one of them is not simple or does not walk through.
 static bool walk_strips(const mesher *m, const int *strips, int count, strip_out *total)
 {
 	*total = dry_out();
-	for (int j = 0; j < count; ++j) {
-		if (strips[j] < 0)
-			continue;
-		int i, k;
-		const mesh_strip *strip = m->strip_list + strips[j];
-		if (!strip_is_simple(m, strip, &i, &k) || !walk_strip(m, strip, total, &i, &k))
+	for (int j = 0; j < count; ++j)
+		if (strips[j] >= 0 && !walk_dry(m, m->strip_list + strips[j], total))
 			return false;
-	}
 	return true;
 }
 
@@ -1235,10 +1242,8 @@ static bool walk_line_strips(const mesher *m, int l, strip_out *total)
 	*total = dry_out();
 	for (int s = 0; s < m->strip_count; ++s) {
 		const mesh_strip *strip = m->strip_list + s;
-		if ((strip->a != l && strip->b != l) || !m->lines[strip->a].present || !m->lines[strip->b].present)
-			continue;
-		int i, k;
-		if (!strip_is_simple(m, strip, &i, &k) || !walk_strip(m, strip, total, &i, &k))
+		bool of_line = (strip->a == l || strip->b == l) && m->lines[strip->a].present && m->lines[strip->b].present;
+		if (of_line && !walk_dry(m, strip, total))
 			return false;
 	}
 	return true;
@@ -1349,11 +1354,11 @@ static int trim_outline_tails(mesher *m)
 	int cut = 0;
 	for (int l = 0; l < 2 * m->row_count; ++l) {
 		mesh_line *line = m->lines + l;
-		strip_out whole, best;
+		strip_out whole;
 		if (!line->present || line->count <= 2 || line->join_line >= 0 || line->join_target ||
 		    in_shared_end_strip(m, l) || !walk_line_strips(m, l, &whole) || !(whole.open < bound))
 			continue;
-		best = whole;
+		double best_open = whole.open;
 		int whole_count = line->count, kept = whole_count;
 		for (int count = whole_count - 1; count >= 2; --count) {
 			line->count = count;
@@ -1361,8 +1366,8 @@ static int trim_outline_tails(mesher *m)
 			if (!walk_line_strips(m, l, &tried) || whole.area - tried.area > TAIL_AREA * m->e * m->e ||
 			    closing_edges_cross(m, l))
 				break;
-			if (tried.open > best.open) {
-				best = tried;
+			if (tried.open > best_open) {
+				best_open = tried.open;
 				kept = count;
 			}
 		}
@@ -1621,8 +1626,7 @@ static double moved_face_quality(const plume_mesh *mesh, int f, int v, plume_vec
 		int w = mesh->faces[3 * f + k];
 		q[k] = w == v ? p : mesh->reference[w];
 	}
-	double area2 = (q[1].x - q[0].x) * (q[2].y - q[0].y) - (q[1].y - q[0].y) * (q[2].x - q[0].x);
-	if (!(area2 > tolerance))
+	if (!(twice_area(q[0], q[1], q[2]) > tolerance))
 		return -1.0;
 	return smallest_corner(q, junction);
 }
@@ -1784,8 +1788,7 @@ static plume_status emit_rachis(const mesher *m, plume_mesh *mesh, int *face)
 		for (int j = 0; j < 2; ++j) {
 			plume_vec2 a = mesh->reference[tris[j][0]], b = mesh->reference[tris[j][1]],
 			           c = mesh->reference[tris[j][2]];
-			double area2 = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
-			if (!(area2 > tolerance))
+			if (!(twice_area(a, b, c) > tolerance))
 				return plume_error_set(m->err, PLUME_ERROR_NUMERIC,
 				                       "the rachis band folds over between %g m and %g m along the rachis: the "
 				                       "rachis bends too sharply for its width; use a narrower band or a larger "
@@ -2350,9 +2353,8 @@ static double vane_area(const plume_mesh *mesh)
 	for (int f = 0; f < mesh->face_count; ++f) {
 		if (mesh->material[f] != PLUME_MATERIAL_VANE)
 			continue;
-		plume_vec2 p = mesh->reference[mesh->faces[3 * f]], q = mesh->reference[mesh->faces[3 * f + 1]],
-		           r = mesh->reference[mesh->faces[3 * f + 2]];
-		area += 0.5 * fabs((q.x - p.x) * (r.y - p.y) - (q.y - p.y) * (r.x - p.x));
+		const int *v = mesh->faces + 3 * f;
+		area += 0.5 * fabs(twice_area(mesh->reference[v[0]], mesh->reference[v[1]], mesh->reference[v[2]]));
 	}
 	return area;
 }
