@@ -146,7 +146,8 @@ static double angle_between(double ax, double ay, double bx, double by)
 	return atan2(fabs(ax * by - ay * bx), ax * bx + ay * by);
 }
 
-/// Twice the signed area of plane triangle abc (positive counter-clockwise).
+/// Twice the signed area of plane triangle abc (positive counter-clockwise): cross2 for
+/// reference-plane points.
 static double twice_area(plume_vec2 a, plume_vec2 b, plume_vec2 c)
 {
 	return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
@@ -824,12 +825,10 @@ static void emit_face(const mesher *m, strip_out *out, int la, int ia, int lb, i
 	out->faces++;
 }
 
-static double orient3(plume_vec3 a, plume_vec3 b, plume_vec3 c) { return cross2(a, b, c); }
-
 /// Proper crossing of segments pq and rs.
 static bool cross_segments(plume_vec3 p, plume_vec3 q, plume_vec3 r, plume_vec3 s)
 {
-	double o1 = orient3(p, q, r), o2 = orient3(p, q, s), o3 = orient3(r, s, p), o4 = orient3(r, s, q);
+	double o1 = cross2(p, q, r), o2 = cross2(p, q, s), o3 = cross2(r, s, p), o4 = cross2(r, s, q);
 	return ((o1 > 0.0 && o2 < 0.0) || (o1 < 0.0 && o2 > 0.0)) && ((o3 > 0.0 && o4 < 0.0) || (o3 < 0.0 && o4 > 0.0));
 }
 
