@@ -33,7 +33,7 @@ static double compression_fn(const void *element, const plume_vec3 *x, double *g
 
 static double triangle_fn(const void *element, const plume_vec3 *x, double *gradient, double *hessian)
 {
-	return plume_triangle_energy(element, x, gradient, hessian, false);
+	return plume_triangle_energy(element, x, 1.0, gradient, hessian, false);
 }
 
 static double hinge_fn(const void *element, const plume_vec3 *x, double *gradient, double *hessian)
@@ -650,6 +650,59 @@ static void test_compression_only_under_compression(void **state)
 	}
 }
 
+/// d psi / dJ of the exact Kikuuwe density at an isotropic strain of area ratio J, where
+/// dJ / d eps_xx = 1.
+static double compression_slope(const plume_membrane_element *element, double J)
+{
+	double strain[3] = {(J - 1) / 2, (J - 1) / 2, 0}, psi, dpsi[3], d2psi[9];
+	return plume_compression_density(element, strain, 1.0, &psi, dpsi, d2psi) ? dpsi[0] : 0.0;
+}
+
+/// The first Newton iteration's modified Hessian (membrane.h): psi and its gradient stay
+/// exact, and the curvature in J becomes the slope of the secant of d psi / dJ to secant_J,
+/// so the quadratic model's force at secant_J is the true one.
+static void test_compression_secant_curvature(void **state)
+{
+	(void)state;
+	double voigt[9];
+	plume_orthotropic_tensor(4.8e4, 4.8e4, 4.8e4, 0.0, voigt);
+	plume_vec2 reference[3] = {{0, 0}, {1, 0}, {0, 1}};
+	plume_membrane_element element;
+	assert_true(plume_membrane_element_init(&element, (int[]){0, 1, 2}, reference, 1.2e-4, voigt, 5.04e7));
+	// (J at the iterate, secant_J): stretched, then compressed less than secant_J, then
+	// compressed more (the exact curvature kept), then secant_J stretched (likewise).
+	const double cases[4][2] = {{1.03, 0.97}, {0.98, 0.95}, {0.95, 0.98}, {0.98, 1.02}};
+	for (int i = 0; i < 4; ++i) {
+		double J = cases[i][0], secant_J = cases[i][1];
+		double strain[3] = {(J - 1) / 2, (J - 1) / 2, 0};
+		double psi, dpsi[3], d2psi[9], exact_psi, exact_dpsi[3] = {0}, exact_d2psi[9] = {0};
+		bool written = plume_compression_density(&element, strain, secant_J, &psi, dpsi, d2psi);
+		bool exact_written = plume_compression_density(&element, strain, 1.0, &exact_psi, exact_dpsi, exact_d2psi);
+		assert_true(written);
+		assert_true(psi == exact_psi);
+		for (int k = 0; k < 3; ++k)
+			assert_true(dpsi[k] == exact_dpsi[k]);
+		// At an isotropic strain dJ = (1, 1, 0): the change is (k - k_exact) on that block.
+		double change = d2psi[0] - (exact_written ? exact_d2psi[0] : 0.0);
+		for (int k = 0; k < 9; ++k) {
+			double expected = (k == 0 || k == 1 || k == 3 || k == 4) ? change : 0.0;
+			assert_close(d2psi[k] - (exact_written ? exact_d2psi[k] : 0.0), expected, 1e-12 * fabs(d2psi[0]));
+		}
+		double delta = 1e-6;
+		double exact_curvature =
+		    (compression_slope(&element, J + delta) - compression_slope(&element, J - delta)) / (2 * delta);
+		if (secant_J >= J) {
+			assert_true(fabs(change) <= 1e-9 * fabs(exact_curvature));
+			continue;
+		}
+		double curvature = exact_curvature + change;
+		assert_true(curvature > exact_curvature);
+		// The model's force at secant_J is the density's.
+		double model = compression_slope(&element, J) + curvature * (secant_J - J);
+		assert_close(model, compression_slope(&element, secant_J), 1e-7 * fabs(compression_slope(&element, secant_J)));
+	}
+}
+
 static void test_degenerate_elements_are_refused(void **state)
 {
 	(void)state;
@@ -1024,7 +1077,7 @@ static void test_triangle_energy_and_projection(void **state)
 			deform(&rng, scaled, 3, 0.2, 0.05, x);
 		}
 		double g[9], H[81], gm[9], Hm[81], gc[9], Hc[81], gp[9], P[81];
-		double energy = plume_triangle_energy(&element, x, g, H, false);
+		double energy = plume_triangle_energy(&element, x, 1.0, g, H, false);
 		double sum = plume_membrane_energy(&element, x, gm, Hm) + plume_compression_energy(&element, x, gc, Hc);
 		assert_close(energy, sum, 1e-13 * fabs(sum));
 		double scale = test_norm(Hm, 81) + test_norm(Hc, 81);
@@ -1034,7 +1087,7 @@ static void test_triangle_energy_and_projection(void **state)
 			assert_close(H[i], Hm[i] + Hc[i], 1e-12 * scale);
 		assert_true(finite_difference_error(triangle_fn, &element, x, 3, 1e-6) < 1e-6);
 
-		assert_true(plume_triangle_energy(&element, x, gp, P, true) == energy);
+		assert_true(plume_triangle_energy(&element, x, 1.0, gp, P, true) == energy);
 		assert_memory_equal(gp, g, sizeof g);
 		double values[9];
 		plume_symmetric_eigen(P, 9, values, NULL);
@@ -1184,6 +1237,7 @@ int main(void)
 	    cmocka_unit_test(test_fundamental_form_tensor_and_rigid_motion),
 	    cmocka_unit_test(test_rigid_motion_stores_nothing),
 	    cmocka_unit_test(test_compression_only_under_compression),
+	    cmocka_unit_test(test_compression_secant_curvature),
 	    cmocka_unit_test(test_degenerate_elements_are_refused),
 	    cmocka_unit_test(test_bending_modulus_and_tilt),
 	    cmocka_unit_test(test_cylinder_bending_energy),

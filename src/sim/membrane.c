@@ -182,8 +182,8 @@ static void clamp_stress(double s[3])
 	s[2] = scale * s[2];
 }
 
-double plume_triangle_energy(const plume_membrane_element *element, const plume_vec3 x[3], double gradient[9],
-                             double hessian[81], bool project)
+double plume_triangle_energy(const plume_membrane_element *element, const plume_vec3 x[3], double secant_J,
+                             double gradient[9], double hessian[81], bool project)
 {
 	plume_green_strain strain;
 	plume_green_strain_eval(element, x, &strain);
@@ -197,7 +197,8 @@ double plume_triangle_energy(const plume_membrane_element *element, const plume_
 	memcpy(d2psi, C, sizeof d2psi);
 	// Kikuuwe compression (thesis eq. 6.6), on the same strain.
 	double psi_c, dpsi_c[3], d2psi_c[9];
-	bool compressed = plume_compression_density(element, e, &psi_c, (gradient || hessian) ? dpsi_c : NULL, d2psi_c);
+	bool compressed = plume_compression_density(element, e, hessian ? secant_J : 1.0, &psi_c,
+	                                            (gradient || hessian) ? dpsi_c : NULL, d2psi_c);
 	energy += element->area * psi_c;
 	if (compressed)
 		for (int k = 0; k < 3; ++k) {

@@ -49,11 +49,23 @@ double plume_membrane_energy(const plume_membrane_element *element, const plume_
 double plume_compression_energy(const plume_membrane_element *element, const plume_vec3 x[3], double gradient[9],
                                 double hessian[81]);
 
+/// The triangle's J = deformed area / reference area, as the Kikuuwe term measures it.
+double plume_compression_area_ratio(const plume_membrane_element *element, const plume_vec3 x[3]);
+
 /// Kikuuwe density psi per unit reference area at Green strain (Voigt, reference frame):
 /// *psi always; with dpsi != NULL also its first (3) and second (3 x 3) strain derivatives,
-/// returning true when they were written (0 < J < 1), false when they are zero.
-bool plume_compression_density(const plume_membrane_element *element, const double strain[3], double *psi,
-                               double dpsi[3], double d2psi[9]);
+/// returning true when they were written, false when they are zero.
+///
+/// secant_J = 1 gives the exact derivatives (written where 0 < J < 1). A secant_J below
+/// J and below 1 replaces d2 psi / dJ2 in d2psi by the slope of the secant of d psi / dJ
+/// from J to secant_J, a modified Hessian (psi and dpsi stay exact): psi is a cubic in
+/// 1 - J with no curvature at J = 1, so the exact model of a triangle the step's start
+/// left stretched has no compression stiffness, and Newton's step compresses it several
+/// times as far as it will end (docs/simulation.md, "What the ordinary steps' iterations
+/// go to"). The secant's model has the true force at secant_J, the triangle's J at the
+/// last solution (newton.c, the first iteration).
+bool plume_compression_density(const plume_membrane_element *element, const double strain[3], double secant_J,
+                               double *psi, double dpsi[3], double d2psi[9]);
 
 /// A shell triangle's in-plane energy: membrane plus compression (when element->compression
 /// > 0), with gradient and Hessian as above on one evaluation of the strain. With project,
@@ -62,9 +74,10 @@ bool plume_compression_density(const plume_membrane_element *element, const doub
 /// of the 2 x 2 stress (closed form) and P(d2psi) d2psi projected when the compression term
 /// makes it indefinite (3 x 3). Not the nearest PSD matrix, but a PSD one that equals the
 /// exact Hessian wherever the element is in tension (S PSD, no compression term): the
-/// projected Newton steps are descent steps, and the exact ones are unchanged.
-double plume_triangle_energy(const plume_membrane_element *element, const plume_vec3 x[3], double gradient[9],
-                             double hessian[81], bool project);
+/// projected Newton steps are descent steps, and the exact ones are unchanged. secant_J
+/// modifies the compression term's Hessian (plume_compression_density; 1 for the exact one).
+double plume_triangle_energy(const plume_membrane_element *element, const plume_vec3 x[3], double secant_J,
+                             double gradient[9], double hessian[81], bool project);
 
 /// Green strain of a deformed triangle and its derivatives: the kinematics shared by every
 /// energy density psi(strain) of a triangle (library-internal).

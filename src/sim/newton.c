@@ -352,6 +352,21 @@ static plume_status factor_and_solve(plume_sim *sim, bool exact, plume_solve_rep
 	return status;
 }
 
+/// Whether the step moves some vertex farther than the shell's size (the bounding box's
+/// diagonal). An exact Hessian that factors with a small shift can still be nearly singular
+/// along a soft mode, and its step then runs off along that mode: traced on Figure 1 at e =
+/// 1.25 mm (t = 0.627 s, with the secant first iteration, below), steps of 0.17 to 3.7 m on
+/// the 20 cm feather, which the line search cut to 1e-6 to 4e-9 of their length, 50
+/// iterations in every substep count up to 16 without converging. Projected there, the
+/// step converges and the run completes. No other scene or mesh size takes such a step.
+static bool runaway_step(const plume_sim *sim)
+{
+	for (int i = 0; i < 3 * sim->vertex_count; ++i)
+		if (fabs(sim->step[i]) > sim->length_scale)
+			return true;
+	return false;
+}
+
 /// Largest force component on a free unknown: elastic (the gradient) or constraint (C^T lambda).
 static double largest_force(const plume_sim *sim, const double *gradient)
 {
@@ -403,8 +418,24 @@ static plume_status newton(plume_sim *sim, const sim_problem *problem, plume_sol
 	// 5 mm 442 / 397 -> 435 / 396, wing-draft.json 1246 / 774 -> 1153 / 772,
 	// coat-settle.json 121 / 95 -> 111 / 96.
 	bool ran_out = false;
+	// The first iteration's model takes the Kikuuwe term's secant curvature towards each
+	// face's J at the step's start (membrane.h, plume_compression_density), the later ones
+	// the exact curvature; the gradient, and so where Newton stops, is the same. On the
+	// first iteration of a step a triangle the prediction left stretched has no
+	// compression stiffness in the exact model, and the exact step compresses it several
+	// times as far as it ends, to be halved back over three or four iterations (thesis eq.
+	// 6.6's cubic; docs/simulation.md, "What the ordinary steps' iterations go to"). Measured
+	// (Newton iterations of the whole scene, exact -> secant): Figure 1 at 5 mm 396 -> 343,
+	// at 2.5 mm 598 -> 505, at 1.75 mm 743 -> 594, at 1.25 mm 1036 -> 1163 (another wrinkle
+	// pattern, reached through one step of 365 iterations; its first 0.165 s 112 -> 86),
+	// swing.json 1013 -> 799, bird-flap.json 886 -> 772, falling.json 617 -> 583,
+	// figure6.5-pull.json 267 -> 245, coat-settle.json 86 -> 71, wing-draft.json 772 -> 777.
+	// The secant at every iteration took wing-draft.json to 1639.
+	sim_problem exact_model = *problem;
+	exact_model.start_area_ratio = NULL;
 
 	for (int iteration = 0;; ++iteration) {
+		const sim_problem *model = iteration == 0 ? problem : &exact_model;
 		double phi, residual;
 		// Where Newton's quadratic convergence predicts that a full step has reached the
 		// tolerance, the gradient alone says whether it has, and the Hessian, several times
@@ -414,7 +445,7 @@ static plume_status newton(plume_sim *sim, const sim_problem *problem, plume_sol
 		bool feasible = max_constraint_strain(sim, x) <= STRAIN_TOLERANCE;
 		double predicted = contraction * previous_ratio * previous_ratio;
 		bool check_first = feasible && full_step && contraction > 0 && predicted <= CHECK_FIRST_PREDICTION;
-		plume_status status = newton_system(sim, problem, exact, !check_first, &phi, &residual, report, err);
+		plume_status status = newton_system(sim, model, exact, !check_first, &phi, &residual, report, err);
 		if (status != PLUME_OK)
 			return status;
 		if (iteration == 0)
@@ -436,7 +467,7 @@ static plume_status newton(plume_sim *sim, const sim_problem *problem, plume_sol
 		if (iteration >= solver->max_iterations)
 			break;
 		if (check_first) {
-			status = newton_system(sim, problem, exact, true, &phi, &residual, report, err);
+			status = newton_system(sim, model, exact, true, &phi, &residual, report, err);
 			if (status != PLUME_OK)
 				return status;
 		}
@@ -446,15 +477,17 @@ static plume_status newton(plume_sim *sim, const sim_problem *problem, plume_sol
 		// Without constraints g . dx must be negative: a Cholesky factorisation that
 		// succeeds on a matrix that is positive definite only to rounding can still give
 		// an ascent step. (With constraints its sign is no test, see above.)
-		if (exact && (status == PLUME_ERROR_NUMERIC || (m == 0 && status == PLUME_OK && slope >= 0))) {
+		if (exact && (status == PLUME_ERROR_NUMERIC || (m == 0 && status == PLUME_OK && slope >= 0) ||
+		              (status == PLUME_OK && runaway_step(sim)))) {
 			// The exact Hessian needs more than EXACT_SHIFT_LIMIT times its mean diagonal to
-			// factor (kkt.h), or gave an ascent step: project. The exact one is tried again
-			// after a full step (projected Newton alone is linear, too slow on the lab's
-			// locked meshes), and the next solve starts projected.
+			// factor (kkt.h), or gave an ascent step or a runaway one (runaway_step):
+			// project. The exact one is tried again after a full step (projected Newton
+			// alone is linear, too slow on the lab's locked meshes), and the next solve
+			// starts projected.
 			exact = false;
 			sim->exact_hessian_failed = true;
 			ran_out = status == PLUME_ERROR_NUMERIC;
-			status = newton_system(sim, problem, exact, true, &phi, &residual, report, err);
+			status = newton_system(sim, model, exact, true, &phi, &residual, report, err);
 			if (status == PLUME_OK)
 				status = factor_and_solve(sim, exact, report, err);
 			slope = status == PLUME_OK ? free_dot(sim, g, step) : 0;
@@ -518,14 +551,14 @@ static plume_status newton(plume_sim *sim, const sim_problem *problem, plume_sol
 			break; // CCD allows no motion at all (a pair that starts in contact): no step to take
 		for (int backtrack = 0; backtrack < MAX_BACKTRACKS && !accepted; ++backtrack) {
 			apply_step(sim, x, step, alpha, sim->trial);
-			double trial = merit(sim, problem, sim->trial, mu, NULL);
+			double trial = merit(sim, &exact_model, sim->trial, mu, NULL);
 			if (isfinite(trial) && trial <= current + 1e-4 * alpha * fmin(slope, 0)) {
 				accepted = true;
 				accepted_merit = trial;
 				break;
 			}
-			if (m > 0 && corrected_trial(sim, problem, x, mu, current + 1e-4 * alpha * fmin(slope, 0), &accepted_merit,
-			                             report, err)) {
+			if (m > 0 && corrected_trial(sim, &exact_model, x, mu, current + 1e-4 * alpha * fmin(slope, 0),
+			                             &accepted_merit, report, err)) {
 				accepted = true;
 				break;
 			}

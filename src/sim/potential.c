@@ -22,7 +22,20 @@ static void gather(const plume_vec3 *x, const int *vertices, int count, plume_ve
 		out[i] = vertices[i] >= 0 ? x[vertices[i]] : plume_v3(0, 0, 0);
 }
 
-static void evaluate_faces(plume_sim *sim, const plume_vec3 *x, bool gradient, bool hessian, bool project)
+void plume_sim_area_ratios(const plume_sim *sim, const plume_vec3 *x, double *area_ratio)
+{
+	for (int f = 0; f < sim->face_count; ++f) {
+		const plume_membrane_element *element = sim->membranes + f;
+		plume_vec3 local[3];
+		gather(x, element->vertices, 3, local);
+		area_ratio[f] = element->compression > 0 ? plume_compression_area_ratio(element, local) : 1.0;
+	}
+}
+
+/// secant_J: each face's J for the Kikuuwe term's secant curvature (membrane.h), or NULL
+/// for the exact Hessian.
+static void evaluate_faces(plume_sim *sim, const plume_vec3 *x, const double *secant_J, bool gradient, bool hessian,
+                           bool project)
 {
 	int count = sim->face_count;
 #pragma omp parallel for schedule(static) if (count >= 4096)
@@ -32,7 +45,7 @@ static void evaluate_faces(plume_sim *sim, const plume_vec3 *x, bool gradient, b
 		gather(x, element->vertices, 3, local);
 		double *g = gradient ? sim->face_gradient + 9 * f : NULL;
 		double *h = hessian ? sim->face_hessian + 81 * f : NULL;
-		sim->face_energy[f] = plume_triangle_energy(element, local, g, h, project);
+		sim->face_energy[f] = plume_triangle_energy(element, local, secant_J ? secant_J[f] : 1.0, g, h, project);
 	}
 }
 
@@ -179,7 +192,7 @@ double plume_sim_potential(plume_sim *sim, const sim_problem *problem, const plu
 {
 	int n = sim->vertex_count;
 	bool want_gradient = gradient != NULL;
-	evaluate_faces(sim, x, want_gradient, hessian, project);
+	evaluate_faces(sim, x, problem->start_area_ratio, want_gradient, hessian, project);
 	if (sim->def.bending && sim->def.bending_model == PLUME_BENDING_PAPER_HINGE)
 		evaluate_hinges(sim, x, want_gradient, hessian, project);
 	else if (sim->def.bending)

@@ -498,6 +498,7 @@ static bool allocate_state(plume_sim *sim)
 	sim->vertex_area = plume_calloc(n, sizeof(double));
 	sim->fixed = plume_calloc(3 * n, 1);
 	sim->face_energy = plume_alloc(sizeof(double) * f);
+	sim->face_start_area_ratio = plume_alloc(sizeof(double) * f);
 	sim->face_gradient = plume_alloc(sizeof(double) * 9 * f);
 	sim->face_hessian = plume_alloc(sizeof(double) * 81 * f);
 	sim->gradient = plume_alloc(sizeof(double) * unknowns);
@@ -513,9 +514,9 @@ static bool allocate_state(plume_sim *sim)
 	sim->normals = plume_alloc(sizeof(plume_vec3) * n);
 	sim->lambda = plume_calloc((size_t)(sim->constraint_count > 0 ? sim->constraint_count : 1), sizeof(double));
 	return sim->x && sim->v && sim->rest && sim->mass && sim->load && sim->vertex_area && sim->fixed &&
-	       sim->face_energy && sim->face_gradient && sim->face_hessian && sim->gradient && sim->residual && sim->rhs &&
-	       sim->step && sim->trial && sim->scratch && sim->saved_x && sim->saved_v && sim->previous && sim->predicted &&
-	       sim->normals && sim->lambda &&
+	       sim->face_energy && sim->face_start_area_ratio && sim->face_gradient && sim->face_hessian && sim->gradient &&
+	       sim->residual && sim->rhs && sim->step && sim->trial && sim->scratch && sim->saved_x && sim->saved_v &&
+	       sim->previous && sim->predicted && sim->normals && sim->lambda &&
 	       plume_integrator_init(&sim->integrator, sim->def.integrator, sim->vertex_count) &&
 	       plume_air_init(&sim->air, &sim->def.air, sim->face_count);
 }
@@ -647,6 +648,7 @@ void plume_sim_destroy(plume_sim *sim)
 	                  sim->barb_length,
 	                  sim->fixed,
 	                  sim->face_energy,
+	                  sim->face_start_area_ratio,
 	                  sim->face_gradient,
 	                  sim->face_hessian,
 	                  sim->hinge_energy,
@@ -921,6 +923,8 @@ plume_status plume_sim_step(plume_sim *sim, plume_solve_report *report, plume_er
 				vertex_normals(sim, sim->x, sim->normals);
 			if (sim->air.active)
 				plume_air_begin(sim, sim->time + s * h);
+			plume_sim_area_ratios(sim, sim->x, sim->face_start_area_ratio);
+			problem.start_area_ratio = sim->face_start_area_ratio;
 			// Free vertices start from the prediction, handle vertices at their targets.
 			memcpy(sim->x, sim->predicted, bytes);
 			plume_sim_place_handles(sim, (double)s / substeps);

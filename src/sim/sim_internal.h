@@ -41,6 +41,9 @@ typedef struct sim_problem {
 	const plume_vec3 *velocity_base;
 	/// Vertex normals at the start of the step, for the linear drag (dynamic only).
 	const plume_vec3 *drag_normals;
+	/// Each face's area ratio J at the start of the step (dynamic only, else NULL): newton.c's
+	/// first iteration takes the Kikuuwe term's secant curvature towards it (membrane.h).
+	const double *start_area_ratio;
 } sim_problem;
 
 struct plume_sim {
@@ -103,6 +106,8 @@ struct plume_sim {
 	plume_kkt kkt;
 	/// Per-element outputs, computed in parallel and summed in a fixed order.
 	double *face_energy;
+	/// sim_problem.start_area_ratio's storage, one per face.
+	double *face_start_area_ratio;
 	double *face_gradient;
 	double *face_hessian;
 	/// Per bending element (hinge: 12 and 144 entries; fundamental-form face: 18 and 324).
@@ -148,6 +153,10 @@ struct plume_sim {
 /// gradient (3 n); with the KKT matrix also fills its Hessian block (projected
 /// per element when project is true, exact otherwise). Returns NaN when the
 /// potential is not finite.
+/// Each face's area ratio J at x (plume_compression_area_ratio; 1 for faces without the
+/// Kikuuwe term).
+void plume_sim_area_ratios(const plume_sim *sim, const plume_vec3 *x, double *area_ratio);
+
 double plume_sim_potential(plume_sim *sim, const sim_problem *problem, const plume_vec3 *x, double *gradient,
                            bool hessian, bool project);
 
