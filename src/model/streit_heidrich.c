@@ -328,9 +328,12 @@ static int barb_positions(double length, double spb, double spt, double *out, in
 {
 	double slope = (spt - spb) / length;
 	double total = fabs(slope) < 1e-12 ? length / spb : log1p(slope * length / spb) / slope;
-	int count = (int)floor(total + 0.5);
-	if (count > max)
+	// Compared as a double first: a count beyond int's range (a 1500 km rachis, found by
+	// fuzz/feather_spec) must not be converted.
+	double rounded = floor(total + 0.5);
+	if (!(rounded <= max))
 		return -1;
+	int count = (int)rounded;
 	for (int k = 0; k < count && out != NULL; ++k) {
 		double n = k + 0.5;
 		out[k] = fabs(slope) < 1e-12 ? n * spb : spb * expm1(slope * n) / slope;
