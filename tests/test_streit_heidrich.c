@@ -723,6 +723,11 @@ static void test_bad_specs(void **state)
 	                  PLUME_ERROR_SPEC, "$.key_barbs[0].cvs: a key barb needs 2 to 32 control vertices");
 	expect_spec_error("{\"model\": \"streit-heidrich\", \"rachis_length\": 0}", PLUME_ERROR_SPEC,
 	                  "$.rachis_length is 0, must be a positive length");
+	// A 1500 km rachis (fuzz/corpus/feather_spec/sh-rachis-1500-km.json): a barb count past int's range,
+	// refused before any conversion, with the rachis named.
+	expect_spec_error("{\"model\": \"streit-heidrich\", \"rachis_length\": 1500002}", PLUME_ERROR_SPEC,
+	                  "puts more than 4000 barbs on a vane along a rachis of arc length 1.50561e+06 m (rachis_length "
+	                  "1.5e+06 m)");
 	expect_spec_error("{\"model\": \"streit-heidrich\", \"calamus_length\": -0.01}", PLUME_ERROR_SPEC,
 	                  "$.calamus_length is -0.01, must be a non-negative length");
 	expect_spec_error("{\"model\": \"streit-heidrich\", \"barb_length\": -0.01}", PLUME_ERROR_SPEC,

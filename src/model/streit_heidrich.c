@@ -666,8 +666,10 @@ static plume_status build_feather(const plume_sh_def *def, const plume_sh_params
 	if (count < 0) {
 		status = plume_error_set(err, PLUME_ERROR_SPEC,
 		                         "the barb spacing (spacing_base %g m, spacing_tip %g m) puts more than %d barbs on a "
-		                         "vane; widen it",
-		                         params->spacing_base, params->spacing_tip, PLUME_SH_MAX_BARBS);
+		                         "vane along a rachis of arc length %g m (rachis_length %g m); widen the spacing or "
+		                         "shorten the rachis",
+		                         params->spacing_base, params->spacing_tip, PLUME_SH_MAX_BARBS, b->rachis_arc.length,
+		                         params->rachis_length);
 		goto done;
 	}
 	// One reservation, exact enough: no barb has more control vertices than the widest key barb (four when

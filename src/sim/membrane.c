@@ -197,10 +197,10 @@ double plume_triangle_energy(const plume_membrane_element *element, const plume_
 	memcpy(d2psi, C, sizeof d2psi);
 	// Kikuuwe compression (thesis eq. 6.6), on the same strain.
 	double psi_c, dpsi_c[3], d2psi_c[9];
-	bool compressed = plume_compression_density(element, e, hessian ? secant_J : 1.0, &psi_c,
-	                                            (gradient || hessian) ? dpsi_c : NULL, d2psi_c);
+	bool has_compression_terms = plume_compression_density(element, e, hessian ? secant_J : 1.0, &psi_c,
+	                                                       (gradient || hessian) ? dpsi_c : NULL, d2psi_c);
 	energy += element->area * psi_c;
-	if (compressed)
+	if (has_compression_terms)
 		for (int k = 0; k < 3; ++k) {
 			dpsi[k] += dpsi_c[k];
 			for (int l = 0; l < 3; ++l)
@@ -216,7 +216,7 @@ double plume_triangle_energy(const plume_membrane_element *element, const plume_
 	// H = area (J^T d2psi J + (B^T S B) x I3), S the 2 x 2 stress: positive semidefinite
 	// when d2psi and S are. C is; the compression term may not be (then a 3 x 3
 	// projection), and S is not under compression (then clamped, closed form).
-	if (compressed && !plume_is_positive_semidefinite(d2psi, 3))
+	if (has_compression_terms && !plume_is_positive_semidefinite(d2psi, 3))
 		plume_project_psd(d2psi, 3);
 	clamp_stress(dpsi);
 	plume_green_strain_chain(&strain, element->area, dpsi, d2psi, NULL, hessian);
