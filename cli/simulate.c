@@ -110,6 +110,8 @@ typedef struct run_state {
 	double max_kinetic;
 	double max_elastic;
 	double *max_reaction;                 ///< per handle: the largest |reaction|, N
+	const char **handle_groups;           ///< per handle: its group, for plume_sim_group_reactions
+	plume_vec3 *reactions;                ///< per handle: this step's reaction, N
 	plume_vec3 *body_positions;           ///< the scene's body posed at a frame's time
 	plume_mesh *body_mesh;                ///< the body at rest, for sim.glb
 	plume_mesh_animation *body_animation; ///< the body's frames, node "body" of sim.glb
@@ -236,13 +238,18 @@ static plume_status write_frame(run_state *run, int frame, double time, const pl
 /// translation, m) at this step, appended to the stats row.
 static void write_handle_columns(run_state *run, double time, const plume_sim *sim)
 {
-	for (int h = 0; h < run->scene->handle_count; ++h) {
+	// plume_scene_run hands its own (non-const) simulator to the callback as const; the
+	// reactions only re-evaluate forces at the current state and change nothing it reports.
+	// One evaluation for every handle (cli_simulate: handle_groups).
+	int count = run->scene->handle_count;
+	for (int h = 0; h < count; ++h)
+		run->reactions[h] = (plume_vec3){NAN, NAN, NAN};
+	if (count > 0)
+		plume_sim_group_reactions((plume_sim *)sim, run->handle_groups, count, run->reactions);
+	for (int h = 0; h < count; ++h) {
 		const plume_scene_handle *handle = &run->scene->handles[h];
-		plume_vec3 force = {NAN, NAN, NAN}, translation;
+		plume_vec3 force = run->reactions[h], translation;
 		plume_mat3 rotation;
-		// plume_scene_run hands its own (non-const) simulator to the callback as const; the
-		// reaction only re-evaluates forces at the current state and changes nothing it reports.
-		plume_sim_group_reaction((plume_sim *)sim, handle->group, &force);
 		run->max_reaction[h] = fmax(run->max_reaction[h], plume_v3_length(force));
 		plume_scene_handle_pose(handle, time, &translation, &rotation);
 		fprintf(run->stats, ",%.9e,%.9e,%.9e,%.9g,%.9g,%.9g", force.x, force.y, force.z, translation.x, translation.y,
@@ -556,8 +563,13 @@ static plume_status simulate(const plume_scene *scene, cli_output *output, run_s
 	run->vane_base = vane_base_group(scene);
 	run->min_stretch = run->max_out_of_plane = run->max_kinetic = run->max_elastic = NAN;
 	run->max_reaction = calloc((size_t)(scene->handle_count > 0 ? scene->handle_count : 1), sizeof *run->max_reaction);
-	if (run->max_reaction == NULL)
+	size_t handles = (size_t)(scene->handle_count > 0 ? scene->handle_count : 1);
+	run->handle_groups = calloc(handles, sizeof *run->handle_groups);
+	run->reactions = calloc(handles, sizeof *run->reactions);
+	if (run->max_reaction == NULL || run->handle_groups == NULL || run->reactions == NULL)
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "simulate: out of memory");
+	for (int h = 0; h < scene->handle_count; ++h)
+		run->handle_groups[h] = scene->handles[h].group;
 	run->stats = fopen(cli_output_path(output, "stats.csv", path, sizeof path), "wb");
 	if (run->stats == NULL)
 		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write", path);
@@ -786,6 +798,8 @@ int cli_simulate(int argc, char **argv)
 	plume_embedding_destroy(run.carried);
 	free(run.field_times);
 	free(run.max_reaction);
+	free(run.handle_groups);
+	free(run.reactions);
 	free(run.body_positions);
 	plume_mesh_animation_destroy(run.body_animation);
 	plume_mesh_destroy(run.body_mesh);

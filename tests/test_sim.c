@@ -360,6 +360,17 @@ static void test_reaction_balances_load(void **state)
 	assert_close(reaction.y, -load.y, 1e-9);
 	assert_close(reaction.z, -load.z, 1e-9);
 	assert_false(plume_sim_group_reaction(sim, "nowhere", &reaction));
+	// Many groups on one evaluation: the same clamp bits, and nothing on the free tip, whose
+	// forces balance (to the solver's tolerance, relative to the load).
+	const char *groups[2] = {"tip", "clamp"};
+	plume_vec3 reactions[2];
+	assert_true(plume_sim_group_reactions(sim, groups, 2, reactions));
+	assert_true(reactions[1].x == reaction.x && reactions[1].y == reaction.y && reactions[1].z == reaction.z);
+	assert_true(plume_v3_length(reactions[0]) < 1e-6 * plume_v3_length(load));
+	const char *unknown[2] = {"clamp", "nowhere"};
+	reactions[0] = plume_v3(7, 7, 7);
+	assert_false(plume_sim_group_reactions(sim, unknown, 2, reactions));
+	assert_true(reactions[0].x == 7); // nothing written
 	plume_sim_destroy(sim);
 	plume_mesh_destroy(mesh);
 }

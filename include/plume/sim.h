@@ -266,6 +266,10 @@ double plume_sim_time(const plume_sim *sim);
 /// (it balances the elastic, constraint and gravity forces on them), N, at the current state.
 /// A clamp that stretches a sample in +y reports a positive y. Unknown group: returns false.
 bool plume_sim_group_reaction(plume_sim *sim, const char *group, plume_vec3 *force);
+/// plume_sim_group_reaction for count groups on one evaluation of the forces (each call of the
+/// singular one evaluates them all): forces[k] for groups[k]. Returns false, and writes
+/// nothing, when a group is unknown.
+bool plume_sim_group_reactions(plume_sim *sim, const char *const *groups, int count, plume_vec3 *forces);
 
 /// Energies at the current state, J.
 typedef struct plume_sim_energies {

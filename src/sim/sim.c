@@ -992,21 +992,29 @@ double plume_sim_time(const plume_sim *sim)
 
 bool plume_sim_group_reaction(plume_sim *sim, const char *group_name, plume_vec3 *force)
 {
+	return plume_sim_group_reactions(sim, &group_name, 1, force);
+}
+
+bool plume_sim_group_reactions(plume_sim *sim, const char *const *groups, int count, plume_vec3 *forces)
+{
 	PLUME_ASSERT_HANDLE(sim);
-	PLUME_ASSERT(group_name != NULL && force != NULL);
-	const plume_vertex_group *group = plume_sim_find_group(sim, group_name);
-	if (group == NULL)
-		return false;
+	PLUME_ASSERT(count >= 0 && (count == 0 || (groups != NULL && forces != NULL)));
+	for (int k = 0; k < count; ++k)
+		if (groups[k] == NULL || plume_sim_find_group(sim, groups[k]) == NULL)
+			return false;
 	static const sim_problem statics = {.dynamic = false};
 	double *g = sim->gradient;
 	plume_sim_potential(sim, &statics, sim->x, g, false, false);
 	plume_sim_add_constraint_forces(sim, sim->x, g);
-	plume_vec3 sum = {0, 0, 0};
-	for (int i = 0; i < group->count; ++i) {
-		int v = group->vertices[i];
-		sum = plume_v3_add(sum, plume_v3(g[3 * v], g[3 * v + 1], g[3 * v + 2]));
+	for (int k = 0; k < count; ++k) {
+		const plume_vertex_group *group = plume_sim_find_group(sim, groups[k]);
+		plume_vec3 sum = {0, 0, 0};
+		for (int i = 0; i < group->count; ++i) {
+			int v = group->vertices[i];
+			sum = plume_v3_add(sum, plume_v3(g[3 * v], g[3 * v + 1], g[3 * v + 2]));
+		}
+		forces[k] = sum;
 	}
-	*force = sum;
 	return true;
 }
 
