@@ -125,6 +125,7 @@ typedef struct result {
 	int steps;
 	double cpu;     ///< load, mesh and run
 	double run_cpu; ///< plume_scene_run alone
+	double wall;    ///< load, mesh and run, wall seconds
 	int iterations;
 	double rachis_tip; ///< the rachis tip's deflection at the end (m)
 	counters c;
@@ -171,7 +172,7 @@ static int load(const char *name, double edge_length, plume_scene **out)
 /// Runs the scene on a mesh of this edge length, for duration seconds (0: the scene's).
 static int run(const char *name, double edge_length, double duration, result *out)
 {
-	double start = process_cpu();
+	double start = process_cpu(), load_wall = wall_clock();
 	plume_scene *scene = NULL;
 	if (load(name, edge_length, &scene) != 0) {
 		plume_scene_destroy(scene);
@@ -189,6 +190,7 @@ static int run(const char *name, double edge_length, double duration, result *ou
 	                .steps = summary.steps,
 	                .cpu = end - start,
 	                .run_cpu = end - run_start,
+	                .wall = wall_clock() - load_wall,
 	                .iterations = summary.newton_iterations,
 	                .rachis_tip = summary.rachis_tip_deflection,
 	                .c = counted};
@@ -238,20 +240,27 @@ static double exponent(const result *r, int count, bool factor)
 }
 
 /// CPU seconds of `plume simulate SCENE -o DIR` (a child process, all its files).
-static double command_cpu(void)
+/// `plume simulate` of Figure 1 with all its files: CPU seconds (returned; -1 when it
+/// fails) and wall seconds (*wall). Its feather dump and OBJ frames are written by a
+/// second thread beside the run (cli/writer.c), so on two cores its wall time is the
+/// nearer to the library's.
+static double command_cpu(double *wall)
 {
 	char dir[] = "/tmp/plume-bench-XXXXXX";
 	if (mkdtemp(dir) == NULL)
 		return -1;
 	char command[2048];
 	snprintf(command, sizeof command,
-	         "'%s' simulate '%s/examples/scenes/figure1-anisotropic.json' -o '%s/out' >/dev/null 2>&1 && rm -rf '%s'",
-	         PLUME_BINARY, PLUME_SOURCE_DIR, dir, dir);
+	         "'%s' simulate '%s/examples/scenes/figure1-anisotropic.json' -o '%s/out' >/dev/null 2>&1",
+	         PLUME_BINARY, PLUME_SOURCE_DIR, dir);
 	struct rusage before, after;
 	getrusage(RUSAGE_CHILDREN, &before);
+	double start = wall_clock();
 	int status = system(command);
+	*wall = wall_clock() - start;
 	getrusage(RUSAGE_CHILDREN, &after);
-	if (status != 0)
+	snprintf(command, sizeof command, "rm -rf '%s'", dir);
+	if (system(command) != 0 || status != 0)
 		return -1;
 	double seconds = (double)(after.ru_utime.tv_sec - before.ru_utime.tv_sec) +
 	                 (double)(after.ru_stime.tv_sec - before.ru_stime.tv_sec) +
@@ -298,13 +307,13 @@ int main(int argc, char **argv)
 		printf("fitted exponent, time ~ V^k over %d sizes: CPU a step k = %.2f, one factorisation k = %.2f\n",
 		       size_count, exponent(results, size_count, false), exponent(results, size_count, true));
 	}
-	double command = command_cpu();
+	double command_wall, command = command_cpu(&command_wall);
 	if (command < 0) {
 		printf("plume simulate failed (%s)\n", PLUME_BINARY);
 		return 1;
 	}
-	printf("plume simulate figure1-anisotropic (all files): %.2f s CPU; library load + run %.2f s CPU; "
-	       "command / library = %.2f (target <= 1.20)\n",
-	       command, paper.cpu, command / paper.cpu);
+	printf("plume simulate figure1-anisotropic (all files): %.2f s CPU, %.2f s wall; library load + run %.2f s CPU, "
+	       "%.2f s wall; command / library = %.2f CPU, %.2f wall (target <= 1.20)\n",
+	       command, command_wall, paper.cpu, paper.wall, command / paper.cpu, command_wall / paper.wall);
 	return failures == 0 ? 0 : 1;
 }

@@ -152,6 +152,21 @@ plume_status cli_fields_write_frame(cli_output *output, const plume_scene *scene
 /// DIR/fields.pvd listing fields/0000.vtu ... with their times.
 plume_status cli_fields_write_pvd(cli_output *output, const double *times, int frames, plume_error *err);
 
+/// A background writer (cli/writer.c): one thread running file-writing jobs in the order
+/// they are handed over, beside the computation. A job returns a status and fills err on
+/// failure; the first failure drops the jobs after it.
+typedef plume_status cli_writer_job_fn(void *data, plume_error *err);
+typedef struct cli_writer cli_writer;
+plume_status cli_writer_start(cli_writer **out, plume_error *err);
+/// Queues run(data) and then release(data) (release may be NULL); blocks while the queue is
+/// full. After a failure the job is not run, only released.
+void cli_writer_submit(cli_writer *writer, cli_writer_job_fn *run, void (*release)(void *data), void *data);
+/// The first failure so far (err: its error, when not NULL), or PLUME_OK. Does not wait.
+plume_status cli_writer_status(cli_writer *writer, plume_error *err);
+/// Runs what is queued, stops the thread and frees the writer (NULL: nothing to do); returns
+/// the first failure's status and error, or PLUME_OK.
+plume_status cli_writer_finish(cli_writer *writer, plume_error *err);
+
 int cli_generate(int argc, char **argv);
 int cli_grow(int argc, char **argv);
 int cli_mesh(int argc, char **argv);

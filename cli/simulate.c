@@ -99,6 +99,7 @@ typedef struct run_state {
 	double max_strain;
 	plume_mesh_animation *animation; ///< every frame, for DIR/sim.glb
 	plume_mesh_obj_writer *obj;      ///< frames/NNNN.obj, the lines shared by all frames formatted once
+	cli_writer *writer;              ///< writes the feather and the OBJ frames beside the run (cli/writer.c)
 	bool fields;                     ///< --fields: DIR/fields/NNNN.vtu and DIR/fields.pvd
 	bool glb_feather;                ///< --glb-feather: sim.glb also carries the feather
 	plume_barb_embedding *carried;   ///< its embedding
@@ -190,6 +191,54 @@ static plume_status write_body_obj(const plume_body *body, const plume_vec3 *pos
 	return PLUME_OK;
 }
 
+/// A job of the background writer: one file from a copy of the positions it needs (the
+/// simulator moves on while it is written).
+typedef struct write_job {
+	char path[4352];
+	const plume_mesh_obj_writer *obj; ///< a shell frame: the writer of the scene's mesh
+	const plume_body *body;           ///< a body frame
+	const plume_feather *feather;     ///< the feather's dump (positions NULL)
+	plume_vec3 *positions;
+} write_job;
+
+static plume_status run_write_job(void *data, plume_error *err)
+{
+	const write_job *job = data;
+	if (job->feather != NULL)
+		return plume_write_json_binary(job->feather, job->path, err);
+	if (job->obj != NULL)
+		return plume_mesh_obj_writer_write(job->obj, job->positions, job->path, err);
+	return write_body_obj(job->body, job->positions, job->path, err);
+}
+
+static void release_write_job(void *data)
+{
+	write_job *job = data;
+	if (job != NULL)
+		free(job->positions);
+	free(job);
+}
+
+/// Hands the writing of path to the background writer, with a copy of count positions
+/// (none for the feather's dump).
+static plume_status submit_write(run_state *run, write_job job, int count, const char *path, plume_error *err)
+{
+	write_job *copy = malloc(sizeof *copy);
+	if (copy != NULL) {
+		*copy = job;
+		snprintf(copy->path, sizeof copy->path, "%s", path);
+		copy->positions = NULL;
+		if (count > 0 && (copy->positions = malloc(sizeof(plume_vec3) * (size_t)count)) != NULL)
+			memcpy(copy->positions, job.positions, sizeof(plume_vec3) * (size_t)count);
+	}
+	if (copy == NULL || (count > 0 && copy->positions == NULL)) {
+		release_write_job(copy);
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "%s: out of memory", path);
+	}
+	cli_writer_submit(run->writer, run_write_job, release_write_job, copy);
+	return PLUME_OK;
+}
+
 // time: the scene's time of the step (plume_sim_time stays 0 in quasi-static scenes,
 // whose keyframed handles still move with it).
 static plume_status write_frame(run_state *run, int frame, double time, const plume_sim *sim, plume_error *err)
@@ -197,12 +246,15 @@ static plume_status write_frame(run_state *run, int frame, double time, const pl
 	char name[64], path[4352];
 	snprintf(name, sizeof name, "frames/%04d.obj", frame);
 	cli_output_path(run->output, name, path, sizeof path);
-	plume_status status = plume_mesh_obj_writer_write(run->obj, plume_sim_positions(sim), path, err);
+	plume_status status =
+	    submit_write(run, (write_job){.obj = run->obj, .positions = (plume_vec3 *)plume_sim_positions(sim)},
+	                 plume_sim_vertex_count(sim), path, err);
 	if (status == PLUME_OK && run->scene->body != NULL) {
 		snprintf(name, sizeof name, "frames/body-%04d.obj", frame);
 		plume_scene_body_pose(run->scene, time, run->body_positions);
-		status = write_body_obj(run->scene->body, run->body_positions,
-		                        cli_output_path(run->output, name, path, sizeof path), err);
+		status = submit_write(run, (write_job){.body = run->scene->body, .positions = run->body_positions},
+		                      plume_body_vertex_count(run->scene->body),
+		                      cli_output_path(run->output, name, path, sizeof path), err);
 	}
 	if (status == PLUME_OK)
 		status = plume_mesh_animation_add_frame(run->animation, time, plume_sim_positions(sim), err);
@@ -271,6 +323,9 @@ static plume_status on_step(void *user, int step, double time, const plume_sim *
                             double wall_seconds, plume_error *err)
 {
 	run_state *run = user;
+	plume_status written = cli_writer_status(run->writer, err);
+	if (written != PLUME_OK)
+		return written; // a frame or the feather could not be written: stop here
 	if (report != NULL) {
 		// The energies of the state (docs/simulation.md): kinetic, elastic (membrane, compression,
 		// bending), gravitational (with the scene's constant forces), and contact's barrier and
@@ -510,16 +565,17 @@ static plume_status write_feathers(const plume_scene *scene, cli_output *output,
 }
 
 /// Writes the rest shell and the feather, then runs the scene into frames/ and stats.csv.
-static plume_status simulate(const plume_scene *scene, cli_output *output, run_state *run, plume_scene_summary *summary,
-                             plume_error *failure, plume_error *err)
+/// The feather's dump and the OBJ frames go to run->writer, which may still be writing them
+/// when this returns.
+static plume_status run_scene(const plume_scene *scene, cli_output *output, run_state *run,
+                              plume_scene_summary *summary, plume_error *failure, plume_error *err)
 {
 	char path[4352];
-	run->output = output;
 	plume_status status =
 	    plume_mesh_write_obj(scene->mesh, NULL, cli_output_path(output, "mesh.obj", path, sizeof path), err);
-	if (status == PLUME_OK && scene->feather != NULL)
-		status =
-		    plume_write_json_binary(scene->feather, cli_output_path(output, "feather.json", path, sizeof path), err);
+	if (status == PLUME_OK && scene->feather != NULL) // the largest file: written beside the run
+		status = submit_write(run, (write_job){.feather = scene->feather}, 0,
+		                      cli_output_path(output, "feather.json", path, sizeof path), err);
 	else if (status == PLUME_OK)
 		status = write_feathers(scene, output, err);
 	if (status == PLUME_OK && scene->body != NULL) {
@@ -585,11 +641,32 @@ static plume_status simulate(const plume_scene *scene, cli_output *output, run_s
 	cli_progress_end(&run->bar);
 	if (fclose(run->stats) != 0)
 		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write", path);
+	if (run_status != PLUME_OK && run_status != PLUME_ERROR_NUMERIC)
+		*err = *failure;
+	return run_status;
+}
+
+/// run_scene, then, once the writer has written everything, the files made from all the
+/// frames (sim.glb, sim.usda, fields.pvd, the movie) and summary.json.
+static plume_status simulate(const plume_scene *scene, cli_output *output, run_state *run, plume_scene_summary *summary,
+                             plume_error *failure, plume_error *err)
+{
+	char path[4352];
+	run->output = output;
+	plume_status status = cli_writer_start(&run->writer, err);
+	if (status != PLUME_OK)
+		return status;
+	plume_status run_status = run_scene(scene, output, run, summary, failure, err);
+	plume_error write_error;
+	status = cli_writer_finish(run->writer, &write_error);
+	run->writer = NULL;
 	// A run that failed part way keeps what it wrote; input and I/O errors keep nothing.
 	// A failed first step keeps frame 0 and a summary saying so (docs/cli.md).
-	if (run_status != PLUME_OK && run_status != PLUME_ERROR_NUMERIC) {
-		*err = *failure;
+	if (run_status != PLUME_OK && run_status != PLUME_ERROR_NUMERIC)
 		return run_status;
+	if (status != PLUME_OK) {
+		*err = write_error;
+		return status;
 	}
 	if (run->render)
 		make_movie(output);

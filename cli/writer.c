@@ -1,0 +1,134 @@
+// A background writer: one thread that runs the file-writing jobs a command hands it, in
+// the order it hands them, so that formatting numbers into text files (printf per number:
+// a frame's OBJ, the barb-level feather's JSON) runs beside the computation instead of
+// between its steps (issue 15, "I/O off the critical path"). The bytes written are the
+// same as when the jobs run inline; only when they are written changes.
+//
+// The queue is bounded: a job handed over while CLI_WRITER_QUEUE jobs wait blocks until
+// the thread takes one, so a writer slower than the computation costs memory for that many
+// jobs at most. The first job that fails stops the writer: later jobs are dropped (their
+// data released), and the failure is reported by cli_writer_status and cli_writer_finish.
+#define _POSIX_C_SOURCE 200809L
+#include <pthread.h>
+#include <stdlib.h>
+
+#include "cli.h"
+
+#define CLI_WRITER_QUEUE 8
+
+typedef struct writer_job {
+	cli_writer_job_fn *run;
+	void (*release)(void *data);
+	void *data;
+} writer_job;
+
+struct cli_writer {
+	pthread_t thread;
+	pthread_mutex_t lock;
+	pthread_cond_t changed; // a job queued, taken or finished, or the writer closing
+	writer_job queue[CLI_WRITER_QUEUE];
+	int head, count;
+	bool closing;
+	plume_status status; // the first failure, PLUME_OK until then
+	plume_error error;
+};
+
+static void release_job(writer_job *job)
+{
+	if (job->release != NULL)
+		job->release(job->data);
+}
+
+static void *writer_main(void *argument)
+{
+	cli_writer *writer = argument;
+	pthread_mutex_lock(&writer->lock);
+	for (;;) {
+		while (writer->count == 0 && !writer->closing)
+			pthread_cond_wait(&writer->changed, &writer->lock);
+		if (writer->count == 0)
+			break; // closing, nothing left
+		writer_job job = writer->queue[writer->head];
+		writer->head = (writer->head + 1) % CLI_WRITER_QUEUE;
+		--writer->count;
+		bool failed = writer->status != PLUME_OK;
+		pthread_cond_broadcast(&writer->changed);
+		pthread_mutex_unlock(&writer->lock);
+
+		plume_error error = {0};
+		plume_status status = failed ? PLUME_OK : job.run(job.data, &error);
+		release_job(&job);
+
+		pthread_mutex_lock(&writer->lock);
+		if (status != PLUME_OK && writer->status == PLUME_OK) {
+			writer->status = status;
+			writer->error = error;
+		}
+		pthread_cond_broadcast(&writer->changed);
+	}
+	pthread_mutex_unlock(&writer->lock);
+	return NULL;
+}
+
+plume_status cli_writer_start(cli_writer **out, plume_error *err)
+{
+	*out = NULL;
+	cli_writer *writer = calloc(1, sizeof *writer);
+	if (writer == NULL)
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory starting the writer");
+	pthread_mutex_init(&writer->lock, NULL);
+	pthread_cond_init(&writer->changed, NULL);
+	if (pthread_create(&writer->thread, NULL, writer_main, writer) != 0) {
+		pthread_cond_destroy(&writer->changed);
+		pthread_mutex_destroy(&writer->lock);
+		free(writer);
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "cannot start the writer thread");
+	}
+	*out = writer;
+	return PLUME_OK;
+}
+
+void cli_writer_submit(cli_writer *writer, cli_writer_job_fn *run, void (*release)(void *data), void *data)
+{
+	writer_job job = {run, release, data};
+	pthread_mutex_lock(&writer->lock);
+	while (writer->count == CLI_WRITER_QUEUE && writer->status == PLUME_OK)
+		pthread_cond_wait(&writer->changed, &writer->lock);
+	if (writer->status != PLUME_OK) { // failed already: the job would be dropped anyway
+		pthread_mutex_unlock(&writer->lock);
+		release_job(&job);
+		return;
+	}
+	writer->queue[(writer->head + writer->count) % CLI_WRITER_QUEUE] = job;
+	++writer->count;
+	pthread_cond_broadcast(&writer->changed);
+	pthread_mutex_unlock(&writer->lock);
+}
+
+plume_status cli_writer_status(cli_writer *writer, plume_error *err)
+{
+	pthread_mutex_lock(&writer->lock);
+	plume_status status = writer->status;
+	if (status != PLUME_OK && err != NULL)
+		*err = writer->error;
+	pthread_mutex_unlock(&writer->lock);
+	return status;
+}
+
+plume_status cli_writer_finish(cli_writer *writer, plume_error *err)
+{
+	if (writer == NULL)
+		return PLUME_OK;
+	pthread_mutex_lock(&writer->lock);
+	writer->closing = true;
+	pthread_cond_broadcast(&writer->changed);
+	pthread_mutex_unlock(&writer->lock);
+	pthread_join(writer->thread, NULL);
+	plume_status status = writer->status;
+	if (status != PLUME_OK && err != NULL)
+		*err = writer->error;
+	pthread_cond_destroy(&writer->changed);
+	pthread_mutex_destroy(&writer->lock);
+	free(writer);
+	return status;
+}
