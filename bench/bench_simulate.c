@@ -251,8 +251,8 @@ static double command_cpu(double *wall)
 		return -1;
 	char command[2048];
 	snprintf(command, sizeof command,
-	         "'%s' simulate '%s/examples/scenes/figure1-anisotropic.json' -o '%s/out' >/dev/null 2>&1",
-	         PLUME_BINARY, PLUME_SOURCE_DIR, dir);
+	         "'%s' simulate '%s/examples/scenes/figure1-anisotropic.json' -o '%s/out' >/dev/null 2>&1", PLUME_BINARY,
+	         PLUME_SOURCE_DIR, dir);
 	struct rusage before, after;
 	getrusage(RUSAGE_CHILDREN, &before);
 	double start = wall_clock();
