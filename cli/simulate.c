@@ -99,7 +99,7 @@ typedef struct run_state {
 	double max_strain;
 	plume_mesh_animation *animation; ///< every frame, for DIR/sim.glb
 	plume_mesh_obj_writer *obj;      ///< frames/NNNN.obj, the lines shared by all frames formatted once
-	cli_writer *writer;              ///< writes the feather and the OBJ frames beside the run (cli/writer.c)
+	cli_writer *writer;              ///< writes the feather and the OBJ and PNG frames beside the run (cli/writer.c)
 	bool fields;                     ///< --fields: DIR/fields/NNNN.vtu and DIR/fields.pvd
 	bool glb_feather;                ///< --glb-feather: sim.glb also carries the feather
 	plume_barb_embedding *carried;   ///< its embedding
@@ -191,24 +191,38 @@ static plume_status write_body_obj(const plume_body *body, const plume_vec3 *pos
 	return PLUME_OK;
 }
 
-/// A job of the background writer: one file from a copy of the positions it needs (the
-/// simulator moves on while it is written).
+/// A job of the background writer: files from a copy of the positions they need (the
+/// simulator moves on while they are written).
+typedef enum write_kind {
+	WRITE_FEATHER, ///< the feather's dump (feather.json + feather.bin)
+	WRITE_SHELL,   ///< a frame of the shell: its OBJ, and with --png its shaded view
+	WRITE_BODY,    ///< a frame of the body: its OBJ
+} write_kind;
+
 typedef struct write_job {
-	char path[4352];
-	const plume_mesh_obj_writer *obj; ///< a shell frame: the writer of the scene's mesh
-	const plume_body *body;           ///< a body frame
-	const plume_feather *feather;     ///< the feather's dump (positions NULL)
-	plume_vec3 *positions;
+	write_kind kind;
+	char path[4352];                  ///< the file (the OBJ for a frame)
+	char png_path[4352];              ///< WRITE_SHELL with --png: the shaded view; "" without
+	const plume_feather *feather;     ///< WRITE_FEATHER
+	const plume_mesh_obj_writer *obj; ///< WRITE_SHELL: the OBJ writer of the scene's mesh
+	const plume_mesh *mesh;           ///< WRITE_SHELL with --png: the scene's mesh
+	const plume_shell_view_def *view; ///< and the view
+	const plume_body *body;           ///< WRITE_BODY
+	plume_vec3 *positions;            ///< the frame's (owned by the job); NULL for the feather
 } write_job;
 
 static plume_status run_write_job(void *data, plume_error *err)
 {
 	const write_job *job = data;
-	if (job->feather != NULL)
-		return plume_write_json_binary(job->feather, job->path, err);
-	if (job->obj != NULL)
-		return plume_mesh_obj_writer_write(job->obj, job->positions, job->path, err);
-	return write_body_obj(job->body, job->positions, job->path, err);
+	switch (job->kind) {
+	case WRITE_FEATHER: return plume_write_json_binary(job->feather, job->path, err);
+	case WRITE_BODY: return write_body_obj(job->body, job->positions, job->path, err);
+	case WRITE_SHELL: break;
+	}
+	plume_status status = plume_mesh_obj_writer_write(job->obj, job->positions, job->path, err);
+	if (status == PLUME_OK && job->png_path[0] != '\0')
+		status = plume_render_shell_png(job->mesh, job->positions, job->view, job->png_path, err);
+	return status;
 }
 
 static void release_write_job(void *data)
@@ -219,21 +233,20 @@ static void release_write_job(void *data)
 	free(job);
 }
 
-/// Hands the writing of path to the background writer, with a copy of count positions
+/// Hands job to the background writer, with a copy of count positions from job->positions
 /// (none for the feather's dump).
-static plume_status submit_write(run_state *run, write_job job, int count, const char *path, plume_error *err)
+static plume_status submit_write(run_state *run, const write_job *job, int count, plume_error *err)
 {
 	write_job *copy = malloc(sizeof *copy);
 	if (copy != NULL) {
-		*copy = job;
-		snprintf(copy->path, sizeof copy->path, "%s", path);
+		*copy = *job;
 		copy->positions = NULL;
 		if (count > 0 && (copy->positions = malloc(sizeof(plume_vec3) * (size_t)count)) != NULL)
-			memcpy(copy->positions, job.positions, sizeof(plume_vec3) * (size_t)count);
+			memcpy(copy->positions, job->positions, sizeof(plume_vec3) * (size_t)count);
 	}
 	if (copy == NULL || (count > 0 && copy->positions == NULL)) {
 		release_write_job(copy);
-		return plume_error_set(err, PLUME_ERROR_MEMORY, "%s: out of memory", path);
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "%s: out of memory", job->path);
 	}
 	cli_writer_submit(run->writer, run_write_job, release_write_job, copy);
 	return PLUME_OK;
@@ -244,17 +257,25 @@ static plume_status submit_write(run_state *run, write_job job, int count, const
 static plume_status write_frame(run_state *run, int frame, double time, const plume_sim *sim, plume_error *err)
 {
 	char name[64], path[4352];
+	// The shell's OBJ and --png view: one job, from one copy of the positions.
+	write_job job = {.kind = WRITE_SHELL,
+	                 .obj = run->obj,
+	                 .mesh = run->scene->mesh,
+	                 .view = &run->view,
+	                 .positions = (plume_vec3 *)plume_sim_positions(sim)};
 	snprintf(name, sizeof name, "frames/%04d.obj", frame);
-	cli_output_path(run->output, name, path, sizeof path);
-	plume_status status =
-	    submit_write(run, (write_job){.obj = run->obj, .positions = (plume_vec3 *)plume_sim_positions(sim)},
-	                 plume_sim_vertex_count(sim), path, err);
+	cli_output_path(run->output, name, job.path, sizeof job.path);
+	if (run->png) {
+		snprintf(name, sizeof name, "frames/%04d.png", frame);
+		cli_output_path(run->output, name, job.png_path, sizeof job.png_path);
+	}
+	plume_status status = submit_write(run, &job, plume_sim_vertex_count(sim), err);
 	if (status == PLUME_OK && run->scene->body != NULL) {
-		snprintf(name, sizeof name, "frames/body-%04d.obj", frame);
 		plume_scene_body_pose(run->scene, time, run->body_positions);
-		status = submit_write(run, (write_job){.body = run->scene->body, .positions = run->body_positions},
-		                      plume_body_vertex_count(run->scene->body),
-		                      cli_output_path(run->output, name, path, sizeof path), err);
+		job = (write_job){.kind = WRITE_BODY, .body = run->scene->body, .positions = run->body_positions};
+		snprintf(name, sizeof name, "frames/body-%04d.obj", frame);
+		cli_output_path(run->output, name, job.path, sizeof job.path);
+		status = submit_write(run, &job, plume_body_vertex_count(run->scene->body), err);
 	}
 	if (status == PLUME_OK)
 		status = plume_mesh_animation_add_frame(run->animation, time, plume_sim_positions(sim), err);
@@ -271,11 +292,6 @@ static plume_status write_frame(run_state *run, int frame, double time, const pl
 		}
 		run->field_times[frame] = time;
 		status = cli_fields_write_frame(run->output, run->scene, sim, frame, err);
-	}
-	if (status == PLUME_OK && run->png) {
-		snprintf(name, sizeof name, "frames/%04d.png", frame);
-		cli_output_path(run->output, name, path, sizeof path);
-		status = plume_render_shell_png(run->scene->mesh, plume_sim_positions(sim), &run->view, path, err);
 	}
 	if (status == PLUME_OK && run->render) {
 		snprintf(name, sizeof name, "frames/%04d-rt.png", frame);
@@ -573,10 +589,11 @@ static plume_status run_scene(const plume_scene *scene, cli_output *output, run_
 	char path[4352];
 	plume_status status =
 	    plume_mesh_write_obj(scene->mesh, NULL, cli_output_path(output, "mesh.obj", path, sizeof path), err);
-	if (status == PLUME_OK && scene->feather != NULL) // the largest file: written beside the run
-		status = submit_write(run, (write_job){.feather = scene->feather}, 0,
-		                      cli_output_path(output, "feather.json", path, sizeof path), err);
-	else if (status == PLUME_OK)
+	if (status == PLUME_OK && scene->feather != NULL) { // the largest file: written beside the run
+		write_job job = {.kind = WRITE_FEATHER, .feather = scene->feather};
+		cli_output_path(output, "feather.json", job.path, sizeof job.path);
+		status = submit_write(run, &job, 0, err);
+	} else if (status == PLUME_OK)
 		status = write_feathers(scene, output, err);
 	if (status == PLUME_OK && scene->body != NULL) {
 		run->body_positions = malloc(sizeof(plume_vec3) * (size_t)plume_body_vertex_count(scene->body));
