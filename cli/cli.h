@@ -158,13 +158,14 @@ plume_status cli_fields_write_pvd(cli_output *output, const double *times, int f
 typedef plume_status cli_writer_job_fn(void *data, plume_error *err);
 typedef struct cli_writer cli_writer;
 plume_status cli_writer_start(cli_writer **out, plume_error *err);
-/// Queues run(data) and then release(data) (release may be NULL); blocks while the queue is
-/// full. After a failure the job is not run, only released.
+/// Queues run(data) and then release(data) (release may be NULL); while the queue is full,
+/// runs its oldest job on the calling thread first. After a failure the job is not run,
+/// only released.
 void cli_writer_submit(cli_writer *writer, cli_writer_job_fn *run, void (*release)(void *data), void *data);
 /// The first failure so far (err: its error, when not NULL), or PLUME_OK. Does not wait.
 plume_status cli_writer_status(cli_writer *writer, plume_error *err);
-/// Runs what is queued, stops the thread and frees the writer (NULL: nothing to do); returns
-/// the first failure's status and error, or PLUME_OK.
+/// Runs what is queued (on the calling thread too), stops the thread and frees the writer
+/// (NULL: nothing to do); returns the first failure's status and error, or PLUME_OK.
 plume_status cli_writer_finish(cli_writer *writer, plume_error *err);
 
 int cli_generate(int argc, char **argv);

@@ -1,13 +1,17 @@
-// A background writer: one thread that runs the file-writing jobs a command hands it, in
-// the order it hands them, so that formatting numbers into text files (printf per number:
-// a frame's OBJ, the barb-level feather's JSON) runs beside the computation instead of
-// between its steps (issue 15, "I/O off the critical path"). The bytes written are the
-// same as when the jobs run inline; only when they are written changes.
+// A background writer: one thread that runs the file-writing jobs a command hands it, so
+// that formatting numbers into text files (printf per number: a frame's OBJ, the
+// barb-level feather's JSON) and drawing preview pictures run beside the computation
+// instead of between its steps (issue 15, "I/O off the critical path"). Each job writes
+// its own files whole: the bytes are the same as when the jobs run inline, and only when
+// they are written changes.
 //
-// The queue is bounded: a job handed over while CLI_WRITER_QUEUE jobs wait blocks until
-// the thread takes one, so a writer slower than the computation costs memory for that many
-// jobs at most. The first job that fails stops the writer: later jobs are dropped (their
-// data released), and the failure is reported by cli_writer_status and cli_writer_finish.
+// The queue is bounded. A job handed over while CLI_WRITER_QUEUE jobs wait is not queued
+// behind them: the handing thread first runs the oldest waiting job itself, so a writer
+// slower than the computation (a PNG per frame costs more than a step) costs memory for
+// that many jobs at most, and both threads write until it has caught up. cli_writer_finish
+// likewise runs what is left on the calling thread beside the writer's. The first job that
+// fails stops the writer: later jobs are dropped (their data released), and the failure is
+// reported by cli_writer_status and cli_writer_finish.
 #define _POSIX_C_SOURCE 200809L
 #include <pthread.h>
 #include <stdlib.h>
@@ -25,7 +29,7 @@ typedef struct writer_job {
 struct cli_writer {
 	pthread_t thread;
 	pthread_mutex_t lock;
-	pthread_cond_t changed; // a job queued, taken or finished, or the writer closing
+	pthread_cond_t changed; // a job queued, or the writer closing
 	writer_job queue[CLI_WRITER_QUEUE];
 	int head, count;
 	bool closing;
@@ -39,6 +43,28 @@ static void release_job(writer_job *job)
 		job->release(job->data);
 }
 
+/// Takes the oldest waiting job and runs it (or, after a failure, only releases it), with
+/// the lock released meanwhile. Called with the lock held and a job waiting; returns with
+/// the lock held.
+static void run_oldest(cli_writer *writer)
+{
+	writer_job job = writer->queue[writer->head];
+	writer->head = (writer->head + 1) % CLI_WRITER_QUEUE;
+	--writer->count;
+	bool failed = writer->status != PLUME_OK;
+	pthread_mutex_unlock(&writer->lock);
+
+	plume_error error = {0};
+	plume_status status = failed ? PLUME_OK : job.run(job.data, &error);
+	release_job(&job);
+
+	pthread_mutex_lock(&writer->lock);
+	if (status != PLUME_OK && writer->status == PLUME_OK) {
+		writer->status = status;
+		writer->error = error;
+	}
+}
+
 static void *writer_main(void *argument)
 {
 	cli_writer *writer = argument;
@@ -48,23 +74,7 @@ static void *writer_main(void *argument)
 			pthread_cond_wait(&writer->changed, &writer->lock);
 		if (writer->count == 0)
 			break; // closing, nothing left
-		writer_job job = writer->queue[writer->head];
-		writer->head = (writer->head + 1) % CLI_WRITER_QUEUE;
-		--writer->count;
-		bool failed = writer->status != PLUME_OK;
-		pthread_cond_broadcast(&writer->changed);
-		pthread_mutex_unlock(&writer->lock);
-
-		plume_error error = {0};
-		plume_status status = failed ? PLUME_OK : job.run(job.data, &error);
-		release_job(&job);
-
-		pthread_mutex_lock(&writer->lock);
-		if (status != PLUME_OK && writer->status == PLUME_OK) {
-			writer->status = status;
-			writer->error = error;
-		}
-		pthread_cond_broadcast(&writer->changed);
+		run_oldest(writer);
 	}
 	pthread_mutex_unlock(&writer->lock);
 	return NULL;
@@ -93,7 +103,7 @@ void cli_writer_submit(cli_writer *writer, cli_writer_job_fn *run, void (*releas
 	writer_job job = {run, release, data};
 	pthread_mutex_lock(&writer->lock);
 	while (writer->count == CLI_WRITER_QUEUE && writer->status == PLUME_OK)
-		pthread_cond_wait(&writer->changed, &writer->lock);
+		run_oldest(writer);           // help rather than wait
 	if (writer->status != PLUME_OK) { // failed already: the job would be dropped anyway
 		pthread_mutex_unlock(&writer->lock);
 		release_job(&job);
@@ -101,7 +111,7 @@ void cli_writer_submit(cli_writer *writer, cli_writer_job_fn *run, void (*releas
 	}
 	writer->queue[(writer->head + writer->count) % CLI_WRITER_QUEUE] = job;
 	++writer->count;
-	pthread_cond_broadcast(&writer->changed);
+	pthread_cond_signal(&writer->changed);
 	pthread_mutex_unlock(&writer->lock);
 }
 
@@ -121,7 +131,9 @@ plume_status cli_writer_finish(cli_writer *writer, plume_error *err)
 		return PLUME_OK;
 	pthread_mutex_lock(&writer->lock);
 	writer->closing = true;
-	pthread_cond_broadcast(&writer->changed);
+	pthread_cond_signal(&writer->changed);
+	while (writer->count > 0)
+		run_oldest(writer); // beside the writer's thread
 	pthread_mutex_unlock(&writer->lock);
 	pthread_join(writer->thread, NULL);
 	plume_status status = writer->status;
