@@ -79,7 +79,8 @@ plume_status cli_output_begin(cli_output *output, const char *dir, plume_error *
 /// Path of a new file in the staging folder; remembers the name for commit.
 const char *cli_output_path(cli_output *output, const char *name, char *buffer, size_t size);
 plume_status cli_output_commit(cli_output *output, plume_error *err);
-void cli_output_abort(cli_output *output);
+/// Removes the staging folder; with err, first names DIR instead of it in err's message.
+void cli_output_abort(cli_output *output, plume_error *err);
 /// Removes a file or a folder and everything in it (links removed, not followed).
 void cli_remove_tree(const char *path);
 

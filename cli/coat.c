@@ -156,7 +156,7 @@ int cli_coat(int argc, char **argv)
 		if (status == PLUME_OK)
 			status = cli_output_commit(&output, &err);
 		else
-			cli_output_abort(&output);
+			cli_output_abort(&output, &err);
 	}
 	plume_coat_destroy(coat);
 	if (status != PLUME_OK)

@@ -119,7 +119,7 @@ int cli_demo(int argc, char **argv)
 		if (status == PLUME_OK)
 			status = cli_output_commit(&output, &err);
 		else
-			cli_output_abort(&output);
+			cli_output_abort(&output, &err);
 	}
 	if (status == PLUME_OK) {
 		plume_feather_info info = plume_feather_get_info(feather);

@@ -115,7 +115,7 @@ int cli_generate(int argc, char **argv)
 		if (status == PLUME_OK)
 			status = cli_output_commit(&output, &err);
 		else
-			cli_output_abort(&output);
+			cli_output_abort(&output, &err);
 	}
 	plume_feather_destroy(feather);
 	plume_texture_destroy(texture);

@@ -185,7 +185,7 @@ int cli_grow(int argc, char **argv)
 		if (status == PLUME_OK)
 			status = cli_output_commit(&output, &err);
 		else
-			cli_output_abort(&output);
+			cli_output_abort(&output, &err);
 	}
 	if (status != PLUME_OK)
 		return cli_fail(&err);

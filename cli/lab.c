@@ -207,7 +207,7 @@ static int run_traction(int argc, char **argv)
 		if (status == PLUME_OK)
 			status = cli_output_commit(&output, &err);
 		else
-			cli_output_abort(&output);
+			cli_output_abort(&output, &err);
 	}
 	if (status == PLUME_OK)
 		printf("slope: %.10g Pa\n", result.slope);
@@ -350,7 +350,7 @@ static int write_calibration(const char *dir, const plume_calibration_def *def, 
 	if (status == PLUME_OK)
 		status = cli_output_commit(&output, &err);
 	else
-		cli_output_abort(&output);
+		cli_output_abort(&output, &err);
 	return status == PLUME_OK ? CLI_EXIT_OK : cli_fail(&err);
 }
 
@@ -523,7 +523,7 @@ static int run_study(int argc, char **argv)
 	if (status == PLUME_OK)
 		status = cli_output_commit(&output, &err);
 	else
-		cli_output_abort(&output);
+		cli_output_abort(&output, &err);
 	if (status != PLUME_OK)
 		return cli_fail(&err);
 	printf("%s\n", summary);

@@ -246,7 +246,7 @@ int cli_mesh(int argc, char **argv)
 		if (status == PLUME_OK)
 			status = cli_output_commit(&output, &err);
 		else
-			cli_output_abort(&output);
+			cli_output_abort(&output, &err);
 	}
 	plume_mesh_destroy(mesh);
 	if (status != PLUME_OK)

@@ -473,7 +473,7 @@ static plume_status make_stage(cli_output *output, bool *made, plume_error *err)
 	if (failure == 0)
 		return PLUME_OK;
 	if (*made)
-		cli_output_abort(output);
+		cli_output_abort(output, NULL);
 	return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write the output folder: %s", output->dir,
 	                       strerror(failure));
 }
@@ -614,7 +614,7 @@ static plume_status commit_by_moves(cli_output *output, plume_error *err)
 	DIR *stage = opendir(output->stage);
 	if (stage == NULL) {
 		plume_error_set(err, PLUME_ERROR_IO, "%s: cannot read the staging folder: %s", output->stage, strerror(errno));
-		cli_output_abort(output);
+		cli_output_abort(output, NULL);
 		return PLUME_ERROR_IO;
 	}
 	struct dirent *entry;
@@ -644,7 +644,7 @@ static plume_status commit_by_moves(cli_output *output, plume_error *err)
 	}
 	closedir(stage);
 	if (status != PLUME_OK) {
-		cli_output_abort(output);
+		cli_output_abort(output, NULL);
 		end_critical();
 		return status;
 	}
@@ -692,7 +692,7 @@ plume_status cli_output_commit(cli_output *output, plume_error *err)
 		if (rename(output->stage, output->dir) != 0) {
 			plume_error_set(err, PLUME_ERROR_IO, "%s: cannot create the output folder: %s", output->dir,
 			                strerror(errno));
-			cli_output_abort(output);
+			cli_output_abort(output, NULL);
 			end_critical();
 			return PLUME_ERROR_IO;
 		}
@@ -712,13 +712,13 @@ plume_status cli_output_commit(cli_output *output, plume_error *err)
 		                "%s: this file system cannot hard-link the folder's other files into the new run (%s); "
 		                "write to a new folder instead",
 		                output->dir, strerror(failure));
-		cli_output_abort(output);
+		cli_output_abort(output, NULL);
 		return PLUME_ERROR_IO;
 	}
 	if (failure == -1) {
 		plume_error_set(err, PLUME_ERROR_IO, "%s: the run writes a file or folder of that name; move it away first",
 		                conflict);
-		cli_output_abort(output);
+		cli_output_abort(output, NULL);
 		return PLUME_ERROR_IO;
 	}
 	begin_critical();
@@ -728,7 +728,7 @@ plume_status cli_output_commit(cli_output *output, plume_error *err)
 	}
 	if (failure != 0) {
 		plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write: %s", output->dir, strerror(failure));
-		cli_output_abort(output);
+		cli_output_abort(output, NULL);
 		end_critical();
 		return PLUME_ERROR_IO;
 	}
@@ -744,8 +744,33 @@ plume_status cli_output_commit(cli_output *output, plume_error *err)
 	return PLUME_OK;
 }
 
-void cli_output_abort(cli_output *output)
+/// err's message with every mention of the staging folder replaced by DIR: a file the
+/// run could not write is named where the user asked for it, not in a folder that is
+/// removed before they read the message.
+static void name_output_in_error(const cli_output *output, plume_error *err)
 {
+	size_t stage_length = strlen(output->stage);
+	if (stage_length == 0)
+		return;
+	char named[sizeof err->message];
+	size_t used = 0;
+	for (const char *at = err->message; *at != '\0' && used + 1 < sizeof named;) {
+		if (strncmp(at, output->stage, stage_length) == 0) {
+			used += (size_t)snprintf(named + used, sizeof named - used, "%s", output->dir);
+			used = used < sizeof named ? used : sizeof named - 1;
+			at += stage_length;
+		} else {
+			named[used++] = *at++;
+		}
+	}
+	named[used] = '\0';
+	memcpy(err->message, named, used + 1);
+}
+
+void cli_output_abort(cli_output *output, plume_error *err)
+{
+	if (err != NULL)
+		name_output_in_error(output, err);
 	if (output->stage[0] != '\0')
 		cli_remove_tree(output->stage);
 	untrack_stage(output);

@@ -771,7 +771,7 @@ int cli_render(int argc, char **argv)
 		if (status == PLUME_OK)
 			status = cli_output_commit(&output, &err);
 		else
-			cli_output_abort(&output);
+			cli_output_abort(&output, &err);
 	}
 	plume_texture_destroy(texture);
 	if (status != PLUME_OK)

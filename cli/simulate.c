@@ -876,7 +876,7 @@ int cli_simulate(int argc, char **argv)
 	if (status == PLUME_OK) {
 		plume_status run_status = simulate(scene, &output, &run, &summary, &failure, &err);
 		bool keep = run_status == PLUME_OK || run_status == PLUME_ERROR_NUMERIC;
-		status = keep ? cli_output_commit(&output, &err) : (cli_output_abort(&output), run_status);
+		status = keep ? cli_output_commit(&output, &err) : (cli_output_abort(&output, &err), run_status);
 		if (status == PLUME_OK)
 			status = run_status;
 	}

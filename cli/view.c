@@ -523,7 +523,7 @@ int cli_view(int argc, char **argv)
 	if (err.status == PLUME_OK)
 		write_models(cli_output_path(&output, "models.js", path, sizeof path), files, count, embed, &err);
 	if (err.status != PLUME_OK || cli_output_commit(&output, &err) != PLUME_OK) {
-		cli_output_abort(&output);
+		cli_output_abort(&output, &err);
 		return cli_fail(&err);
 	}
 

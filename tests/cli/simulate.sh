@@ -88,10 +88,12 @@ check "progress on a terminal" grep -q 'plume simulate: \([0-9]*\)/\1 (100%), [0
 check "help describes the outputs" test $? -eq 0
 
 # The feather's dump and the OBJ frames are written by a second thread beside the run
-# (cli/writer.c): a write it cannot finish still fails the command with the file named,
-# exit 4, and nothing kept. A 4 MiB file-size limit (SIGXFSZ ignored, so the write
-# returns EFBIG) lets every file but the 10 MB feather.bin through.
-expect_no_output "a write the background writer cannot finish" 4 "feather.bin: write failed: File too large" \
+# (cli/writer.c): a write it cannot finish still fails the command with the file named
+# where it was asked for (not in the staging folder, removed by then), exit 4, and
+# nothing kept. A 4 MiB file-size limit (SIGXFSZ ignored, so the write returns EFBIG)
+# lets every file but the 10 MB feather.bin through.
+expect_no_output "a write the background writer cannot finish" 4 \
+	"plume: $scratch/too-large/feather.bin: write failed: File too large" \
 	"$scratch/too-large" bash -c "trap '' XFSZ; ulimit -f 4096; exec '$plume' simulate '$scratch/swing.json' -o '$scratch/too-large'"
 
 finish
