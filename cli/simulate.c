@@ -581,8 +581,8 @@ static plume_status write_feathers(const plume_scene *scene, cli_output *output,
 }
 
 /// Writes the rest shell and the feather, then runs the scene into frames/ and stats.csv.
-/// The feather's dump and the OBJ frames go to run->writer, which may still be writing them
-/// when this returns.
+/// The feather's dump and the OBJ and --png frames go to run->writer, which may still be
+/// writing them when this returns.
 static plume_status run_scene(const plume_scene *scene, cli_output *output, run_state *run,
                               plume_scene_summary *summary, plume_error *failure, plume_error *err)
 {
@@ -635,8 +635,8 @@ static plume_status run_scene(const plume_scene *scene, cli_output *output, run_
 		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot create: %s", path, "mkdir failed");
 	run->vane_base = vane_base_group(scene);
 	run->min_stretch = run->max_out_of_plane = run->max_kinetic = run->max_elastic = NAN;
-	run->max_reaction = calloc((size_t)(scene->handle_count > 0 ? scene->handle_count : 1), sizeof *run->max_reaction);
 	size_t handles = (size_t)(scene->handle_count > 0 ? scene->handle_count : 1);
+	run->max_reaction = calloc(handles, sizeof *run->max_reaction);
 	run->handle_groups = calloc(handles, sizeof *run->handle_groups);
 	run->reactions = calloc(handles, sizeof *run->reactions);
 	if (run->max_reaction == NULL || run->handle_groups == NULL || run->reactions == NULL)
