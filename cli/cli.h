@@ -158,6 +158,8 @@ plume_status cli_fields_write_pvd(cli_output *output, const double *times, int f
 /// failure; the first failure drops the jobs after it.
 typedef plume_status cli_writer_job_fn(void *data, plume_error *err);
 typedef struct cli_writer cli_writer;
+/// Fails only when out of memory; where no thread can be started, jobs run where they are
+/// handed over.
 plume_status cli_writer_start(cli_writer **out, plume_error *err);
 /// Queues run(data) and then release(data) (release may be NULL); while the queue is full,
 /// runs its oldest job on the calling thread first. After a failure the job is not run,

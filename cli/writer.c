@@ -28,6 +28,7 @@ typedef struct writer_job {
 
 struct cli_writer {
 	pthread_t thread;
+	bool threaded; // false when no thread could be started: every job runs where it is handed over
 	pthread_mutex_t lock;
 	pthread_cond_t changed; // a job queued, or the writer closing
 	writer_job queue[CLI_WRITER_QUEUE];
@@ -88,12 +89,9 @@ plume_status cli_writer_start(cli_writer **out, plume_error *err)
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory starting the writer");
 	pthread_mutex_init(&writer->lock, NULL);
 	pthread_cond_init(&writer->changed, NULL);
-	if (pthread_create(&writer->thread, NULL, writer_main, writer) != 0) {
-		pthread_cond_destroy(&writer->changed);
-		pthread_mutex_destroy(&writer->lock);
-		free(writer);
-		return plume_error_set(err, PLUME_ERROR_MEMORY, "cannot start the writer thread");
-	}
+	// Without a thread (a process limit, say) the jobs run inline, as they did before the
+	// writer: slower, never wrong.
+	writer->threaded = pthread_create(&writer->thread, NULL, writer_main, writer) == 0;
 	*out = writer;
 	return PLUME_OK;
 }
@@ -111,6 +109,8 @@ void cli_writer_submit(cli_writer *writer, cli_writer_job_fn *run, void (*releas
 	}
 	writer->queue[(writer->head + writer->count) % CLI_WRITER_QUEUE] = job;
 	++writer->count;
+	if (!writer->threaded)
+		run_oldest(writer); // no thread to hand it to
 	pthread_cond_signal(&writer->changed);
 	pthread_mutex_unlock(&writer->lock);
 }
@@ -135,7 +135,8 @@ plume_status cli_writer_finish(cli_writer *writer, plume_error *err)
 	while (writer->count > 0)
 		run_oldest(writer); // beside the writer's thread
 	pthread_mutex_unlock(&writer->lock);
-	pthread_join(writer->thread, NULL);
+	if (writer->threaded)
+		pthread_join(writer->thread, NULL);
 	plume_status status = writer->status;
 	if (status != PLUME_OK && err != NULL)
 		*err = writer->error;
