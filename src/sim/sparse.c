@@ -1,10 +1,14 @@
 // The CHOLMOD side of plume's sparse symmetric systems: the design, in sparse.h.
+#include <assert.h>
+#include <limits.h>
 #include <math.h>
 #include <omp.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "core/alloc.h"
+#include "core/sort.h"
 #include "sim/sparse.h"
 
 // OpenBLAS's thread count, when the BLAS that CHOLMOD loaded is OpenBLAS (a weak
@@ -12,12 +16,19 @@
 // by the thread count, which would make the factors' bits depend on it.
 extern void openblas_set_num_threads(int threads) __attribute__((weak));
 
-static int compare_entries(const void *a, const void *b)
+static bool same_entry(const plume_sparse_entry *p, const plume_sparse_entry *q)
 {
-	const plume_sparse_entry *p = a, *q = b;
-	if (p->column != q->column)
-		return p->column < q->column ? -1 : 1;
-	return (p->row > q->row) - (p->row < q->row);
+	return p->column == q->column && p->row == q->row;
+}
+
+/// Sorts entries by (column, row), by counting (core/sort.h): qsort's comparisons were 1.5 %
+/// of Figure 1's whole run at e = 5 mm (140 M instructions for the four sorts of the set-up).
+/// False when memory runs out.
+static bool sort_entries(plume_sparse_entry *entries, size_t count, int n)
+{
+	static_assert(sizeof(plume_sparse_entry) == 2 * sizeof(int) && offsetof(plume_sparse_entry, row) == sizeof(int),
+	              "an entry is the pair (column, row)");
+	return count <= INT_MAX && plume_sort_pairs((int *)entries, (int)count, n, n) == 0;
 }
 
 /// Allocates s->matrix with the pattern of the sorted, unique entries, one triangle:
@@ -90,11 +101,11 @@ plume_status plume_sparse_init(plume_sparse *s, int n, plume_sparse_entry *entri
                                const char *what, plume_error *err)
 {
 	memset(s, 0, sizeof *s);
-	if (count > 0)
-		qsort(entries, count, sizeof *entries, compare_entries);
+	if (!sort_entries(entries, count, n))
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory allocating %s", what);
 	size_t unique = 0;
 	for (size_t e = 0; e < count; ++e)
-		if (unique == 0 || compare_entries(entries + unique - 1, entries + e) != 0)
+		if (unique == 0 || !same_entry(entries + unique - 1, entries + e))
 			entries[unique++] = entries[e];
 
 	cholmod_start(&s->common);
@@ -118,7 +129,8 @@ plume_status plume_sparse_init(plume_sparse *s, int n, plume_sparse_entry *entri
 		int i = s->inverse[entries[k].row], j = s->inverse[entries[k].column];
 		entries[k] = (plume_sparse_entry){i > j ? i : j, i > j ? j : i};
 	}
-	qsort(entries, unique, sizeof *entries, compare_entries);
+	if (!sort_entries(entries, unique, n))
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory allocating %s", what);
 	cholmod_free_sparse(&s->matrix, &s->common);
 	if (!allocate_pattern(s, n, entries, unique, 1))
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory allocating %s", what);
@@ -160,7 +172,8 @@ plume_status plume_sparse_init(plume_sparse *s, int n, plume_sparse_entry *entri
 	if (s->factor->is_super) {
 		for (size_t k = 0; k < unique; ++k)
 			entries[k] = (plume_sparse_entry){entries[k].row, entries[k].column};
-		qsort(entries, unique, sizeof *entries, compare_entries);
+		if (!sort_entries(entries, unique, n))
+			return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory allocating %s", what);
 		cholmod_free_sparse(&s->matrix, &s->common);
 		if (!allocate_pattern(s, n, entries, unique, -1))
 			return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory allocating %s", what);
