@@ -239,7 +239,6 @@ static double exponent(const result *r, int count, bool factor)
 	return (count * sxy - sx * sy) / (count * sxx - sx * sx);
 }
 
-/// CPU seconds of `plume simulate SCENE -o DIR` (a child process, all its files).
 /// `plume simulate` of Figure 1 with all its files: CPU seconds (returned; -1 when it
 /// fails) and wall seconds (*wall). Its feather dump and OBJ frames are written by a
 /// second thread beside the run (cli/writer.c), so on two cores its wall time is the

@@ -153,9 +153,9 @@ plume_status cli_fields_write_frame(cli_output *output, const plume_scene *scene
 /// DIR/fields.pvd listing fields/0000.vtu ... with their times.
 plume_status cli_fields_write_pvd(cli_output *output, const double *times, int frames, plume_error *err);
 
-/// A background writer (cli/writer.c): one thread running file-writing jobs in the order
-/// they are handed over, beside the computation. A job returns a status and fills err on
-/// failure; the first failure drops the jobs after it.
+/// A background writer (cli/writer.c): one thread running file-writing jobs, oldest first,
+/// beside the computation (the handing thread helps when its queue is full). A job returns
+/// a status and fills err on failure; the first failure drops the jobs after it.
 typedef plume_status cli_writer_job_fn(void *data, plume_error *err);
 typedef struct cli_writer cli_writer;
 /// Fails only when out of memory; where no thread can be started, jobs run where they are

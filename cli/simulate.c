@@ -211,18 +211,23 @@ typedef struct write_job {
 	plume_vec3 *positions;            ///< the frame's (owned by the job); NULL for the feather
 } write_job;
 
+static plume_status write_shell_frame(const write_job *job, plume_error *err)
+{
+	plume_status status = plume_mesh_obj_writer_write(job->obj, job->positions, job->path, err);
+	if (status == PLUME_OK && job->png_path[0] != '\0')
+		status = plume_render_shell_png(job->mesh, job->positions, job->view, job->png_path, err);
+	return status;
+}
+
 static plume_status run_write_job(void *data, plume_error *err)
 {
 	const write_job *job = data;
 	switch (job->kind) {
 	case WRITE_FEATHER: return plume_write_json_binary(job->feather, job->path, err);
+	case WRITE_SHELL: return write_shell_frame(job, err);
 	case WRITE_BODY: return write_body_obj(job->body, job->positions, job->path, err);
-	case WRITE_SHELL: break;
 	}
-	plume_status status = plume_mesh_obj_writer_write(job->obj, job->positions, job->path, err);
-	if (status == PLUME_OK && job->png_path[0] != '\0')
-		status = plume_render_shell_png(job->mesh, job->positions, job->view, job->png_path, err);
-	return status;
+	return PLUME_OK; // unreachable: every kind is handled above
 }
 
 static void release_write_job(void *data)

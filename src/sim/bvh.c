@@ -11,9 +11,6 @@
 // two different children of a node once each, so it reports each i < j once. Boxes are
 // closed: boxes that only touch overlap. The new pairs are sorted by (i, j) at the end
 // (two counting-sort passes, or qsort for a few pairs).
-#include <stdlib.h>
-#include <string.h>
-
 #include "sim/bvh.h"
 
 #include "core/alloc.h"
