@@ -223,6 +223,75 @@ static void test_json_refuses_ungrouped_barbules(void **state)
 	assert_int_equal(plume_bytes_in_use(), before);
 }
 
+/// Numbers are printed as jansson printed them before the writer printed its own
+/// (feather_json.c, put_real): 17 significant digits, ".0" where the digits would read
+/// back as an integer, exponents without leading zeros; and they read back bit for bit.
+static void test_json_number_text(void **state)
+{
+	(void)state;
+	int64_t before = plume_bytes_in_use();
+	char dir[256], path[512];
+	test_make_temp_dir(dir, sizeof dir);
+	snprintf(path, sizeof path, "%s/numbers.json", dir);
+	plume_feather *original = small_feather(0);
+	plume_vec3 *point = &original->points[original->barbs[0].curve.first];
+	*point = plume_v3(1e11, -2.5e-5, 3.0); // the reader takes magnitudes up to 1e12
+	write_ok(FORMAT_JSON, original, path);
+	size_t size;
+	char *text = (char *)test_read_file(path, &size);
+	assert_non_null(text);
+	assert_non_null(strstr(text, "\"position\":[100000000000.0,-2.5000000000000001e-5,3.0,"));
+	assert_non_null(strstr(text, "\"rachis_t\":0.40000000000000002,"));
+	free(text);
+	plume_feather *copy = read_ok(path);
+	assert_true(plume_feather_equal(original, copy));
+	plume_feather_destroy(copy);
+	plume_feather_destroy(original);
+	test_remove_tree(dir);
+	assert_int_equal(plume_bytes_in_use(), before);
+}
+
+/// JSON has no NaN or infinity: either version refuses the feather, names the piece that
+/// has one, and writes nothing.
+static void test_json_refuses_non_finite_numbers(void **state)
+{
+	(void)state;
+	int64_t before = plume_bytes_in_use();
+	char dir[256], path[512];
+	test_make_temp_dir(dir, sizeof dir);
+	snprintf(path, sizeof path, "%s/bad.json", dir);
+	for (int binary = 0; binary < 2; ++binary)
+		for (int piece = 0; piece < 3; ++piece) {
+			plume_feather *feather = small_feather(1);
+			plume_feather *after = feather->afterfeather;
+			const char *named = NULL;
+			switch (piece) {
+			case 0:
+				feather->shaft[1].width = NAN;
+				named = "the shaft has a NaN";
+				break;
+			case 1:
+				after->widths[after->barbs[2].curve.first] = INFINITY;
+				named = "barb 2 has a NaN";
+				break;
+			default:
+				feather->afterfeather_t = -INFINITY;
+				named = "the afterfeather's t has a NaN";
+				break;
+			}
+			plume_error err;
+			plume_status status =
+			    binary ? plume_write_json_binary(feather, path, &err) : plume_write_json(feather, path, &err);
+			assert_int_equal(status, PLUME_ERROR_NUMERIC);
+			if (strstr(err.message, named) == NULL || strstr(err.message, path) == NULL)
+				fail_msg("binary %d, piece %d: %s", binary, piece, err.message);
+			assert_int_equal(test_count_entries(dir), 0);
+			plume_feather_destroy(feather);
+		}
+	test_remove_tree(dir);
+	assert_int_equal(plume_bytes_in_use(), before);
+}
+
 static long long file_size(const char *path)
 {
 	struct stat info;
@@ -881,6 +950,8 @@ int main(void)
 	    cmocka_unit_test(test_json_round_trip_small_with_barbules_and_afterfeathers),
 	    cmocka_unit_test(test_json_refuses_ungrouped_barbules),
 	    cmocka_unit_test(test_json_binary_round_trip),
+	    cmocka_unit_test(test_json_number_text),
+	    cmocka_unit_test(test_json_refuses_non_finite_numbers),
 	    cmocka_unit_test(test_json_binary_errors),
 	    cmocka_unit_test(test_same_seed_same_bytes_other_seed_other_bytes),
 	    cmocka_unit_test(test_obj_parses_back_to_the_feather),
