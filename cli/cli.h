@@ -87,6 +87,20 @@ void cli_remove_tree(const char *path);
 /// Writes <stem>.<ext> for every format in the set into the staging folder.
 plume_status cli_write_feather(cli_output *output, const plume_feather *feather, const char *stem, unsigned formats,
                                const cli_image_options *images, plume_error *err);
+/// One file of a feather: its format (one CLI_FORMAT_ bit) and its path in the staging folder.
+enum { CLI_FEATHER_FORMATS = 7 };
+typedef struct cli_feather_file {
+	unsigned format;
+	char path[4352];
+} cli_feather_file;
+/// cli_write_feather in two halves, so that the files can be written on another thread
+/// (cli/grow.c's writer): the paths of <stem>.<ext> for every format in the set, in the
+/// order cli_write_feather writes them (files holds CLI_FEATHER_FORMATS; returns how many),
+/// registered with output; then one file, touching no cli_output. Images are drawn with
+/// image; a glTF file takes texture.
+int cli_feather_file_paths(cli_output *output, const char *stem, unsigned formats, cli_feather_file files[]);
+plume_status cli_write_feather_file(const plume_feather *feather, const cli_feather_file *file,
+                                    const plume_render2d_def *image, const plume_texture *texture, plume_error *err);
 
 /// Many feathers carried by one joined shell, and a body, drawn together (cli/carry.c): the
 /// one path of `plume simulate --render` and `plume render` of a many-feather run folder.

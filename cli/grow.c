@@ -74,18 +74,38 @@ static plume_status frame_bounds(const char *spec, plume_spec_options options, i
 	return PLUME_OK;
 }
 
-/// Generates and writes every frame into the staged output: images with one shared view, geometry with
-/// cli_write_feather.
+/// One frame's files, written by the background writer (cli/writer.c) while the next frame
+/// grows: writing (the OBJ's and USD's printed numbers, PNG compression) costs several times
+/// the generation. The job owns the feather.
+typedef struct frame_job {
+	plume_feather *feather;
+	plume_render2d_def image; ///< the framing every frame shares
+	cli_feather_file files[CLI_FEATHER_FORMATS];
+	int file_count;
+} frame_job;
+
+static plume_status run_frame_job(void *data, plume_error *err)
+{
+	const frame_job *job = data;
+	plume_status status = PLUME_OK;
+	for (int i = 0; i < job->file_count && status == PLUME_OK; ++i)
+		status = cli_write_feather_file(job->feather, job->files + i, &job->image, NULL, err);
+	return status;
+}
+
+static void release_frame_job(void *data)
+{
+	frame_job *job = data;
+	plume_feather_destroy(job->feather);
+	free(job);
+}
+
+/// Generates every frame and hands it to the writer: images with one shared view, geometry
+/// as cli_write_feather writes it. The first failure, here or in the writer, is the one
+/// returned.
 static plume_status write_frames(cli_output *output, const char *spec, plume_spec_options options, int frames,
                                  unsigned formats, plume_render2d_def image, plume_error *err)
 {
-	static const struct {
-		unsigned bit;
-		const char *extension;
-		plume_image_format format;
-	} images[] = {{CLI_FORMAT_PNG, "png", PLUME_IMAGE_PNG},
-	              {CLI_FORMAT_SVG, "svg", PLUME_IMAGE_SVG},
-	              {CLI_FORMAT_PDF, "pdf", PLUME_IMAGE_PDF}};
 	plume_status status = PLUME_OK;
 	if ((formats & (CLI_FORMAT_PNG | CLI_FORMAT_SVG | CLI_FORMAT_PDF)) != 0) {
 		if ((status = frame_bounds(spec, options, frames, &image.view_min, &image.view_max, err)) != PLUME_OK)
@@ -98,25 +118,31 @@ static plume_status write_frames(cli_output *output, const char *spec, plume_spe
 			image.width = width < 256 ? 256 : (width > 4096 ? 4096 : width);
 		}
 	}
-	cli_image_options geometry_only = {0, 0, NULL};
-	for (int i = 0; i < frames && status == PLUME_OK; ++i) {
+	cli_writer *writer = NULL;
+	if ((status = cli_writer_start(&writer, err)) != PLUME_OK)
+		return status;
+	for (int i = 0; i < frames && status == PLUME_OK && cli_writer_status(writer, NULL) == PLUME_OK; ++i) {
 		options.stage = frame_stage(i, frames);
-		plume_feather *feather = NULL;
-		status = plume_spec_generate(spec, &options, &feather, err);
+		frame_job *job = malloc(sizeof *job);
+		if (job == NULL) {
+			status = plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory");
+			break;
+		}
+		*job = (frame_job){.image = image};
+		if ((status = plume_spec_generate(spec, &options, &job->feather, err)) != PLUME_OK) {
+			free(job);
+			break;
+		}
 		char stem[32];
 		snprintf(stem, sizeof stem, "frame-%04d", i);
-		for (size_t k = 0; k < sizeof images / sizeof images[0] && status == PLUME_OK; ++k) {
-			if ((formats & images[k].bit) == 0)
-				continue;
-			char name[64], path[4352];
-			snprintf(name, sizeof name, "%s.%s", stem, images[k].extension);
-			status = plume_render2d(feather, &image, images[k].format, cli_output_path(output, name, path, sizeof path),
-			                        err);
-		}
-		unsigned rest = formats & ~(unsigned)(CLI_FORMAT_PNG | CLI_FORMAT_SVG | CLI_FORMAT_PDF);
-		if (status == PLUME_OK && rest != 0)
-			status = cli_write_feather(output, feather, stem, rest, &geometry_only, err);
-		plume_feather_destroy(feather);
+		job->file_count = cli_feather_file_paths(output, stem, formats, job->files);
+		cli_writer_submit(writer, run_frame_job, release_frame_job, job);
+	}
+	plume_error write_error;
+	plume_status write_status = cli_writer_finish(writer, &write_error);
+	if (status == PLUME_OK && write_status != PLUME_OK) {
+		*err = write_error;
+		status = write_status;
 	}
 	return status;
 }

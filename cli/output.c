@@ -798,38 +798,56 @@ static plume_render2d_def image_def(const plume_feather *feather, const cli_imag
 	return def;
 }
 
+/// The formats of a feather's files, in the order cli_write_feather writes them.
+static const struct {
+	unsigned bit;
+	const char *extension;
+} feather_formats[] = {
+    {CLI_FORMAT_PNG, "png"},   {CLI_FORMAT_SVG, "svg"},   {CLI_FORMAT_PDF, "pdf"}, {CLI_FORMAT_OBJ, "obj"},
+    {CLI_FORMAT_USDA, "usda"}, {CLI_FORMAT_JSON, "json"}, {CLI_FORMAT_GLB, "glb"},
+};
+
+int cli_feather_file_paths(cli_output *output, const char *stem, unsigned formats, cli_feather_file files[])
+{
+	int count = 0;
+	for (size_t i = 0; i < sizeof feather_formats / sizeof feather_formats[0]; ++i) {
+		if ((formats & feather_formats[i].bit) == 0)
+			continue;
+		char name[64];
+		snprintf(name, sizeof name, "%s.%s", stem, feather_formats[i].extension);
+		files[count].format = feather_formats[i].bit;
+		cli_output_path(output, name, files[count].path, sizeof files[count].path);
+		++count;
+	}
+	return count;
+}
+
+plume_status cli_write_feather_file(const plume_feather *feather, const cli_feather_file *file,
+                                    const plume_render2d_def *image, const plume_texture *texture, plume_error *err)
+{
+	switch (file->format) {
+	case CLI_FORMAT_PNG: return plume_render2d(feather, image, PLUME_IMAGE_PNG, file->path, err);
+	case CLI_FORMAT_SVG: return plume_render2d(feather, image, PLUME_IMAGE_SVG, file->path, err);
+	case CLI_FORMAT_PDF: return plume_render2d(feather, image, PLUME_IMAGE_PDF, file->path, err);
+	case CLI_FORMAT_OBJ: return plume_write_obj(feather, file->path, err);
+	case CLI_FORMAT_USDA: return plume_write_usda(feather, file->path, err);
+	case CLI_FORMAT_GLB: {
+		plume_gltf_def gltf = plume_gltf_default_def();
+		gltf.texture = texture;
+		return plume_write_glb(feather, &gltf, file->path, err);
+	}
+	default: return plume_write_json(feather, file->path, err);
+	}
+}
+
 plume_status cli_write_feather(cli_output *output, const plume_feather *feather, const char *stem, unsigned formats,
                                const cli_image_options *images, plume_error *err)
 {
-	static const struct {
-		unsigned bit;
-		const char *extension;
-	} order[] = {
-	    {CLI_FORMAT_PNG, "png"},   {CLI_FORMAT_SVG, "svg"},   {CLI_FORMAT_PDF, "pdf"}, {CLI_FORMAT_OBJ, "obj"},
-	    {CLI_FORMAT_USDA, "usda"}, {CLI_FORMAT_JSON, "json"}, {CLI_FORMAT_GLB, "glb"},
-	};
+	cli_feather_file files[CLI_FEATHER_FORMATS];
+	int count = cli_feather_file_paths(output, stem, formats, files);
 	plume_render2d_def def = image_def(feather, images);
-	for (size_t i = 0; i < sizeof order / sizeof order[0]; ++i) {
-		if ((formats & order[i].bit) == 0)
-			continue;
-		char name[64], path[4352];
-		snprintf(name, sizeof name, "%s.%s", stem, order[i].extension);
-		cli_output_path(output, name, path, sizeof path);
-		plume_status status;
-		switch (order[i].bit) {
-		case CLI_FORMAT_PNG: status = plume_render2d(feather, &def, PLUME_IMAGE_PNG, path, err); break;
-		case CLI_FORMAT_SVG: status = plume_render2d(feather, &def, PLUME_IMAGE_SVG, path, err); break;
-		case CLI_FORMAT_PDF: status = plume_render2d(feather, &def, PLUME_IMAGE_PDF, path, err); break;
-		case CLI_FORMAT_OBJ: status = plume_write_obj(feather, path, err); break;
-		case CLI_FORMAT_USDA: status = plume_write_usda(feather, path, err); break;
-		case CLI_FORMAT_GLB: {
-			plume_gltf_def gltf = plume_gltf_default_def();
-			gltf.texture = images->texture;
-			status = plume_write_glb(feather, &gltf, path, err);
-			break;
-		}
-		default: status = plume_write_json(feather, path, err); break;
-		}
+	for (int i = 0; i < count; ++i) {
+		plume_status status = cli_write_feather_file(feather, files + i, &def, images->texture, err);
 		if (status != PLUME_OK)
 			return status;
 	}

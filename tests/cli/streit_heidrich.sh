@@ -44,6 +44,12 @@ check "grow: one frame is the finished feather" cmp -s "$scratch/grow1/frame-000
 "$plume" grow "$presets/semiplume.json" -o "$scratch/grow-strips" --frames 2 --format png --style strips --size 100x100
 check "grow --style strips" test -s "$scratch/grow-strips/frame-0001.png"
 check "help grow" bash -c "'$plume' help grow | grep -q -- '--frames'"
+# The frames are written by a background writer while the next frame grows: a file it
+# cannot write (a 300 KiB file-size limit lets every file through but the last frame's
+# 416 KB USD) fails the command, names the file in DIR, and keeps nothing.
+expect_no_output "grow: a write the background writer cannot finish" 4 \
+	"plume: $scratch/too-large/frame-0004.usda: write failed: File too large" "$scratch/too-large" \
+	bash -c "trap '' XFSZ; ulimit -f 300; exec '$plume' grow '$presets/contour.json' -o '$scratch/too-large' --frames 5 --size 160x240"
 
 expect_no_output "grow: --unfurl on streit-heidrich" 1 "no unfurling" "$scratch/g1" \
 	"$plume" grow "$presets/contour.json" -o "$scratch/g1" --frames 3 --unfurl
