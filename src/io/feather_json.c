@@ -4,7 +4,7 @@
 // friendly to diff), so that a 132 000-point feather never sits in memory twice.
 // Until 2026-11-28 it built each barb as a jansson value (13 small objects) and
 // encoded that: on Figure 1's 4400-barb hawk the version 2 dump took 0.46 G
-// instructions, 5 % of `plume simulate`'s run, and takes 0.19 G printed directly,
+// instructions, 5 % of `plume simulate`'s run, and takes 0.15 G printed directly,
 // with the same bytes. Doubles are printed with 17 significant digits as jansson's
 // JSON_REAL_PRECISION(17) prints them (put_real), enough for strtod to give back the
 // same double, bit for bit.
@@ -101,7 +101,8 @@ static void put_real(emitter *out, double value)
 		if (strchr(text, '.') == NULL)
 			memcpy(text + length, ".0", 3);
 	} else {
-		char *digits = exponent + 1, *first = digits + (*digits == '-' ? 1 : 0), *from = digits + 1;
+		// exponent[1] is its sign: '+' is overwritten, '-' kept; then the leading zeros go.
+		char *sign = exponent + 1, *first = sign + (*sign == '-' ? 1 : 0), *from = sign + 1;
 		while (*from == '0' && from[1] != '\0')
 			++from;
 		memmove(first, from, strlen(from) + 1);
