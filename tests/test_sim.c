@@ -465,6 +465,28 @@ static void test_kkt_factor_reports_indefinite(void **state)
 	plume_kkt_free(&kkt);
 }
 
+/// A Newton matrix of two vertices joined by one barb along u: H = diag(k0 I, k1 I),
+/// C = [-u^T u^T].
+static void one_barb_init(plume_kkt *kkt)
+{
+	memset(kkt, 0, sizeof *kkt);
+	plume_error err = {0};
+	static const int pair[2] = {0, 1}; // the matrix keeps the pointer
+	assert_int_equal(plume_kkt_init(kkt, 2, 0, NULL, 0, NULL, 4, 0, 0, NULL, 1, pair, &err), PLUME_OK);
+}
+
+static void one_barb_load(plume_kkt *kkt, double k0, double k1, const double u[3])
+{
+	double *values = plume_kkt_values(kkt);
+	plume_kkt_zero(kkt);
+	for (int d = 0; d < 3; ++d) {
+		values[kkt->system.diagonal[d]] = k0;
+		values[kkt->system.diagonal[3 + d]] = k1;
+		values[kkt->constraint_slots[d]] = -u[d];
+		values[kkt->constraint_slots[3 + d]] = u[d];
+	}
+}
+
 static void test_kkt_factor_inertia(void **state)
 {
 	(void)state;
@@ -472,18 +494,11 @@ static void test_kkt_factor_inertia(void **state)
 	// constraints' tangent space, read from the Cholesky factors of H + C^T R C: one barb
 	// between two vertices along x (C = [-1 0 0 1 0 0]), H = 2 I with one entry changed.
 	plume_kkt kkt;
-	memset(&kkt, 0, sizeof kkt);
+	one_barb_init(&kkt);
 	plume_error err = {0};
-	const int pair[2] = {0, 1};
-	assert_int_equal(plume_kkt_init(&kkt, 2, 0, NULL, 0, NULL, 4, 0, 0, NULL, 1, pair, &err), PLUME_OK);
 	double *values = plume_kkt_values(&kkt), shift;
 	for (int trial = 0; trial < 2; ++trial) {
-		plume_kkt_zero(&kkt);
-		for (int v = 0; v < 2; ++v)
-			for (int d = 0; d < 3; ++d)
-				values[kkt.system.diagonal[3 * v + d]] = 2.0;
-		values[kkt.constraint_slots[0]] = -1.0;
-		values[kkt.constraint_slots[3]] = 1.0;
+		one_barb_load(&kkt, 2.0, 2.0, (const double[3]){1, 0, 0});
 		// Trial 0: H_x0x0 = -1 makes H indefinite, but the tangent space sees x0 only with
 		// x1 ((-1 + 2) / 2 > 0 along x0 = x1): accepted. Trial 1: H_y0y0 = -1 is a tangent
 		// direction: refused.
@@ -499,6 +514,43 @@ static void test_kkt_factor_inertia(void **state)
 		assert_int_equal(plume_kkt_solve(&kkt, rhs, NULL, 1e-14, x, &err), PLUME_OK);
 		assert_close(x[3] - x[0], 0.5, 1e-14);  // the linearised constraint, to rounding
 		assert_close(-x[0] - x[6], 1.0, 1e-12); // H dx + C^T lambda = rhs on x0
+	}
+	plume_kkt_free(&kkt);
+}
+
+static void test_kkt_barb_between_stiff_and_soft(void **state)
+{
+	(void)state;
+	// A barb rooted on the rachis: one end held by a stiffness many decades above the
+	// other's (a sliver of the stiff rachis band, the soft vane). H = diag(k0 I, I), the
+	// barb along u = (1, 1, 0) / sqrt(2), C = [-u^T u^T]. Closed form: along u the barb
+	// stays at length r and the forces split by the stiffnesses, lambda = a1 - dx1.u with
+	// dx0.u = (a0 + a1 - r) / (k0 + 1), dx1.u = dx0.u + r (a_i = g_i.u); then each row,
+	// k0 dx0 - lambda u = g0 and dx1 + lambda u = g1. The regularisation's rho, 1e6 times
+	// the stiffer end's stiffness, must stay within reach of the softer end's: unbounded,
+	// rho u u^T swamps the soft end's own stiffness across the barb (1 against 1e6 k0),
+	// which rounding then loses, and at k0 = 1e12 the matrix no longer factors (the
+	// Streit-Heidrich peacock's rachis tip, 40 um wide against 5 mm rows, did not
+	// converge in a single step).
+	plume_kkt kkt;
+	one_barb_init(&kkt);
+	plume_error err = {0};
+	double shift;
+	const double u[3] = {sqrt(0.5), sqrt(0.5), 0}, g0[3] = {0.3, -0.1, 0.2}, g1[3] = {0.7, 0.4, -0.5}, r = 0.25;
+	for (int decades = 0; decades <= 12; decades += 4) {
+		double k0 = pow(10.0, decades);
+		one_barb_load(&kkt, k0, 1.0, u);
+		assert_int_equal(plume_kkt_factor(&kkt, 0, 0, &shift, &err), PLUME_OK);
+		assert_true(shift == 0.0);
+		double rhs[7] = {g0[0], g0[1], g0[2], g1[0], g1[1], g1[2], r}, x[7];
+		assert_int_equal(plume_kkt_solve(&kkt, rhs, NULL, 1e-14, x, &err), PLUME_OK);
+		double a0 = g0[0] * u[0] + g0[1] * u[1], a1 = g1[0] * u[0] + g1[1] * u[1];
+		double along0 = (a0 + a1 - r) / (k0 + 1), lambda = a1 - (along0 + r);
+		for (int d = 0; d < 3; ++d) {
+			assert_close(x[d], (g0[d] + lambda * u[d]) / k0, 1e-12 / k0);
+			assert_close(x[3 + d], g1[d] - lambda * u[d], 1e-12);
+		}
+		assert_close(x[6], lambda, 1e-12);
 	}
 	plume_kkt_free(&kkt);
 }
@@ -815,6 +867,7 @@ int main(void)
 	    cmocka_unit_test(test_factorisation_restores_openmp_levels),
 	    cmocka_unit_test(test_sparse_simplicial_and_supernodal),
 	    cmocka_unit_test(test_kkt_factor_inertia),
+	    cmocka_unit_test(test_kkt_barb_between_stiff_and_soft),
 	    cmocka_unit_test(test_bad_definitions),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);

@@ -222,16 +222,27 @@ static void shift_positions(plume_kkt *kkt, double amount)
 /// the diagonal it is added to.
 static const double SMALLEST_SHIFT = 1e-10;
 
-/// rho_k over the largest diagonal entry of H at the constraint's free unknowns: large
-/// enough that H + C^T R C is positive definite whenever H is on the constraints' tangent
-/// space and that refinement converges in a few steps, small enough that the factored
-/// matrix stays well conditioned. Measured on Figure 1 (docs/simulation.md, "Linear
-/// algebra"): 1e3 refuses exact Hessians the LDL' inertia accepted and a step fails;
-/// 1e4 converges to positions 1.9e-9 m from the LDL' solver's; 1e6 to 6e-17 m with 4.4
-/// solves an iteration; 1e8 to 1e-16 m with 5.4.
+/// rho_k over the larger diagonal entry of H at the barb's two ends: large enough that
+/// H + C^T R C is positive definite whenever H is on the constraints' tangent space and
+/// that refinement converges in a few steps, small enough that the factored matrix stays
+/// well conditioned. Measured on Figure 1 (docs/simulation.md, "Linear algebra"): 1e3
+/// refuses exact Hessians the LDL' inertia accepted and a step fails; 1e4 converges to
+/// positions 1.9e-9 m from the LDL' solver's; 1e6 to 6e-17 m with 4.4 solves an
+/// iteration; 1e8 to 1e-16 m with 5.4.
 static const double AUGMENTATION = 1e6;
 
-/// The factored matrix from K: H's entries, then C^T R C with rho_k from H's diagonal.
+/// rho_k over the smaller diagonal entry at the barb's ends, at most: rho_k c c^T lands on
+/// both ends, and past this it swamps the softer end's own stiffness across the barb so
+/// far that rounding loses it (to 1e-4 of it here, 1e12 * 2.2e-16). A barb rooted on a
+/// sliver of the stiff rachis band, 1.3e10 times stiffer than the vane vertex at its
+/// other end (the Streit-Heidrich peacock's shaft tapers to 40 um against rows 5 mm
+/// apart), made the matrix indefinite to rounding and no step converged
+/// (tests/test_sim.c, test_kkt_barb_between_stiff_and_soft). Figure 1's barbs span up to
+/// 3e5 (e = 0.9 mm) and keep AUGMENTATION: scaled with the softer end alone, the 0.9 mm
+/// run fails at its buckling step (docs/simulation.md).
+static const double PRECISION_LIMIT = 1e12;
+
+/// The factored matrix from K: H's entries, then C^T R C with rho_k from H's diagonal at each barb's ends.
 static void load_positions(plume_kkt *kkt)
 {
 	const double *stored = kkt->system.matrix->x;
@@ -241,13 +252,18 @@ static void load_positions(plume_kkt *kkt)
 		values[kkt->position_slots[e]] = stored[e];
 	for (int k = 0; k < kkt->constraint_count; ++k) {
 		const int *vertices = kkt->constraint_vertices + 2 * k;
-		double c[6], diagonal = 0;
+		// Each end's stiffness: the largest diagonal entry of H at its free unknowns the
+		// barb moves (a held end has none).
+		double c[6], end[2] = {0, 0};
 		for (int a = 0; a < 6; ++a) {
 			c[a] = stored[kkt->constraint_slots[6 * k + a]];
 			if (c[a] != 0)
-				diagonal = fmax(diagonal, fabs(stored[kkt->system.diagonal[3 * vertices[a / 3] + a % 3]]));
+				end[a / 3] = fmax(end[a / 3], fabs(stored[kkt->system.diagonal[3 * vertices[a / 3] + a % 3]]));
 		}
-		double rho = kkt->rho[k] = AUGMENTATION * (diagonal > 0 ? diagonal : 1);
+		double rho = AUGMENTATION * fmax(end[0], end[1]);
+		if (end[0] > 0 && end[1] > 0)
+			rho = fmin(rho, PRECISION_LIMIT * fmin(end[0], end[1]));
+		kkt->rho[k] = rho = rho > 0 ? rho : AUGMENTATION;
 		const int *slots = kkt->augment_slots + 21 * k;
 		for (int a = 0; a < 6; ++a)
 			for (int b = a; b < 6; ++b, ++slots)

@@ -82,7 +82,7 @@ void plume_kkt_zero(plume_kkt *kkt);
 
 /// Factors the current values. A Hessian that is not positive definite on the free
 /// unknowns (with constraints, when H + C^T R C is not positive definite, which, rho_k
-/// being 1e6 times the diagonal of H at the constraint's ends, says that H is not positive
+/// being 1e6 times the diagonal of H at the constraint's ends (kkt.c), says that H is not positive
 /// definite on the tangent space of the constraints, the condition for a descent
 /// direction of the l1 merit: Nocedal & Wright, sections 16.2 and 18.3) is shifted:
 /// H + s d I, d the mean of H's diagonal and s the smallest of the ladder first_shift,
