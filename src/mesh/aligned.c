@@ -2070,17 +2070,50 @@ static int find_overlap(const plume_mesh *mesh, bool *out_of_memory)
 	return found;
 }
 
+/// The vane's smaller extent, m: the span of its guides' roots along the rachis or its
+/// longest guide in the plane, whichever is shorter (0 with no guide).
+static double vane_extent(const mesh_input *in)
+{
+	double span = 0.0, reach = 0.0;
+	for (int side = 0; side < 2; ++side) {
+		if (in->guide_count[side] == 0)
+			continue;
+		span = fmax(span, in->sigma_last[side] - in->sigma_first[side]);
+		for (int g = 0; g < in->guide_count[side]; ++g) {
+			const plume_vec3 *p = in->guides[side][g].p;
+			double length = 0.0;
+			for (int k = 0; k + 1 < MESH_GUIDE_SAMPLES; ++k)
+				length += sqrt(dist2(p[k], p[k + 1]));
+			reach = fmax(reach, length);
+		}
+	}
+	return fmin(span, reach);
+}
+
 /// Builds the mesh of the settled strips (vane_faces vane faces): vertices,
 /// the rachis band, the strips' faces, sliding, the overlap check, barb edges
 /// and groups; measures it into *measured.
 static plume_status build_mesh(mesher *m, int vane_faces, plume_mesh **out, plume_mesh_report *measured)
 {
 	int vertex_count = number_vertices(m);
-	if (vertex_count == 2 * m->row_count || vane_faces == 0)
+	if (vertex_count == 2 * m->row_count || vane_faces == 0) {
+		const mesh_input *in = m->input;
+		double extent = vane_extent(in);
+		// Guides but no vane face: rows e apart root too few guides, or guides shorter than
+		// a step, on a vane that small; a quarter of it meshes every example feather.
+		if (extent > 0.0 && m->e > 0.25 * extent) {
+			double unit = pow(10.0, floor(log10(0.25 * extent)) - 1.0); // two digits, rounded down
+			return plume_error_set(m->err, PLUME_ERROR_SPEC,
+			                       "no vane to mesh at edge_length %g m: the vane spans %.3g m (%d usable barb "
+			                       "guides on the left, %d on the right); an edge_length of %g m or less meshes it",
+			                       m->e, extent, in->guide_count[0], in->guide_count[1],
+			                       floor(0.25 * extent / unit) * unit);
+		}
 		return plume_error_set(m->err, PLUME_ERROR_SPEC,
 		                       "no vane to mesh: %d usable barb guides on the left, %d on the right (%d input barbs "
 		                       "left out); the feather needs barbs with a length in the feather plane",
-		                       m->input->guide_count[0], m->input->guide_count[1], m->input->guides_dropped);
+		                       in->guide_count[0], in->guide_count[1], in->guides_dropped);
+	}
 	int face_count = 2 * (m->row_count - 1) + vane_faces;
 	plume_mesh *mesh = plume_mesh_create(vertex_count, face_count);
 	if (mesh == NULL)

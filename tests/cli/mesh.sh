@@ -40,6 +40,15 @@ expect_failure "typo key" 3 "typo.json: \$.mesh" "$plume" mesh "$scratch/typo.js
 check "typo key: nothing written" test ! -e "$scratch/typo"
 expect_failure "missing file" 4 "nope.json" "$plume" mesh "$scratch/nope.json" -o "$scratch/nope"
 check "missing file: nothing written" test ! -e "$scratch/nope"
+# An edge length too coarse for a small vane (the Streit-Heidrich down, its vane 7.9 mm):
+# the error names the edge length to use, and that one meshes it.
+expect_no_output "coarse mesh of a small vane" 3 "no vane to mesh at edge_length 0.01 m: the vane spans 0.00785 m" \
+	"$scratch/coarse" "$plume" mesh "$source_dir/examples/streit-heidrich/down.json" -o "$scratch/coarse" -e 0.01
+suggested=$(sed -n 's/.*an edge_length of \([0-9.e-]*\) m or less meshes it.*/\1/p' "$scratch/err.txt")
+check "coarse mesh: an edge length is suggested ($suggested)" test -n "$suggested"
+"$plume" mesh "$source_dir/examples/streit-heidrich/down.json" -o "$scratch/suggested" -e "${suggested:-0}" \
+	>"$scratch/out.txt" 2>"$scratch/err.txt"
+succeeded "the suggested edge length meshes the down"
 "$plume" help mesh >"$scratch/help.txt" 2>&1
 check "help mentions guides spec" grep -q "guides spec" "$scratch/help.txt"
 
