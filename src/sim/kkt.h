@@ -95,12 +95,12 @@ plume_status plume_kkt_factor(plume_kkt *kkt, double first_shift, double largest
 
 /// Solves K [dx; lambda] = rhs with the last factorisation: rhs and solution have
 /// dof_count + constraint_count entries. With constraints, iterative refinement against
-/// K: a step only while the componentwise backward error max |r_i| / (|K||x| + |rhs|)_i
-/// is above tolerance and falling, at most 8 (1e-14: the linearised constraints hold to
-/// rounding). multipliers (constraint_count entries, or NULL for 0) is a guess of the
-/// solution's lambda for the regularised solve to start from: the first residual is the
-/// guess's error over rho, about 1e-5 of the system for a good guess, and each step gains
-/// about five decades.
+/// K: a step only while the componentwise backward error max |r_i| / (|K||x| + |rhs|)_i,
+/// or the largest residual force on a position row over the largest force of rhs, is above
+/// tolerance, and falling, at most 8 (1e-14: the linearised constraints hold to rounding). multipliers
+/// (constraint_count entries, or NULL for 0) is a guess of the solution's lambda for the regularised solve to start
+/// from: the first residual is the guess's error over rho, about 1e-5 of the system for a good guess, and each step
+/// gains about five decades.
 plume_status plume_kkt_solve(plume_kkt *kkt, const double *rhs, const double *multipliers, double tolerance,
                              double *solution, plume_error *err);
 
