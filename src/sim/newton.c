@@ -51,7 +51,7 @@ static double constraint_value(const plume_sim *sim, const plume_vec3 *x, int k,
 	return l - sim->constraint_length[k];
 }
 
-static bool constraint_held(const plume_sim *sim, int k)
+bool plume_sim_constraint_held(const plume_sim *sim, int k)
 {
 	int a = sim->constraint_vertices[2 * k], b = sim->constraint_vertices[2 * k + 1];
 	return sim->fixed[3 * a] && sim->fixed[3 * a + 1] && sim->fixed[3 * a + 2] && sim->fixed[3 * b] &&
@@ -62,7 +62,7 @@ static double constraint_norm1(const plume_sim *sim, const plume_vec3 *x)
 {
 	double sum = 0;
 	for (int k = 0; k < sim->constraint_count; ++k)
-		if (!constraint_held(sim, k))
+		if (!plume_sim_constraint_held(sim, k))
 			sum += fabs(constraint_value(sim, x, k, NULL, NULL));
 	return sum;
 }
@@ -71,7 +71,7 @@ static double max_constraint_strain(const plume_sim *sim, const plume_vec3 *x)
 {
 	double worst = 0;
 	for (int k = 0; k < sim->constraint_count; ++k) {
-		if (constraint_held(sim, k))
+		if (plume_sim_constraint_held(sim, k))
 			continue;
 		double s = fabs(constraint_value(sim, x, k, NULL, NULL)) / sim->constraint_length[k];
 		worst = s > worst ? s : worst;
@@ -91,7 +91,7 @@ static double lagrangian_residual(plume_sim *sim, const plume_vec3 *x, const dou
 	// A barb with both ends held by handles keeps its length (the handle is rigid): nothing
 	// to solve.
 	for (int k = 0; k < sim->constraint_count; ++k)
-		rhs[n3 + k] = constraint_held(sim, k) ? 0 : -constraint_value(sim, x, k, NULL, NULL);
+		rhs[n3 + k] = plume_sim_constraint_held(sim, k) ? 0 : -constraint_value(sim, x, k, NULL, NULL);
 	double norm = 0;
 	for (int i = 0; i < n3; ++i)
 		if (!sim->fixed[i])
@@ -105,7 +105,7 @@ void plume_sim_add_constraint_rows(plume_sim *sim, const plume_vec3 *x, bool exa
 {
 	double *values = plume_kkt_values(&sim->kkt);
 	for (int k = 0; k < sim->constraint_count; ++k) {
-		if (constraint_held(sim, k))
+		if (plume_sim_constraint_held(sim, k))
 			continue;
 		plume_vec3 t;
 		double l;
@@ -134,7 +134,7 @@ void plume_sim_add_constraint_rows(plume_sim *sim, const plume_vec3 *x, bool exa
 void plume_sim_add_constraint_forces(const plume_sim *sim, const plume_vec3 *x, double *forces)
 {
 	for (int k = 0; k < sim->constraint_count; ++k) {
-		if (constraint_held(sim, k))
+		if (plume_sim_constraint_held(sim, k))
 			continue;
 		plume_vec3 t;
 		constraint_value(sim, x, k, &t, NULL);
@@ -208,7 +208,8 @@ static bool corrected_trial(plume_sim *sim, const sim_problem *problem, const pl
 	for (int round = 0; round < CORRECTIONS; ++round) {
 		memset(correction_rhs, 0, sizeof(double) * (size_t)n3);
 		for (int k = 0; k < m; ++k)
-			correction_rhs[n3 + k] = constraint_held(sim, k) ? 0 : -constraint_value(sim, sim->scratch, k, NULL, NULL);
+			correction_rhs[n3 + k] =
+			    plume_sim_constraint_held(sim, k) ? 0 : -constraint_value(sim, sim->scratch, k, NULL, NULL);
 		double solve_start = omp_get_wtime();
 		plume_status status = plume_kkt_solve_unrefined(&sim->kkt, correction_rhs, correction, err);
 		report->seconds_solve += omp_get_wtime() - solve_start;

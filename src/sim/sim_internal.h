@@ -184,6 +184,10 @@ void plume_sim_add_constraint_rows(plume_sim *sim, const plume_vec3 *x, bool exa
 /// Adds C^T lambda, the constraint forces of the current multipliers, to forces (3 n).
 void plume_sim_add_constraint_forces(const plume_sim *sim, const plume_vec3 *x, double *forces);
 
+/// Whether barb constraint k has both ends held (every unknown of both vertices fixed):
+/// Newton leaves it out, and only the handles set its length (plume_sim_step checks it).
+bool plume_sim_constraint_held(const plume_sim *sim, int k);
+
 /// Largest |l - L| / L over all barb-aligned edges at positions x.
 double plume_sim_max_barb_strain(const plume_sim *sim, const plume_vec3 *x);
 

@@ -78,6 +78,23 @@ bad "unknown key" 'did you mean "duration"' '"durations": 1'
 bad "unknown integrator" '$.integrator: unknown value "bdf3"' '"integrator": "bdf3"'
 bad "negative normal drag" '$.air.normal_drag is -1, allowed >= 0' '"air": {"normal_drag": -1}'
 bad "NaN wind" '$.air.wind: element 1 is not a number' '"air": {"wind": [0, "NaN", 0]}'
+# A handle that pulls a barb away from the clamp holding its other end (the Streit-Heidrich
+# bristle's one barb, its vane tip pulled along it): the barb constraint cannot hold, and the
+# run used to end "completed" with the barb stretched 264 %.
+cat >"$scratch/stretch.json" <<JSON
+{
+  "feather": "$source_dir/examples/streit-heidrich/bristle.json",
+  "mesh": {"edge_length": 0.005},
+  "handles": [{"group": "rachis_clamp"},
+              {"group": "vane_tip", "keyframes": [{"time": 0, "translation": [0, 0, 0]},
+                                                  {"time": 0.1, "translation": [-0.015, 0, 0]}]}],
+  "duration": 0.1
+}
+JSON
+expect_no_output "a handle stretching a barb held at both ends" 3 \
+	"the handles hold both ends of the barb edge between vertices 3 and 14 and change its length from 0.00341364 m" \
+	"$scratch/stretch" "$plume" simulate "$scratch/stretch.json" -o "$scratch/stretch"
+check "the stretched barb: the message says what to change" grep -q "hold one end only, or set the vane's barb_constraint to false" "$scratch/err.txt"
 expect_failure "missing scene" 4 "missing.json" "$plume" simulate "$scratch/missing.json" -o "$scratch/none"
 check "missing scene: nothing written" test ! -e "$scratch/none"
 expect_failure "no output" 2 "missing -o DIR" "$plume" simulate "$scratch/swing.json"
