@@ -235,12 +235,15 @@ typedef struct plume_solve_report {
 
 /// Minimises the elastic + gravity potential with the handles where they are.
 /// Returns PLUME_ERROR_NUMERIC when it did not converge: the positions are then
-/// the last iterate (finite), and report says so.
+/// the last iterate (finite), and report says so. PLUME_ERROR_SPEC when the handles hold
+/// both ends of a constrained barb and change its length (by more than 1e-8 of it).
 plume_status plume_sim_solve_static(plume_sim *sim, plume_solve_report *report, plume_error *err);
 
 /// One step of def.time_step with def.integrator; handles must be set for the end of the step.
 /// A step that does not converge is retried with substeps (handles interpolated linearly);
 /// if that fails too, the state is left as before the step and PLUME_ERROR_NUMERIC returned.
+/// PLUME_ERROR_SPEC (the state left as before) when the handles hold both ends of a
+/// constrained barb and change its length by more than 1e-8 of it: no solve can keep it.
 plume_status plume_sim_step(plume_sim *sim, plume_solve_report *report, plume_error *err);
 
 /// Obstacles: triangle meshes moved by prescription (bodies). The shell collides with them
