@@ -205,6 +205,45 @@ static void test_barb_constraint_holds(void **state)
 	assert_int_equal(plume_bytes_in_use(), 0);
 }
 
+/// Handles that pull two held vertices farther apart than the chain of barb edges between
+/// them is long ask for the impossible (sim/held.c): the strip's barbs run along y, six
+/// edges from its bottom row to its top row, and holding both rows and lifting the top one
+/// 1 mm along them stretches every chain by 1 %. The step is refused, saying which chain,
+/// and the state stays; moving both rows together, which the barbs allow, steps.
+static void test_held_chain_cannot_stretch(void **state)
+{
+	(void)state;
+	plume_mesh *mesh = make_strip(0.05, 0.1, 7);
+	strip s = {0.05, 0.1, mesh->vertex_count / 7, 7};
+	int bottom[64], top[64];
+	assert_true(s.columns <= 64);
+	for (int i = 0; i < s.columns; ++i) {
+		bottom[i] = strip_vertex(&s, i, 0);
+		top[i] = strip_vertex(&s, i, s.rows - 1);
+	}
+	assert_int_equal(plume_mesh_add_group(mesh, "bottom", bottom, s.columns, NULL), PLUME_OK);
+	assert_int_equal(plume_mesh_add_group(mesh, "top", top, s.columns, NULL), PLUME_OK);
+	plume_sim_def def = vane_def(plume_v3(0, 0, 0));
+	plume_sim *sim = NULL;
+	plume_error err = {0};
+	assert_int_equal(plume_sim_create(mesh, &def, &sim, &err), PLUME_OK);
+	int lower = plume_sim_add_handle(sim, "bottom", &err), upper = plume_sim_add_handle(sim, "top", &err);
+	assert_true(lower >= 0 && upper >= 0);
+	plume_mat3 identity = plume_m3_identity();
+	plume_sim_set_handle(sim, upper, plume_v3(0, 1e-3, 0), identity, plume_v3(0, 0, 0));
+	assert_int_equal(plume_sim_step(sim, NULL, &err), PLUME_ERROR_SPEC);
+	printf("%s\n", err.message);
+	assert_non_null(strstr(err.message, "the chain of 6 barb edges between them is 0.1 m long"));
+	for (int v = 0; v < mesh->vertex_count; ++v)
+		assert_true(plume_v3_distance(plume_sim_positions(sim)[v], mesh->rest[v]) == 0);
+	// Both rows lifted together: a rigid motion the barbs allow.
+	plume_sim_set_handle(sim, lower, plume_v3(0, 1e-3, 0), identity, plume_v3(0, 0, 0));
+	assert_int_equal(plume_sim_step(sim, NULL, &err), PLUME_OK);
+	plume_sim_destroy(sim);
+	plume_mesh_destroy(mesh);
+	assert_int_equal(plume_bytes_in_use(), 0);
+}
+
 /// A Newton step below the tolerance (times the shell's size) ends a solve, but it moves
 /// the barbs' ends to second order: the solve may end there only if the barbs still hold.
 /// With a tolerance of 0.5 every step of the static sag is "below tolerance" (5.6 cm on
@@ -854,6 +893,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test(test_cantilever_matches_euler_bernoulli),
 	    cmocka_unit_test(test_barb_constraint_holds),
+	    cmocka_unit_test(test_held_chain_cannot_stretch),
 	    cmocka_unit_test(test_small_step_keeps_the_barbs),
 	    cmocka_unit_test(test_curved_rest_shape_is_at_rest),
 	    cmocka_unit_test(test_potential_decreases_every_step),

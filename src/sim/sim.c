@@ -575,7 +575,8 @@ plume_status plume_sim_create(const plume_mesh *mesh, const plume_sim_def *def, 
 	sim->barb_length = plume_alloc(sizeof(double) * (size_t)(sim->barb_edge_count + 1));
 	sim->faces = plume_alloc(sizeof(int) * 3 * (size_t)mesh->face_count);
 	sim->face_material = plume_alloc((size_t)mesh->face_count);
-	if (!sim->constraint_length || !sim->barb_length || !sim->faces || !sim->face_material) {
+	if (!sim->constraint_length || !sim->barb_length || !sim->faces || !sim->face_material ||
+	    !plume_sim_held_init(sim)) {
 		plume_sim_destroy(sim);
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory creating the simulation");
 	}
@@ -624,6 +625,7 @@ void plume_sim_destroy(plume_sim *sim)
 	plume_integrator_free(&sim->integrator);
 	plume_air_free(&sim->air);
 	plume_contact_free(&sim->contact);
+	plume_sim_held_free(sim);
 	void *arrays[] = {sim->x,
 	                  sim->v,
 	                  sim->rest,
@@ -845,31 +847,6 @@ static plume_status solve_substep(plume_sim *sim, const sim_problem *problem, do
 	                       MAX_CONTACT_ROUNDS);
 }
 
-/// The issue's bound on a barb's strain (issue 13: under 1e-8), for barbs whose two ends
-/// the handles hold: past it their motion stretches or shortens an inextensible barb.
-static const double HELD_BARB_STRAIN = 1e-8;
-
-/// A barb constraint held at both ends is out of Newton's reach: its length is the handles'
-/// doing. A scene whose handles change it asks for the impossible (a vane tip pulled away
-/// from a clamped rachis along the barb between them, the Streit-Heidrich bristle's single
-/// barb: strained 264 % over a run that reported success); refuse it and say where.
-static plume_status check_held_barbs(const plume_sim *sim, plume_error *err)
-{
-	for (int k = 0; k < sim->constraint_count; ++k) {
-		if (!plume_sim_constraint_held(sim, k))
-			continue;
-		int a = sim->constraint_vertices[2 * k], b = sim->constraint_vertices[2 * k + 1];
-		double length = plume_v3_distance(sim->x[a], sim->x[b]), rest = sim->constraint_length[k];
-		if (fabs(length - rest) > HELD_BARB_STRAIN * rest)
-			return plume_error_set(err, PLUME_ERROR_SPEC,
-			                       "the handles hold both ends of the barb edge between vertices %d and %d and "
-			                       "change its length from %.6g m to %.6g m (strain %.3g), which its barb "
-			                       "constraint forbids: hold one end only, or set the vane's barb_constraint to false",
-			                       a, b, rest, length, fabs(length - rest) / rest);
-	}
-	return PLUME_OK;
-}
-
 plume_status plume_sim_solve_static(plume_sim *sim, plume_solve_report *report, plume_error *err)
 {
 	PLUME_ASSERT_HANDLE(sim);
@@ -889,7 +866,7 @@ plume_status plume_sim_solve_static(plume_sim *sim, plume_solve_report *report, 
 		for (int s = 1; s <= substeps; ++s) {
 			memcpy(sim->previous, sim->x, bytes);
 			plume_sim_place_handles(sim, (double)s / substeps);
-			status = check_held_barbs(sim, err);
+			status = plume_sim_check_held_barbs(sim, err);
 			if (status == PLUME_OK)
 				status = solve_substep(sim, &statics, (double)(s - 1) / substeps, (double)s / substeps, &total, err);
 			if (status != PLUME_OK)
@@ -955,7 +932,7 @@ plume_status plume_sim_step(plume_sim *sim, plume_solve_report *report, plume_er
 			// Free vertices start from the prediction, handle vertices at their targets.
 			memcpy(sim->x, sim->predicted, bytes);
 			plume_sim_place_handles(sim, (double)s / substeps);
-			status = check_held_barbs(sim, &last);
+			status = plume_sim_check_held_barbs(sim, &last);
 			if (status == PLUME_OK)
 				status = solve_substep(sim, &problem, (double)(s - 1) / substeps, (double)s / substeps, &total, &last);
 			if (status != PLUME_OK)

@@ -86,6 +86,14 @@ struct plume_sim {
 	int *constraint_vertices;
 	double *constraint_length;
 	double *lambda;
+	/// Each vertex's constraints in compressed rows (barb_incident[barb_offsets[v] ..
+	/// barb_offsets[v + 1]]), and the walks' scratch: what the handles may ask of held barbs
+	/// (held.c).
+	int *barb_offsets;
+	int *barb_incident;
+	int *held_mark;
+	int held_stamp;
+	struct sim_chain_step *held_stack;
 	/// Every barb-aligned edge, constrained or not, for the strain report.
 	int barb_edge_count;
 	int *barb_edges;
@@ -187,6 +195,21 @@ void plume_sim_add_constraint_forces(const plume_sim *sim, const plume_vec3 *x, 
 /// Whether barb constraint k has both ends held (every unknown of both vertices fixed):
 /// Newton leaves it out, and only the handles set its length (plume_sim_step checks it).
 bool plume_sim_constraint_held(const plume_sim *sim, int k);
+
+/// A step of held.c's walk along barb chains: a vertex, the edges and length from the start.
+typedef struct sim_chain_step {
+	int vertex;
+	int edges;
+	double length;
+} sim_chain_step;
+
+/// held.c: the vertices' constraints, built once (false: out of memory), and freed.
+bool plume_sim_held_init(plume_sim *sim);
+void plume_sim_held_free(plume_sim *sim);
+/// PLUME_ERROR_SPEC when the handles' positions change the length of a barb edge they hold
+/// at both ends, or pull two held vertices farther apart than the chain of barb edges between
+/// them is long (held.c).
+plume_status plume_sim_check_held_barbs(plume_sim *sim, plume_error *err);
 
 /// Largest |l - L| / L over all barb-aligned edges at positions x.
 double plume_sim_max_barb_strain(const plume_sim *sim, const plume_vec3 *x);

@@ -113,6 +113,11 @@ assert p['barb_constraint'] is False and p['macroscale_elements'] == 'quadratic'
 expect_failure "calibrate out of reach" 1 "no E_vw gives the mesoscale tilted slope" "$plume" lab calibrate --phi 0.14 --Eb 3.92e4 --EB 2.57e9 --elements 600 --macro-elements 300 --unconstrained --phases 1 --aspect 0.769 --no-uncertainty --tilted-strain 0.4 --compression 5.04e7 --linear-macro
 check "calibrate out of reach: both ends of the range" grep -q 'is [0-9.e+]* Pa at E_vw = 48 Pa and [0-9.e+]* Pa at E_vw = 4.8e+07 Pa, the reachable range, so the target is below it' "$scratch/err.txt"
 check "calibrate out of reach: nothing on stdout" test ! -s "$scratch/out.txt"
+# With the barb constraint the same swapped sample cannot be pulled at all: its barbs run
+# from clamp to clamp, and the first traction test says so (sim/held.c) instead of ending
+# in a Newton blow-up (a residual of 3e113 N).
+expect_failure "calibrate, barbs clamp to clamp" 3 "barb edges between them is" "$plume" lab calibrate --phi 0.14 --Eb 3.92e4 --EB 2.57e9 --elements 600 --macro-elements 300 --phases 1 --aspect 0.769 --no-uncertainty --tilted-strain 0.4 --compression 5.04e7 --linear-macro
+check "calibrate, barbs clamp to clamp: nothing on stdout" test ! -s "$scratch/out.txt"
 
 # --- study ---------------------------------------------------------------------
 expect_failure "unknown study" 2 "unknown study 'buckling'" "$plume" lab study buckling -o "$scratch/s"
