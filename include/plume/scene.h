@@ -180,6 +180,34 @@ typedef plume_status plume_scene_step_fn(void *user, int step, double time, cons
 plume_status plume_scene_run(const plume_scene *scene, plume_scene_step_fn *on_step, void *user,
                              plume_scene_summary *summary, plume_error *err);
 
+/// A scene being run step by step, exactly as plume_scene_run runs it: the scene's handles
+/// posed from their keyframes, the feathers carried by the body's follicles, the body's
+/// pose and contact with it, the intersection check of the output frames and the summary.
+/// The scene must outlive its runner. (plume_scene_run is this runner in a loop; the
+/// Python package's Simulation steps one.)
+typedef struct plume_scene_runner plume_scene_runner;
+
+/// Creates the simulation with the scene's handles (ids 0 .. handle_count - 1, in the
+/// scene's order; the follicles' after them), loads and contact surfaces, at t = 0.
+plume_status plume_scene_runner_create(const plume_scene *scene, plume_scene_runner **out, plume_error *err);
+void plume_scene_runner_destroy(plume_scene_runner *runner);
+/// The running simulation: positions, reactions, more handles or loads. A scene handle
+/// moved with plume_sim_set_handle goes back to its keyframes at the next step.
+plume_sim *plume_scene_runner_sim(plume_scene_runner *runner);
+/// Steps taken so far, and the scene's: ceil(duration / time_step). Stepping past the
+/// scene's duration is allowed (handles stay at their last keys, the body keeps moving).
+int plume_scene_runner_steps_done(const plume_scene_runner *runner);
+int plume_scene_runner_step_count(const plume_scene_runner *runner);
+/// The body's vertex positions at the last step's time (plume_body_vertex_count of them),
+/// or NULL for a scene without a body.
+const plume_vec3 *plume_scene_runner_body_positions(const plume_scene_runner *runner);
+/// One step: handles and body posed at the step's end time, then an implicit step (a
+/// static solve for a quasi-static scene). report may be NULL. A step that fails (even
+/// with substeps) leaves the state as it was, and may be tried again.
+plume_status plume_scene_runner_step(plume_scene_runner *runner, plume_solve_report *report, plume_error *err);
+/// What the run measured so far (rachis tip deflection now, wall time since creation).
+void plume_scene_runner_summary(const plume_scene_runner *runner, plume_scene_summary *out);
+
 PLUME_API_END
 #ifdef __cplusplus
 }

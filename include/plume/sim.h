@@ -200,10 +200,15 @@ void plume_sim_destroy(plume_sim *sim);
 /// Returns the handle index, or -1 with err set (unknown group).
 int plume_sim_add_handle(plume_sim *sim, const char *group, plume_error *err);
 /// Moves a handle rigidly: each vertex goes to rotation * (rest - pivot) + pivot + translation.
+/// handle is an index plume_sim_add_handle returned (below plume_sim_handle_count); every
+/// number finite.
 void plume_sim_set_handle(plume_sim *sim, int handle, plume_vec3 translation, plume_mat3 rotation, plume_vec3 pivot);
+/// The handles added so far: their indices are 0 .. count - 1.
+int plume_sim_handle_count(const plume_sim *sim);
 
 /// Applies a constant external force, N, shared equally by the group's vertices (a weight
-/// hung on them); replaces any load set on that group before. Unknown group: PLUME_ERROR_SPEC.
+/// hung on them); replaces any load set on that group before. Unknown group, or a force that
+/// is not finite: PLUME_ERROR_SPEC.
 plume_status plume_sim_set_group_load(plume_sim *sim, const char *group, plume_vec3 force, plume_error *err);
 
 /// What one solve did.

@@ -94,6 +94,75 @@ def test_dict_scene_handles_loads_and_static(source):
         assert sim.reaction("rachis_clamp")[2] > 0
 
 
+def wing(source, steps=3):
+    """Two feathers carried at their follicles by examples/scenes/wing-draft.json's flapping arm,
+    with contact: the body's bones move the feathers' clamps, and the body is an obstacle."""
+    spec = json.loads((source / "examples" / "scenes" / "wing-draft.json").read_text())
+    spec.pop("description")
+    spec["feathers"] = spec["feathers"][:2]
+    for feather in spec["feathers"]:
+        feather["feather"] = str(source / "examples" / "franco-walter" / "blue.json")
+    spec.update(duration=steps * spec["time_step"], frame_every=1, contact={})
+    return spec
+
+
+def test_scene_with_a_body_matches_plume_simulate(source, cli, tmp_path):
+    # The Simulation steps the library's scene runner, as `plume simulate` does: it carries the
+    # follicles' clamps with the bones and poses the body (before, it held no clamp and let the
+    # feathers fall free: 12 mm off the CLI's after 4 steps of the full wing-draft scene).
+    scene = tmp_path / "wing.json"
+    scene.write_text(json.dumps(wing(source)))
+    cli("simulate", scene, "-o", tmp_path / "out")
+    rows = (tmp_path / "out" / "stats.csv").read_text().splitlines()[1:]
+    with plume.Simulation(scene) as sim:
+        assert sim.handles == [] and sim.steps_total == 3
+        assert sim.body_positions is not None
+        body0 = read_obj_vertices(tmp_path / "out" / "frames" / "body-0000.obj")
+        assert np.abs(body0 - sim.body_positions).max() < 1e-9
+        reports = sim.run()
+        assert [r["newton_iterations"] for r in reports] == [int(row.split(",")[1]) for row in rows]
+        last = read_obj_vertices(tmp_path / "out" / "frames" / "0003.obj")
+        assert np.abs(last - sim.positions).max() < 1e-9
+        body = read_obj_vertices(tmp_path / "out" / "frames" / "body-0003.obj")
+        assert np.abs(body - sim.body_positions).max() < 1e-9
+        assert np.abs(body - body0).max() > 1e-4  # the arm did move
+        summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+        mine = sim.summary()
+        for key in ("steps", "newton_iterations", "retried_steps", "feather_count", "vertex_count",
+                    "contact_pairs_max", "min_distance", "intersecting_pairs", "frames_checked",
+                    "first_intersecting_step"):
+            assert mine[key] == summary[key], key
+        assert mine["max_barb_strain"] == pytest.approx(summary["max_barb_strain"], rel=1e-9)
+        assert mine["rachis_tip_deflection"] == pytest.approx(summary["rachis_tip_deflection"], rel=1e-9)
+
+
+def test_bad_handles_and_loads_raise(source):
+    with plume.Simulation(swing(source)) as sim:
+        for bad in (1, -1, 1.0, True, "0"):
+            with pytest.raises(ValueError, match="handle is"):
+                sim.set_handle(bad, (0, 0, 0))
+        with pytest.raises(ValueError, match="translation must be 3 finite numbers"):
+            sim.set_handle(0, (math.nan, 0, 0))
+        with pytest.raises(ValueError, match="translation must be 3 finite numbers"):
+            sim.set_handle(0, (0, 0))
+        with pytest.raises(ValueError, match="pivot must be 3 finite numbers"):
+            sim.set_handle(0, pivot=(0, 0, math.inf))
+        with pytest.raises(ValueError, match="rotation must be a finite 3 x 3 matrix"):
+            sim.set_handle(0, rotation=np.eye(4))
+        with pytest.raises(ValueError, match="rotation must be a finite 3 x 3 matrix"):
+            sim.set_handle(0, rotation=np.full((3, 3), np.inf))
+        with pytest.raises(ValueError, match="force must be 3 finite numbers"):
+            sim.set_load("rachis_tip", (math.nan, 0, 0))
+        assert sim.loads == {}
+        extra = sim.add_handle("rachis_tip")
+        assert extra == 1
+        sim.set_handle(extra, (0, 0, 1e-3))  # the new handle is valid
+        sim.step()
+    for name in ("time_step", "duration", "steps_total", "step_count", "handles", "positions", "body_positions"):
+        with pytest.raises(ValueError, match="the simulation was closed"):
+            getattr(sim, name)
+
+
 def test_positions_stay_valid_after_close(source):
     sim = plume.Simulation(swing(source))
     sim.step()

@@ -151,35 +151,50 @@ static plume_status check_frame(plume_scene_surfaces *surfaces, const plume_sim 
 	return PLUME_OK;
 }
 
-plume_status plume_scene_run(const plume_scene *scene, plume_scene_step_fn *on_step, void *user,
-                             plume_scene_summary *summary, plume_error *err)
+/// A scene being run: its simulation, the handles' ids, the body's pose and the contact
+/// surfaces, and the summary so far. plume_scene_run and the Python package both step a
+/// scene through it, so a script sees exactly the run `plume simulate` makes.
+struct plume_scene_runner {
+	const plume_scene *scene;
+	plume_sim *sim;
+	/// The scene's handles, then one per feather carried by a follicle (-1 for the others).
+	int *ids;
+	/// The body's pose at the last step's time (contact takes it as an obstacle there), or NULL.
+	plume_vec3 *body_positions;
+	plume_scene_surfaces *surfaces;
+	plume_scene_summary summary;
+	int step_count; ///< the scene's steps: ceil(duration / time_step)
+	double start;   ///< omp_get_wtime() at creation
+};
+
+void plume_scene_runner_destroy(plume_scene_runner *runner)
 {
-	memset(summary, 0, sizeof *summary);
-	double start = omp_get_wtime();
-	plume_sim *sim = NULL;
-	plume_status status = plume_sim_create(scene->mesh, &scene->sim, &sim, err);
-	if (status != PLUME_OK)
-		return status;
-	int *ids = plume_alloc(sizeof(int) * (size_t)(scene->handle_count + scene->feather_count + 1));
-	// The body's pose at each step's time (contact takes it as an obstacle there).
-	plume_vec3 *body_positions =
-	    scene->body != NULL ? plume_alloc(sizeof(plume_vec3) * (size_t)plume_body_vertex_count(scene->body)) : NULL;
-	if (ids == NULL || (scene->body != NULL && body_positions == NULL)) {
-		plume_free(ids);
-		plume_free(body_positions);
-		plume_sim_destroy(sim);
-		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory starting the scene");
-	}
+	if (runner == NULL)
+		return;
+	plume_scene_surfaces_destroy(runner->surfaces);
+	plume_free(runner->body_positions);
+	plume_free(runner->ids);
+	plume_sim_destroy(runner->sim);
+	plume_free(runner);
+}
+
+/// The handles, the loads, the summary's sizes, the contact surfaces and the check of the
+/// initial frame.
+static plume_status runner_begin(plume_scene_runner *runner, plume_error *err)
+{
+	const plume_scene *scene = runner->scene;
+	plume_sim *sim = runner->sim;
+	plume_scene_summary *summary = &runner->summary;
+	plume_status status = PLUME_OK;
 	for (int h = 0; h < scene->handle_count && status == PLUME_OK; ++h) {
-		ids[h] = plume_sim_add_handle(sim, scene->handles[h].group, err);
-		if (ids[h] < 0)
+		runner->ids[h] = plume_sim_add_handle(sim, scene->handles[h].group, err);
+		if (runner->ids[h] < 0)
 			status = err != NULL ? err->status : PLUME_ERROR_SPEC;
 	}
 	if (status == PLUME_OK)
-		status = add_follicle_handles(scene, sim, ids, err);
+		status = add_follicle_handles(scene, sim, runner->ids, err);
 	for (int l = 0; l < scene->force_count && status == PLUME_OK; ++l)
 		status = plume_sim_set_group_load(sim, scene->forces[l].group, scene->forces[l].force, err);
-
 	summary->vertex_count = scene->mesh->vertex_count;
 	summary->feather_count = scene->feather_count;
 	summary->face_count = scene->mesh->face_count;
@@ -187,70 +202,149 @@ plume_status plume_scene_run(const plume_scene *scene, plume_scene_step_fn *on_s
 	summary->first_intersecting_step = -1;
 	summary->min_distance = INFINITY;
 	summary->contact_measured = scene->sim.contact.enabled;
-	plume_scene_surfaces *surfaces = NULL;
-	if (body_positions != NULL)
-		plume_scene_body_pose(scene, 0, body_positions);
+	if (runner->body_positions != NULL)
+		plume_scene_body_pose(scene, 0, runner->body_positions);
 	if (status == PLUME_OK && (checks_intersections(scene) || scene->sim.contact.enabled))
-		status = plume_scene_surfaces_create(scene, sim, body_positions, &surfaces, err);
+		status = plume_scene_surfaces_create(scene, sim, runner->body_positions, &runner->surfaces, err);
 	if (status == PLUME_OK && checks_intersections(scene))
-		status = check_frame(surfaces, sim, body_positions, 0, summary, err);
-	if (status == PLUME_OK && on_step != NULL)
-		status = on_step(user, 0, 0, sim, NULL, omp_get_wtime() - start, err);
+		status = check_frame(runner->surfaces, sim, runner->body_positions, 0, summary, err);
+	if (status != PLUME_OK)
+		return status;
+	double step_count = ceil(scene->duration / scene->sim.time_step - 1e-9);
+	if (!(step_count >= 0.0 && step_count <= PLUME_SCENE_MAX_STEPS))
+		return plume_error_set(err, PLUME_ERROR_SPEC,
+		                       "scene: duration %g s in steps of %g s is %.3g steps; "
+		                       "allowed at most %d",
+		                       scene->duration, scene->sim.time_step, step_count, PLUME_SCENE_MAX_STEPS);
+	runner->step_count = (int)step_count;
+	return PLUME_OK;
+}
 
-	double dt = scene->sim.time_step;
-	double step_count = ceil(scene->duration / dt - 1e-9);
-	int steps = 0;
-	if (!(step_count >= 0.0 && step_count <= PLUME_SCENE_MAX_STEPS)) {
-		if (status == PLUME_OK)
-			status = plume_error_set(err, PLUME_ERROR_SPEC,
-			                         "scene: duration %g s in steps of %g s is %.3g steps; "
-			                         "allowed at most %d",
-			                         scene->duration, dt, step_count, PLUME_SCENE_MAX_STEPS);
-	} else {
-		steps = (int)step_count;
+plume_status plume_scene_runner_create(const plume_scene *scene, plume_scene_runner **out, plume_error *err)
+{
+	PLUME_ASSERT(scene != NULL && out != NULL);
+	*out = NULL;
+	plume_scene_runner *runner = plume_calloc(1, sizeof *runner);
+	if (runner == NULL)
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory starting the scene");
+	runner->scene = scene;
+	runner->start = omp_get_wtime();
+	plume_status status = plume_sim_create(scene->mesh, &scene->sim, &runner->sim, err);
+	if (status != PLUME_OK) {
+		plume_scene_runner_destroy(runner);
+		return status;
 	}
-	for (int n = 1; n <= steps && status == PLUME_OK; ++n) {
-		double t = n * dt;
-		pose_handles(scene, sim, ids, t);
-		// The body where it is at the end of the step: with contact, the obstacle's positions
-		// for this step (plume_sim_set_obstacle_positions; plume_sim_add_obstacle takes the
-		// pose at t = 0 when the simulation is created).
-		if (body_positions != NULL) {
-			plume_scene_body_pose(scene, t, body_positions);
-			plume_scene_surfaces_move_body(surfaces, sim, body_positions);
-		}
+	runner->ids = plume_alloc(sizeof(int) * (size_t)(scene->handle_count + scene->feather_count + 1));
+	if (scene->body != NULL)
+		runner->body_positions = plume_alloc(sizeof(plume_vec3) * (size_t)plume_body_vertex_count(scene->body));
+	if (runner->ids == NULL || (scene->body != NULL && runner->body_positions == NULL))
+		status = plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory starting the scene");
+	if (status == PLUME_OK)
+		status = runner_begin(runner, err);
+	if (status != PLUME_OK) {
+		plume_scene_runner_destroy(runner);
+		return status;
+	}
+	*out = runner;
+	return PLUME_OK;
+}
+
+plume_sim *plume_scene_runner_sim(plume_scene_runner *runner)
+{
+	PLUME_ASSERT(runner != NULL);
+	return runner->sim;
+}
+
+int plume_scene_runner_steps_done(const plume_scene_runner *runner)
+{
+	PLUME_ASSERT(runner != NULL);
+	return runner->summary.steps;
+}
+
+int plume_scene_runner_step_count(const plume_scene_runner *runner)
+{
+	PLUME_ASSERT(runner != NULL);
+	return runner->step_count;
+}
+
+const plume_vec3 *plume_scene_runner_body_positions(const plume_scene_runner *runner)
+{
+	PLUME_ASSERT(runner != NULL);
+	return runner->body_positions;
+}
+
+plume_status plume_scene_runner_step(plume_scene_runner *runner, plume_solve_report *report, plume_error *err)
+{
+	PLUME_ASSERT(runner != NULL);
+	const plume_scene *scene = runner->scene;
+	plume_sim *sim = runner->sim;
+	plume_scene_summary *summary = &runner->summary;
+	int n = summary->steps + 1;
+	double t = n * scene->sim.time_step;
+	pose_handles(scene, sim, runner->ids, t);
+	// The body where it is at the end of the step: with contact, the obstacle's positions
+	// for this step (plume_sim_set_obstacle_positions; plume_sim_add_obstacle takes the
+	// pose at t = 0 when the simulation is created).
+	if (runner->body_positions != NULL) {
+		plume_scene_body_pose(scene, t, runner->body_positions);
+		plume_scene_surfaces_move_body(runner->surfaces, sim, runner->body_positions);
+	}
+	plume_solve_report local;
+	if (report == NULL)
+		report = &local;
+	plume_status status =
+	    scene->quasi_static ? plume_sim_solve_static(sim, report, err) : plume_sim_step(sim, report, err);
+	if (status != PLUME_OK) {
+		plume_error_prefix(err, scene->quasi_static ? "quasi-static solve" : "simulation");
+		return status;
+	}
+	summary->steps = n;
+	summary->newton_iterations += report->newton_iterations;
+	summary->seconds_assembly += report->seconds_assembly;
+	summary->seconds_factor += report->seconds_factor;
+	summary->seconds_solve += report->seconds_solve;
+	summary->seconds_contact += report->seconds_contact;
+	summary->max_barb_strain = fmax(summary->max_barb_strain, report->max_barb_strain);
+	summary->retried_steps += report->substeps > 1;
+	if (scene->sim.contact.enabled) {
+		summary->contact_pairs_max =
+		    report->contact_pairs > summary->contact_pairs_max ? report->contact_pairs : summary->contact_pairs_max;
+		summary->min_distance = fmin(summary->min_distance, report->min_distance);
+	}
+	if (checks_intersections(scene) && (n % scene->frame_every == 0 || n == runner->step_count))
+		status = check_frame(runner->surfaces, sim, runner->body_positions, n, summary, err);
+	return status;
+}
+
+void plume_scene_runner_summary(const plume_scene_runner *runner, plume_scene_summary *out)
+{
+	PLUME_ASSERT(runner != NULL && out != NULL);
+	*out = runner->summary;
+	out->rachis_tip_deflection = rachis_tip_deflection(runner->scene, runner->sim);
+	out->wall_seconds = omp_get_wtime() - runner->start;
+}
+
+plume_status plume_scene_run(const plume_scene *scene, plume_scene_step_fn *on_step, void *user,
+                             plume_scene_summary *summary, plume_error *err)
+{
+	memset(summary, 0, sizeof *summary);
+	double start = omp_get_wtime();
+	plume_scene_runner *runner = NULL;
+	plume_status status = plume_scene_runner_create(scene, &runner, err);
+	if (status != PLUME_OK)
+		return status;
+	plume_sim *sim = runner->sim;
+	if (on_step != NULL)
+		status = on_step(user, 0, 0, sim, NULL, omp_get_wtime() - start, err);
+	for (int n = 1; n <= runner->step_count && status == PLUME_OK; ++n) {
 		plume_solve_report report;
 		double step_start = omp_get_wtime();
-		status = scene->quasi_static ? plume_sim_solve_static(sim, &report, err) : plume_sim_step(sim, &report, err);
-		if (status != PLUME_OK) {
-			plume_error_prefix(err, scene->quasi_static ? "quasi-static solve" : "simulation");
-			break;
-		}
-		summary->steps = n;
-		summary->newton_iterations += report.newton_iterations;
-		summary->seconds_assembly += report.seconds_assembly;
-		summary->seconds_factor += report.seconds_factor;
-		summary->seconds_solve += report.seconds_solve;
-		summary->seconds_contact += report.seconds_contact;
-		summary->max_barb_strain = fmax(summary->max_barb_strain, report.max_barb_strain);
-		summary->retried_steps += report.substeps > 1;
-		if (scene->sim.contact.enabled) {
-			summary->contact_pairs_max =
-			    report.contact_pairs > summary->contact_pairs_max ? report.contact_pairs : summary->contact_pairs_max;
-			summary->min_distance = fmin(summary->min_distance, report.min_distance);
-		}
-		if (checks_intersections(scene) && (n % scene->frame_every == 0 || n == steps))
-			status = check_frame(surfaces, sim, body_positions, n, summary, err);
-		if (status != PLUME_OK)
-			break;
-		if (on_step != NULL)
-			status = on_step(user, n, t, sim, &report, omp_get_wtime() - step_start, err);
+		status = plume_scene_runner_step(runner, &report, err);
+		if (status == PLUME_OK && on_step != NULL)
+			status = on_step(user, n, n * scene->sim.time_step, sim, &report, omp_get_wtime() - step_start, err);
 	}
-	summary->rachis_tip_deflection = rachis_tip_deflection(scene, sim);
+	plume_scene_runner_summary(runner, summary);
 	summary->wall_seconds = omp_get_wtime() - start;
-	plume_free(ids);
-	plume_scene_surfaces_destroy(surfaces);
-	plume_free(body_positions);
-	plume_sim_destroy(sim);
+	plume_scene_runner_destroy(runner);
 	return status;
 }

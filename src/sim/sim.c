@@ -762,6 +762,9 @@ plume_status plume_sim_set_group_load(plume_sim *sim, const char *group_name, pl
 	const plume_vertex_group *group = plume_sim_find_group(sim, group_name);
 	if (group == NULL || group->count == 0)
 		return plume_error_set(err, PLUME_ERROR_SPEC, "no vertices in group \"%s\" to load", group_name);
+	if (!(isfinite(force.x) && isfinite(force.y) && isfinite(force.z)))
+		return plume_error_set(err, PLUME_ERROR_SPEC, "the load on group \"%s\" is (%g, %g, %g) N; allowed finite",
+		                       group_name, force.x, force.y, force.z);
 	plume_vec3 share = plume_v3_scale(force, 1.0 / group->count);
 	for (int i = 0; i < group->count; ++i)
 		sim->load[group->vertices[i]] = share;
@@ -970,6 +973,12 @@ int plume_sim_vertex_count(const plume_sim *sim)
 {
 	PLUME_ASSERT_HANDLE(sim);
 	return sim->vertex_count;
+}
+
+int plume_sim_handle_count(const plume_sim *sim)
+{
+	PLUME_ASSERT_HANDLE(sim);
+	return sim->handle_count;
 }
 
 int plume_sim_constraint_count(const plume_sim *sim)
