@@ -10,7 +10,7 @@ import re
 import shutil
 import subprocess
 import tempfile
-from typing import Any, Callable, Optional, TypeVar
+from typing import Any, Callable, Iterable, Optional, TypeVar
 
 import cffi
 import numpy as np
@@ -101,8 +101,13 @@ class Error(Exception):
         self.status = status
         self.file = file
 
+    def hint_relative(self) -> None:
+        """Adds to the message of a file not found from a dict spec where its relative name was looked for."""
+        self.message += " (a dict spec's relative file references resolve against the working directory)"
+        self.args = (self.message,)
+
     @classmethod
-    def from_c(cls, err: Any, rename: Optional[dict[str, str]] = None) -> "Error":
+    def from_c(cls, err: Any, rename: Optional[dict[str, str]] = None, files: Iterable[str] = ()) -> "Error":
         message = ffi.string(err.message).decode("utf-8", "replace")
         for old, new in (rename or {}).items():
             message = message.replace(old, new)
@@ -110,32 +115,101 @@ class Error(Exception):
         code = ffi.string(lib.plume_status_name(status)).decode()
         match = re.search(r"(\$[\w.\[\]\"-]*)", message)
         path = match.group(1).rstrip(":.") if match else None
-        file_match = re.match(r"([^:\s]+?)(?::\d+:\d+)?: ", message)
-        file = file_match.group(1) if file_match else None
-        return cls(message, path, code, status, file)
+        return cls(message, path, code, status, _file_of(message, files))
+
+
+# A message that names a file starts with it: "PATH: ...", "PATH:LINE: ..." (OBJ) or
+# "PATH:LINE:COL: ..." (JSON syntax). Others start with a context instead ("raytrace: ...",
+# "calibration: ...", "simulation: ..."), so the first part counts as a file only when it is one
+# the caller passed, "<dict>", or looks like a path: a folder in it or a suffix (".json").
+_PREFIX = re.compile(r"((?:(?!: ).)+?)(?::\d+){0,2}: ")
+_FILE_LIKE = re.compile(r"[/\\]|\.[A-Za-z][A-Za-z0-9]*$")
+
+
+def _file_of(message: str, files: Iterable[str] = ()) -> Optional[str]:
+    match = _PREFIX.match(message)
+    if match is None:
+        return None
+    name = match.group(1)
+    if name in files or name == "<dict>" or (not name.startswith("$") and _FILE_LIKE.search(name)):
+        return name
+    return None
 
 
 def new_error() -> Any:
     return ffi.new("plume_error *")
 
 
-def check(status: int, err: Any, rename: Optional[dict[str, str]] = None) -> None:
-    """Raises plume.Error when status is not PLUME_OK."""
+# The library's messages name the CLI's options; calls that take the matching keyword name that.
+PYTHON_TERMS = {
+    "raise it with --max-memory": "raise it with the max_memory keyword",
+    "drop --unfurl": 'use stage_kind="growth"',
+}
+
+
+def check(status: int, err: Any, rename: Optional[dict[str, str]] = None, files: Iterable[str] = ()) -> None:
+    """Raises plume.Error when status is not PLUME_OK. rename: replacements in the message;
+    files: paths the caller passed, which count as the message's file when it starts with one."""
     if status != lib.PLUME_OK:
-        raise Error.from_c(err, rename)
+        raise Error.from_c(err, rename, files)
 
 
-def check_spec(spec: Any, name: str, call: Callable[[bytes], int], err: Any) -> None:
+def fspath(value: Any, name: str, expected: str = "a path (str, bytes or os.PathLike)") -> str:
+    """A path argument (str, bytes or os.PathLike) as str; TypeError naming the argument otherwise."""
+    try:
+        return os.fsdecode(value)
+    except TypeError:
+        raise TypeError(f"{name} is {type(value).__name__}; expected {expected}") from None
+
+
+def memory_limit(max_memory: Any) -> int:
+    """A max_memory keyword's bytes. The C structs' 0 means the library's default (4 GiB), not
+    "nothing allowed", so it is refused here with anything else that is not a count of bytes."""
+    if isinstance(max_memory, bool) or not isinstance(max_memory, (int, np.integer)) or not 0 < max_memory < 2**64:
+        raise ValueError(f"max_memory is {max_memory!r}; allowed a whole number of bytes in [1, 2**64)")
+    return int(max_memory)
+
+
+def check_spec(spec: Any, name: str, call: Callable[[bytes], int], err: Any,
+               references: Optional[Callable[[dict], set[str]]] = None,
+               rename: Optional[dict[str, str]] = None) -> None:
     """Calls call(path) on a spec file, or on a dict written as JSON to a temporary file
-    (whose messages then name it "<dict>"), and raises plume.Error when it fails."""
+    (whose messages then name it "<dict>"), and raises plume.Error when it fails.
+
+    The C readers resolve a spec's file references against the spec's folder, which for a dict
+    would be the temporary folder: references(spec) makes a copy's relative references absolute
+    against the working directory first (as open() and plume.generate's dicts resolve them) and
+    returns the paths it made. rename: further replacements in the message (PYTHON_TERMS)."""
     if isinstance(spec, dict):
+        made: set[str] = set()
+        if references is not None:
+            spec = json.loads(json.dumps(spec))  # a copy to rewrite, never the caller's dict
+            made = references(spec)
         with tempfile.TemporaryDirectory(prefix="plume-") as folder:
             path = os.path.join(folder, name)
             with open(path, "w") as f:
                 json.dump(spec, f)
-            check(call(path.encode()), err, rename={path: "<dict>"})
+            # A reference not rewritten resolves in the temporary folder: name it as it was written.
+            names = {path: "<dict>", folder + os.sep: "", **(rename or {})}
+            try:
+                check(call(os.fsencode(path)), err, rename=names)
+            except Error as e:
+                # The file not found is one of the rewritten references (the message may name the
+                # spec first: "<dict>: $.surface.obj: /cwd/cap.obj: cannot open: ...").
+                if e.code == "io" and any(f"{p}: cannot" in e.message for p in made):
+                    e.hint_relative()
+                raise
     else:
-        check(call(os.fspath(spec).encode()), err)
+        path = fspath(spec, "spec", "a dict or a path (str, bytes or os.PathLike)")
+        check(call(os.fsencode(path)), err, rename=rename, files=(path,))
+
+
+def absolute(path: Any, made: set[str]) -> Any:
+    """path made absolute against the working directory when it is a relative str (recorded in made)."""
+    if isinstance(path, str) and path and not os.path.isabs(path):
+        path = os.path.abspath(path)
+        made.add(path)
+    return path
 
 
 def view(owner: Any, pointer: Any, count: int, dtype: Any, shape: tuple[int, ...]) -> np.ndarray:

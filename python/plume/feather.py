@@ -8,7 +8,7 @@ from typing import Any, Iterable, Optional, Union
 
 import numpy as np
 
-from ._lib import Error, Handle, check, ffi, lib, new_error, text, view
+from ._lib import PYTHON_TERMS, Error, Handle, check, ffi, fspath, lib, memory_limit, new_error, text, view
 
 PathLike = Union[str, "os.PathLike[str]"]
 Spec = Union[dict, PathLike]
@@ -22,16 +22,19 @@ SHAFT_DTYPE = np.dtype(
 )
 
 
-def _options(seed: Optional[int], stage: Optional[float], stage_kind: str) -> Any:
+def _options(seed: Optional[int], stage: Optional[float], stage_kind: str, max_memory: Optional[int] = None) -> Any:
+    # stage_kind is checked even without a stage: a misspelt kind must not pass unnoticed.
+    if stage_kind not in ("growth", "unfurl"):
+        raise ValueError(f"stage_kind is {stage_kind!r}, allowed 'growth' or 'unfurl'")
     options = ffi.new("plume_spec_options *")
     if seed is not None:
         options.seed = seed
         options.seed_given = True
     if stage is not None:
-        if stage_kind not in ("growth", "unfurl"):
-            raise ValueError(f"stage_kind is {stage_kind!r}, allowed 'growth' or 'unfurl'")
         options.stage_kind = _STAGES[stage_kind]
         options.stage = stage
+    if max_memory is not None:
+        options.max_memory = memory_limit(max_memory)
     return options
 
 
@@ -286,16 +289,16 @@ class Feather(Handle):
             raise MemoryError("plume_feather_clone")
         return Feather(p)
 
-    def write(self, path: PathLike, formats: Optional[Iterable[str]] = None) -> list[str]:
-        """Writes the feather. formats: any of "json", "obj", "usda"; each is written to path
-        with that suffix. Without formats, path's own suffix picks one. Returns the paths written."""
-        path = os.fspath(path)
+    def write(self, path: PathLike, formats: Optional[Union[str, Iterable[str]]] = None) -> list[str]:
+        """Writes the feather. formats: one or a list of "json", "obj", "usda"; each is written to
+        path with that suffix. Without formats, path's own suffix picks one. Returns the paths written."""
+        path = fspath(path, "path")
         root, suffix = os.path.splitext(path)
         if formats is None:
             formats = [suffix.lstrip(".").lower()]
             root_path = {formats[0]: path}
         else:
-            formats = list(formats)
+            formats = [formats] if isinstance(formats, str) else list(formats)  # "json" is one format, not four
             root_path = {f: f"{root}.{f}" for f in formats}
         writers = {"json": lib.plume_write_json, "obj": lib.plume_write_obj, "usda": lib.plume_write_usda}
         written = []
@@ -303,7 +306,7 @@ class Feather(Handle):
             if f not in writers:
                 raise ValueError(f"format {f!r}; allowed: json, obj, usda")
             err = new_error()
-            check(writers[f](self.pointer, root_path[f].encode(), err), err)
+            check(writers[f](self.pointer, os.fsencode(root_path[f]), err), err, files=(root_path[f],))
             written.append(root_path[f])
         return written
 
@@ -311,9 +314,10 @@ class Feather(Handle):
     def read_json(cls, path: PathLike) -> "Feather":
         """Reads a feather JSON dump (plume generate's feather.json, or plume simulate's with its numbers in
         feather.bin): the same feather bit for bit."""
+        path = fspath(path, "path")
         out = ffi.new("plume_feather **")
         err = new_error()
-        check(lib.plume_read_json(os.fspath(path).encode(), out, err), err)
+        check(lib.plume_read_json(os.fsencode(path), out, err), err, files=(path,))
         return cls(out[0])
 
     def __repr__(self) -> str:
@@ -321,24 +325,36 @@ class Feather(Handle):
 
 
 def generate(spec: Spec, *, seed: Optional[int] = None, stage: Optional[float] = None,
-             stage_kind: str = "growth") -> Feather:
+             stage_kind: str = "growth", max_memory: Optional[int] = None) -> Feather:
     """Generates a feather from a spec: a dict (the JSON object of docs/specs) or a path to a
     JSON spec file, for every model (franco-walter, streit-heidrich, zhang-kanai).
 
     seed overrides the spec's seed; stage in [0, 1] builds a growth ("growth") or unfurling
-    ("unfurl", Zhang–Kanai) stage. A bad spec raises plume.Error naming the key's JSON path;
-    a dict is named "<dict>" in messages.
+    ("unfurl", Zhang–Kanai) stage. max_memory: bytes the feather may take (default 4 GiB), past
+    which it fails with code "limit" before the work. A bad spec raises plume.Error naming the
+    key's JSON path; a dict is named "<dict>" in messages, and its relative file references
+    resolve against the working directory.
     """
-    options = _options(seed, stage, stage_kind)
+    options = _options(seed, stage, stage_kind, max_memory)
     out = ffi.new("plume_feather **")
     err = new_error()
+    files: tuple[str, ...] = ()
     if isinstance(spec, dict):
         if spec.get("model") == "coat":
-            raise Error('<dict>: $.model: "coat" is a coat spec, not a feather: use plume.coat()', "$.model")
+            raise Error('<dict>: $.model: "coat" is a coat spec, not a feather: use plume.coat()', "$.model",
+                        file="<dict>")
         status = lib.plume_spec_parse(json.dumps(spec).encode(), b"<dict>", options, out, err)
     else:
-        status = lib.plume_spec_generate(os.fspath(spec).encode(), options, out, err)
-    check(status, err)
+        path = fspath(spec, "spec", "a dict or a path (str, bytes or os.PathLike)")
+        files = (path,)
+        status = lib.plume_spec_generate(os.fsencode(path), options, out, err)
+    try:
+        check(status, err, rename=PYTHON_TERMS, files=files)
+    except Error as e:
+        # A dict's references (a blend's feathers, a scan image) resolve against the working directory.
+        if not files and e.code == "io" and e.file not in (None, "<dict>") and not os.path.isabs(e.file):
+            e.hint_relative()
+        raise
     return Feather(out[0])
 
 
@@ -409,6 +425,10 @@ def banded_colors(feather: Feather, width: int = 256, height: int = 256) -> np.n
     """(B points, 4) sRGBA colours of the barb points (barb_points' rows) from plume's own banded
     hawk texture (plume_texture_create_banded), by each point's (s, t) as Franco & Walter 4.4 map
     a texture onto the vanes."""
+    # The C function answers NULL both for sizes below 2 and for memory: tell them apart here.
+    for name, value in (("width", width), ("height", height)):
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not 2 <= value <= 16384:
+            raise ValueError(f"{name} is {value!r}; allowed a whole number of pixels in [2, 16384]")
     texture = ffi.gc(lib.plume_texture_create_banded(width, height), lib.plume_texture_destroy)
     if texture == ffi.NULL:
         raise MemoryError("plume_texture_create_banded")

@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import json
+import math
 import os
 import tempfile
 from typing import Any, Optional, Union
 
 import numpy as np
 
-from ._lib import check, check_spec, ffi, lib, new_error
+from ._lib import Error, check, check_spec, ffi, fspath, lib, new_error
 
 
 def _load_spec(spec: Union[dict, str, "os.PathLike[str]"]) -> Any:
@@ -128,9 +129,9 @@ def study(kind: str, *, scale: float = 1.0, csv: Optional[str] = None, png: Opti
     err = new_error()
     # The C study writes all three files; those not asked for go to a scratch folder.
     with tempfile.TemporaryDirectory(prefix="plume-study-") as folder:
-        paths = [os.fspath(p) if p is not None else os.path.join(folder, f"{kind}.{ext}")
+        paths = [fspath(p, ext) if p is not None else os.path.join(folder, f"{kind}.{ext}")
                  for p, ext in ((csv, "csv"), (png, "png"), (svg, "svg"))]
-        check(lib.plume_lab_study(d, *(p.encode() for p in paths), summary, 4096, err), err)
+        check(lib.plume_lab_study(d, *(os.fsencode(p) for p in paths), summary, 4096, err), err, files=paths)
         table = _read_csv(paths[0])
     text = ffi.string(summary).decode()
     result = json.loads(text) if text else {}
@@ -156,11 +157,25 @@ def mesoscale_moduli(barb_fraction: float, slope_longitudinal: float, slope_tran
     return E_B[0], E_b[0]
 
 
+def _check_closed_form(barb_fraction: float, **positive: float) -> None:
+    """The ranges plume_lab_mesoscale_moduli checks (include/plume/lab.h): Phi_B in (0, 1), moduli
+    and strains > 0. The closed forms themselves check nothing and answer garbage or NaN outside
+    them (eq. 5.5 divides by (Phi_B - 1)^3), so the binding raises the same plume.Error here."""
+    if not 0.0 < barb_fraction < 1.0:
+        raise Error(f"barb fraction Phi_B is {barb_fraction:g}, allowed in (0, 1)")
+    for name, value in positive.items():
+        if not (value > 0.0 and math.isfinite(value)):
+            raise Error(f"{name} is {value:g}, allowed finite and > 0")
+
+
 def longitudinal_modulus(barb_fraction: float, E_B: float, E_b: float) -> float:
-    """Phi_B E_B + (1 - Phi_B) E_b, Pa (thesis eq. 5.2)."""
+    """Phi_B E_B + (1 - Phi_B) E_b, Pa (thesis eq. 5.2). Phi_B in (0, 1), moduli > 0 (Pa), else plume.Error."""
+    _check_closed_form(barb_fraction, E_B=E_B, E_b=E_b)
     return float(lib.plume_lab_longitudinal_modulus(barb_fraction, E_B, E_b))
 
 
 def transverse_slope_rigid(barb_fraction: float, E_b: float, strain_max: float = 0.4) -> float:
-    """Slope of the transverse test with rigid barbs over [0, strain_max], Pa (thesis eq. 5.5)."""
+    """Slope of the transverse test with rigid barbs over [0, strain_max], Pa (thesis eq. 5.5).
+    Phi_B in (0, 1), E_b (Pa) and strain_max > 0, else plume.Error."""
+    _check_closed_form(barb_fraction, E_b=E_b, strain_max=strain_max)
     return float(lib.plume_lab_transverse_slope_rigid(barb_fraction, E_b, strain_max))

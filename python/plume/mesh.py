@@ -7,7 +7,7 @@ from typing import Any, Optional, Union
 
 import numpy as np
 
-from ._lib import Handle, check, ffi, lib, new_error, text, view
+from ._lib import PYTHON_TERMS, Handle, check, ffi, fspath, lib, memory_limit, new_error, text, view
 from .feather import Feather
 
 
@@ -78,6 +78,7 @@ class Mesh(Handle):
 
     def write_obj(self, path: Union[str, "os.PathLike[str]"], positions: Optional[np.ndarray] = None) -> None:
         """Wavefront OBJ with UVs, at positions (N x 3) or the rest shape."""
+        path = fspath(path, "path")
         err = new_error()
         pos = ffi.NULL
         if positions is not None:
@@ -85,7 +86,7 @@ class Mesh(Handle):
             if positions.shape != (self.vertex_count, 3):
                 raise ValueError(f"positions has shape {positions.shape}, expected ({self.vertex_count}, 3)")
             pos = ffi.cast("const plume_vec3 *", ffi.from_buffer(positions))
-        check(lib.plume_mesh_write_obj(self.pointer, pos, os.fspath(path).encode(), err), err)
+        check(lib.plume_mesh_write_obj(self.pointer, pos, os.fsencode(path), err), err, files=(path,))
 
     def __repr__(self) -> str:
         return f"<plume.Mesh {self.vertex_count} vertices, {self.face_count} triangles>"
@@ -106,9 +107,11 @@ def _report(r: Any) -> dict:
 
 
 def mesh(feather: Feather, edge_length: Optional[float] = None, *, rachis_width_base: Optional[float] = None,
-         rachis_width_tip: Optional[float] = None, include_calamus: bool = True) -> Mesh:
+         rachis_width_tip: Optional[float] = None, include_calamus: bool = True,
+         max_memory: Optional[int] = None) -> Mesh:
     """Meshes a feather with the barb-aligned mesher (Jouve thesis 6.2): its shaft is the rachis,
-    its barbs the guides. edge_length in m (default 5e-3, thesis Table 6.1)."""
+    its barbs the guides. edge_length in m (default 5e-3, thesis Table 6.1). max_memory: bytes the
+    mesher may use (default 4 GiB), past which it fails with code "limit" before the work."""
     d = ffi.new("plume_mesh_def *", lib.plume_mesh_default_def())
     if edge_length is not None:
         d.edge_length = edge_length
@@ -117,8 +120,10 @@ def mesh(feather: Feather, edge_length: Optional[float] = None, *, rachis_width_
     if rachis_width_tip is not None:
         d.rachis_width_tip = rachis_width_tip
     d.include_calamus = include_calamus
+    if max_memory is not None:
+        d.max_memory = memory_limit(max_memory)
     out = ffi.new("plume_mesh **")
     report = ffi.new("plume_mesh_report *")
     err = new_error()
-    check(lib.plume_mesh_from_feather(feather.pointer, d, out, report, err), err)
+    check(lib.plume_mesh_from_feather(feather.pointer, d, out, report, err), err, rename=PYTHON_TERMS)
     return Mesh(out[0], _report(report[0]))

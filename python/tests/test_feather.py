@@ -3,6 +3,7 @@ read with Python's json module (not plume's reader), must hold the binding's arr
 
 import gc
 import json
+import os
 
 import numpy as np
 import pytest
@@ -197,3 +198,55 @@ def test_ribbons_and_colours(source):
     colours = plume.banded_colors(feather, 64, 64)
     assert colours.shape == (len(feather.barb_points), 4)
     assert ((colours >= 0) & (colours <= 1)).all() and len(np.unique(colours[:, 0])) > 3
+
+
+def test_argument_checks(source, tmp_path, monkeypatch):
+    spec = source / "examples" / "franco-walter" / "filoplume.json"
+    feather = plume.generate(spec)
+    # One format given as a string is that format, not its letters.
+    assert feather.write(tmp_path / "one", "json") == [str(tmp_path / "one.json")]
+    # Paths as bytes or os.PathLike, like open(); anything else is a TypeError naming the argument.
+    assert plume.generate(os.fsencode(spec)).equal(feather)
+    assert plume.Feather.read_json(os.fsencode(tmp_path / "one.json")).equal(feather)
+    assert feather.write(os.fsencode(tmp_path / "two.obj")) == [str(tmp_path / "two.obj")]
+    with pytest.raises(TypeError, match="spec is int; expected a dict or a path"):
+        plume.generate(5)
+    with pytest.raises(TypeError, match="path is NoneType; expected a path"):
+        feather.write(None)
+    # stage_kind is checked with or without a stage.
+    with pytest.raises(ValueError, match="stage_kind is 'bogus', allowed 'growth' or 'unfurl'"):
+        plume.generate(spec, stage_kind="bogus")
+    for size in (0, -1, 1, 16385, 2.5):
+        with pytest.raises(ValueError, match=r"width is .*allowed a whole number of pixels in \[2, 16384\]"):
+            plume.banded_colors(feather, width=size)
+        with pytest.raises(ValueError, match=r"height is .*allowed"):
+            plume.banded_colors(feather, height=size)
+    assert plume.banded_colors(feather, 2, 2).shape == (len(feather.barb_points), 4)
+    # A path without a suffix or folder is still the message's file when the call was given it.
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(plume.Error) as e:
+        plume.generate("hawk")
+    assert e.value.code == "io" and e.value.file == "hawk"
+
+
+def test_messages_name_the_python_keywords(source):
+    sh = source / "examples" / "streit-heidrich" / "contour.json"
+    with pytest.raises(plume.Error) as e:
+        plume.generate(sh, stage=0.5, stage_kind="unfurl")
+    assert e.value.code == "unsupported" and 'use stage_kind="growth"' in e.value.message
+    assert "--unfurl" not in e.value.message
+    with pytest.raises(plume.Error) as e:
+        plume.generate(source / "examples" / "franco-walter" / "blue.json", max_memory=1000)
+    assert e.value.code == "limit" and "raise it with the max_memory keyword" in e.value.message
+    assert "--max-memory" not in e.value.message
+    assert plume.generate(sh, max_memory=1 << 30).equal(plume.generate(sh))
+
+
+def test_dict_references_resolve_against_the_working_directory(source, monkeypatch):
+    spec = json.loads((source / "examples" / "streit-heidrich" / "continuum.json").read_text())
+    monkeypatch.chdir(source)
+    with pytest.raises(plume.Error) as e:
+        plume.generate(spec)
+    assert e.value.file == "down.json" and "resolve against the working directory" in e.value.message
+    monkeypatch.chdir(source / "examples" / "streit-heidrich")
+    assert plume.generate(spec).equal(plume.generate("continuum.json"))

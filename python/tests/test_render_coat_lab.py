@@ -1,6 +1,7 @@
 """Rendering, coats and the lab from the binding against the CLI's results."""
 
 import json
+import os
 
 import numpy as np
 import pytest
@@ -117,3 +118,143 @@ def test_study_is_the_cli_study(cli, tmp_path):
     assert (tmp_path / "binding.png").read_bytes()[:4] == b"\x89PNG"
     with pytest.raises(ValueError, match="allowed"):
         plume.study("lockin")
+
+
+def test_render_checks_shell_positions_and_vectors(source):
+    feather = plume.generate({"model": "franco-walter", "segments": [{"barb_count": 3}, {"barb_count": 3}]})
+    shell = plume.mesh(feather, edge_length=0.01)
+    n = shell.vertex_count
+    # Too few rows made the C library read past the buffer; the rest were taken or misread.
+    for bad in (np.zeros((3, 3)), np.zeros((n + 5, 3)), np.zeros(3 * n), np.zeros((n, 2)), np.zeros((n, 3), bool),
+                np.array([["a", "b", "c"]] * n)):
+        with pytest.raises(ValueError, match=rf"shell_positions has shape .*expected shape \({n}, 3\)"):
+            plume.render(width=16, height=16, spp=1, shell=shell, shell_positions=bad)
+    with pytest.raises(ValueError, match="shell_positions has non-finite"):
+        plume.render(width=16, height=16, spp=1, shell=shell, shell_positions=np.full((n, 3), np.nan))
+    with pytest.raises(ValueError, match="shell_positions is given without shell"):
+        plume.render(feather, width=16, height=16, spp=1, shell_positions=shell.vertices)
+    # Any real dtype of the right shape is converted: float32 positions draw what their float64 values do.
+    single = shell.vertices.astype(np.float32)
+    assert np.array_equal(plume.render(width=16, height=16, spp=1, shell=shell, shell_positions=single),
+                          plume.render(width=16, height=16, spp=1, shell=shell, shell_positions=single.astype(float)))
+    for bad in ((1, 0), (1, 0, 0, 0), (0, 0, float("nan")), "xyz", 3.0):
+        with pytest.raises(ValueError, match="view_direction is .*expected 3 finite numbers"):
+            plume.render(feather, width=16, height=16, spp=1, view_direction=bad)
+
+
+def test_write_png_takes_uint8_rgba_only(tmp_path):
+    image = np.zeros((4, 5, 4), np.uint8)
+    plume.write_png(image[:, ::-1], tmp_path / "ok.png")  # a strided view is fine
+    assert (tmp_path / "ok.png").read_bytes()[:4] == b"\x89PNG"
+    for bad in (np.zeros((4, 5, 4)), np.full((4, 5, 4), 300), np.zeros((4, 5, 4), np.int8)):
+        with pytest.raises(TypeError, match=f"image has dtype {bad.dtype}, expected uint8"):
+            plume.write_png(bad, tmp_path / "bad.png")
+    for shape in ((4, 5, 3), (4, 5), (0, 5, 4)):
+        with pytest.raises(ValueError, match=r"image has shape .*expected \(height, width, 4\)"):
+            plume.write_png(np.zeros(shape, np.uint8), tmp_path / "bad.png")
+    assert not (tmp_path / "bad.png").exists()
+
+
+def test_render2d_style_and_paths(source, tmp_path):
+    feather = plume.generate(source / "examples" / "franco-walter" / "filoplume.json")
+    with pytest.raises(ValueError, match="style is 'dots'; allowed 'lines', 'strips'"):
+        plume.render2d(feather, tmp_path / "x.png", style="dots")
+    plume.render2d(feather, os.fsencode(tmp_path / "strips.svg"), width=64, height=64, style="strips")
+    assert "<svg" in (tmp_path / "strips.svg").read_text()[:400]
+    plume.write_png(np.zeros((16, 16, 4), np.uint8), os.fsencode(tmp_path / "b.png"))
+    with pytest.raises(TypeError, match="path is int; expected a path"):
+        plume.render2d(feather, 3)
+
+
+def test_errors_without_a_file_name_none(source):
+    feather = plume.generate(source / "examples" / "franco-walter" / "filoplume.json")
+    with pytest.raises(plume.Error) as e:
+        plume.render(feather, width=1)
+    assert e.value.message.startswith("raytrace: ") and e.value.file is None
+    with pytest.raises(plume.Error) as e:
+        plume.render2d(feather, "front.png", width=1)
+    assert e.value.message.startswith("render2d: ") and e.value.file is None
+    with pytest.raises(plume.Error) as e:
+        plume.calibrate(element_count=0)
+    assert e.value.message.startswith("calibration: ") and e.value.file is None
+
+
+@pytest.mark.parametrize("message, file", [
+    ("simulation: Newton did not converge", None),
+    ("quasi-static solve: the step stalled", None),
+    ("calibration: mesoscale, barbs at 45 deg: band phase 0.5: sample.elements is 0", None),
+    ("$.segments[0]: rachis positions must increase", None),
+    ("camera size is 1x800, each allowed in [16, 16384]", None),
+    ("hawk.json: $.seed is -1", "hawk.json"),
+    ("/tmp/my specs/hawk.json:2:7: '}' expected", "/tmp/my specs/hawk.json"),
+    ("examples/coats/back-cap.obj:12: bad face", "examples/coats/back-cap.obj"),
+    ("out/png: cannot write PNG: Permission denied", "out/png"),
+    ("<dict>: $.model: missing", "<dict>"),
+])
+def test_error_file_is_a_file_or_none(message, file):
+    err = plume._lib.new_error()
+    err.status = 3
+    err.message = message.encode()
+    assert plume.Error.from_c(err).file == file
+
+
+def test_error_file_without_folder_or_suffix_counts_where_passed():
+    err = plume._lib.new_error()
+    err.status = 1
+    err.message = b"hawk: cannot read: No such file or directory"
+    assert plume.Error.from_c(err).file is None and plume.Error.from_c(err, files=["hawk"]).file == "hawk"
+
+
+def test_dict_coat_references_resolve_against_the_working_directory(source, monkeypatch):
+    spec = json.loads((source / "examples" / "coats" / "back-cap.json").read_text())
+    monkeypatch.chdir(source)
+    # Relative to the working directory, not to the hidden temporary file the dict is written to.
+    with pytest.raises(plume.Error) as e:
+        plume.coat(spec)
+    assert e.value.code == "io" and "plume-" not in e.value.message and e.value.file == "<dict>"
+    assert f"$.surface.obj: {source / 'back-cap.obj'}: cannot open" in e.value.message
+    assert "resolve against the working directory" in e.value.message
+    monkeypatch.chdir(source / "examples" / "coats")
+    from_dict, from_file = plume.coat(spec), plume.coat("back-cap.json")
+    assert len(from_dict) == len(from_file) > 0
+    assert all(a.equal(b) for a, b in zip(from_dict.feathers, from_file.feathers))
+    # An inline key feather's references too (a blend of spec files), and the caller's dict is left as it was.
+    monkeypatch.chdir(source)
+    spec["surface"]["obj"] = "examples/coats/back-cap.obj"
+    for key in spec["key_feathers"]:
+        key["feather"] = "examples/coats/key-contour.json"
+    spec["key_feathers"][0]["feather"] = {"model": "streit-heidrich", "blend": {
+        "feathers": ["examples/streit-heidrich/down.json", "examples/streit-heidrich/contour.json"], "t": 0.5}}
+    before = json.dumps(spec)
+    assert len(plume.coat(spec)) == len(from_file)
+    assert json.dumps(spec) == before
+    spec["key_feathers"][0]["feather"]["blend"]["feathers"][0] = "down.json"
+    with pytest.raises(plume.Error) as e:
+        plume.coat(spec)
+    assert e.value.file == str(source / "down.json") and "working directory" in e.value.message
+
+
+def test_python_terms_in_limit_messages(source):
+    with pytest.raises(plume.Error) as e:
+        plume.coat(source / "examples" / "coats" / "sphere.json", max_memory=1000)
+    assert e.value.code == "limit" and "the max_memory keyword" in e.value.message and "--" not in e.value.message
+    feather = plume.generate(source / "examples" / "franco-walter" / "filoplume.json")
+    with pytest.raises(plume.Error) as e:
+        plume.mesh(feather, max_memory=1000)
+    assert e.value.code == "limit" and "the max_memory keyword" in e.value.message and "--" not in e.value.message
+    for bad in (0, -1, 1.5, True, 2**64):
+        with pytest.raises(ValueError, match="max_memory is"):
+            plume.mesh(feather, max_memory=bad)
+
+
+def test_closed_forms_check_their_ranges():
+    for args in ((2.0, 1e9, 1e4), (0.0, 1e9, 1e4), (1.0, 1e9, 1e4), (0.14, -1e9, 1e4), (0.14, 1e9, float("nan")),
+                 (0.14, float("inf"), 1e4)):
+        with pytest.raises(plume.Error) as e:
+            plume.longitudinal_modulus(*args)
+        assert e.value.code == "spec" and "allowed" in e.value.message, args
+    for args in ((1.0, 3.9e4), (0.14, 3.9e4, -1), (0.14, 3.9e4, 0), (0.14, 0, 0.4), (float("nan"), 3.9e4)):
+        with pytest.raises(plume.Error) as e:
+            plume.transverse_slope_rigid(*args)
+        assert e.value.code == "spec" and "allowed" in e.value.message, args
+    assert np.isfinite(plume.transverse_slope_rigid(0.14, 3.9e4, 0.4))
