@@ -9,7 +9,7 @@ from typing import Any, Optional, Sequence, Union
 
 import numpy as np
 
-from ._lib import Closable, Error, check, ffi, lib, new_error, text, view
+from ._lib import PYTHON_TERMS, Closable, Error, check, ffi, fspath, lib, new_error, text, view
 from .feather import Feather, _options
 from .mesh import Mesh, _report
 
@@ -48,15 +48,18 @@ class Simulation(Closable):
     the simulation lives. ``reports`` collects one dict per step.
     """
 
-    def __init__(self, scene: Union[dict, str, "os.PathLike[str]"], *, seed: Optional[int] = None):
-        options = _options(seed, None, "growth")
+    def __init__(self, scene: Union[dict, str, bytes, "os.PathLike[str]"], *, seed: Optional[int] = None,
+                 max_memory: Optional[int] = None):
+        options = _options(seed, None, "growth", max_memory)
         out = ffi.new("plume_scene **")
         err = new_error()
+        rename = PYTHON_TERMS  # the limit's message names the max_memory keyword, not --max-memory
         if isinstance(scene, dict):
             status = lib.plume_scene_parse(json.dumps(scene).encode(), b"<dict>", options, out, err)
+            check(status, err, rename=rename)
         else:
-            status = lib.plume_scene_load(os.fspath(scene).encode(), options, out, err)
-        check(status, err)
+            path = fspath(scene, "scene", "a dict or a path (str, bytes or os.PathLike)")
+            check(lib.plume_scene_load(os.fsencode(path), options, out, err), err, rename=rename, files=(path,))
         self._scene = ffi.gc(out[0], lib.plume_scene_destroy)
         s = self._scene
         # The library's scene runner: the run `plume simulate` makes (follicle handles carried

@@ -136,6 +136,19 @@ def test_scene_with_a_body_matches_plume_simulate(source, cli, tmp_path):
         assert mine["rachis_tip_deflection"] == pytest.approx(summary["rachis_tip_deflection"], rel=1e-9)
 
 
+def test_scene_paths_and_memory_limit(source, tmp_path):
+    scene = tmp_path / "swing.json"
+    scene.write_text(json.dumps(swing(source)))
+    for path in (scene, str(scene), bytes(scene)):
+        with plume.Simulation(path) as sim:
+            assert sim.steps_total == 5
+    with pytest.raises(TypeError, match="scene is int"):
+        plume.Simulation(5)
+    with pytest.raises(plume.Error, match="max_memory keyword") as e:
+        plume.Simulation(scene, max_memory=1000)
+    assert e.value.code == "limit" and e.value.file == str(scene)
+
+
 def test_bad_handles_and_loads_raise(source):
     with plume.Simulation(swing(source)) as sim:
         for bad in (1, -1, 1.0, True, "0"):
