@@ -35,7 +35,8 @@ void cli_help_sweep(void)
 	     "path: grids, lists, seeded random samples (uniform, normal, log-normal,\n"
 	     "truncated) or the rows of another sweep's results.csv.\n"
 	     "Each run is a separate plume process: a failing run is recorded with its\n"
-	     "message and the sweep goes on. docs/sweeps.md describes the sweep file.\n"
+	     "message and the sweep goes on (it exits 1 when every run failed).\n"
+	     "docs/sweeps.md describes the sweep file.\n"
 	     "\n"
 	     "Writes DIR/results.csv (index, parameters, outputs, status, message; in index\n"
 	     "order and the same bytes for any -j or rank count), DIR/timings.csv (seconds per\n"
@@ -124,17 +125,10 @@ int cli_sweep(int argc, char **argv)
 	if (!cli_check_arguments("sweep", argc, argv, "SWEEP.json", output_dir))
 		return CLI_EXIT_USAGE;
 
-	if (dry_run) {
-		sweep s;
-		int code = sweep_load(&s, argv[optind]) && sweep_check(&s) ? CLI_EXIT_OK : CLI_EXIT_INPUT;
-		if (code == CLI_EXIT_OK)
-			print_plan(&s);
-		sweep_free(&s);
-		return code;
-	}
 	int rank = 0, size = 1;
 	(void)size; // read by the MPI build only
 #ifdef PLUME_WITH_MPI
+	// Before anything prints, --dry-run too: under a launcher only rank 0 speaks.
 	bool mpi = sweep_mpi_launched();
 	if (mpi) {
 		MPI_Init(NULL, NULL);
@@ -142,7 +136,8 @@ int cli_sweep(int argc, char **argv)
 		MPI_Comm_size(MPI_COMM_WORLD, &size);
 	}
 #endif
-	// Every rank reads and checks the sweep (it is small); only rank 0 speaks.
+	// Every rank reads the sweep (it is small; the workers start runs from it); only
+	// rank 0 checks it, speaks and writes DIR.
 	FILE *saved_stderr = NULL;
 	if (rank != 0)
 		saved_stderr = freopen("/dev/null", "w", stderr);
@@ -150,8 +145,8 @@ int cli_sweep(int argc, char **argv)
 	sweep s;
 	int code = CLI_EXIT_OK;
 	if (!sweep_load(&s, argv[optind]))
-		code = CLI_EXIT_INPUT;
-	else if (rank == 0 && s.run_count > max_runs) {
+		code = s.failure_code;
+	else if (rank == 0 && !dry_run && s.run_count > max_runs) {
 		// Before any run starts or DIR is touched: each run is a plume process.
 		sweep_error(&s,
 		            "$.samples (%d) x the grids' and lists' values (%d) make %d runs; the limit is %ld (raise it "
@@ -160,9 +155,11 @@ int cli_sweep(int argc, char **argv)
 		code = CLI_EXIT_LIMIT;
 	} else if (rank == 0 && !sweep_check(&s))
 		code = CLI_EXIT_INPUT;
+	else if (rank == 0 && dry_run)
+		print_plan(&s);
 	sweep_state state;
 	memset(&state, 0, sizeof state);
-	if (code == CLI_EXIT_OK && rank == 0) {
+	if (code == CLI_EXIT_OK && rank == 0 && !dry_run) {
 		int begin_code = CLI_EXIT_IO;
 		if (!sweep_state_begin(&begin_code, &state, &s, output_dir))
 			code = begin_code;
@@ -170,7 +167,7 @@ int cli_sweep(int argc, char **argv)
 #ifdef PLUME_WITH_MPI
 	if (mpi) {
 		MPI_Bcast(&code, 1, MPI_INT, 0, MPI_COMM_WORLD);
-		if (code == CLI_EXIT_OK) {
+		if (code == CLI_EXIT_OK && !dry_run) {
 			if (size == 1)
 				code = sweep_run_local(&state, jobs) ? CLI_EXIT_OK : CLI_EXIT_IO;
 			else if (rank == 0)
@@ -180,14 +177,18 @@ int cli_sweep(int argc, char **argv)
 		}
 	} else
 #endif
-	    if (code == CLI_EXIT_OK)
+	    if (code == CLI_EXIT_OK && !dry_run)
 		code = sweep_run_local(&state, jobs) ? CLI_EXIT_OK : CLI_EXIT_IO;
-	if (rank == 0 && code == CLI_EXIT_OK)
+	bool finished = rank == 0 && code == CLI_EXIT_OK && !dry_run;
+	if (finished)
 		code = sweep_write_summary(&state) ? CLI_EXIT_OK : CLI_EXIT_IO;
-	if (rank == 0 && code == CLI_EXIT_OK && !s.keep_runs) {
-		char runs[PATH_MAX + 16];
-		snprintf(runs, sizeof runs, "%s/runs", output_dir);
-		cli_remove_tree(runs); // and what killed attempts left of runs since done
+	if (finished && code == CLI_EXIT_OK && !s.keep_runs)
+		sweep_runs_remove(output_dir); // and what killed attempts left of runs since done
+	if (finished && code == CLI_EXIT_OK && sweep_ok_count(&state) == 0) {
+		// Every row is kept, with its message; but a sweep that measured nothing failed.
+		sweep_error(&s, "every run failed (%d of %d); results.csv in %s has their messages", s.run_count, s.run_count,
+		            output_dir);
+		code = CLI_EXIT_FAILURE;
 	}
 	sweep_state_end(&state);
 	sweep_free(&s);

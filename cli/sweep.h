@@ -3,9 +3,11 @@
 //   sweep.c          the command line, --dry-run, and the order of the steps
 //   sweep_commands.c the commands a sweep can run and the outputs they write
 //   sweep_spec.c     reading SWEEP.json; sweep_paths.c its JSON paths
-//   sweep_check.c    every value through the command's own spec reader, before any run
+//   sweep_check.c    before any run: $.arguments, every value through the command's own
+//                    spec reader, the outputs against the first run
 //   sweep_values.c   each run's values: grids, lists, seeded samples; CSV text
-//   sweep_run.c      a run as a child plume process; the local scheduler (-j)
+//   sweep_run.c      a run as a child plume process in a folder the sweep marks as its
+//                    own; the local scheduler (-j)
 //   sweep_mpi.c      the MPI scheduler (rank 0) and workers
 //   sweep_results.c  DIR/sweep.json, results.csv, timings.csv, resuming
 //   sweep_stats.c    DIR/stats.json and DIR/plots
@@ -44,6 +46,15 @@ typedef enum probe_kind {
 	PROBE_RENDER
 } probe_kind;
 
+/// A value a command writes to its result file: a key into its JSON ("slope_pa",
+/// "slopes.longitudinal", "guide_count[1]"). A key may hold one placeholder, <group>
+/// (a mesh group's name), <handle> or <feather> (an index), which the first run's
+/// probe checks (sweep_check.c).
+typedef struct sweep_output {
+	const char *key;
+	const char *when; ///< the runs that write it ("with contact"); NULL: every run
+} sweep_output;
+
 typedef struct sweep_command {
 	const char *name;
 	const char *words[2]; ///< the command line words before the spec
@@ -51,12 +62,15 @@ typedef struct sweep_command {
 	/// File (in the run's output folder) whose JSON holds the outputs; "stdout" for
 	/// a command that prints its result; NULL for none.
 	const char *result;
-	/// Keys that file has (dotted paths into it); NULL-terminated.
-	const char *const *outputs;
+	/// Every number and boolean that file has; {NULL} ends the list.
+	const sweep_output *outputs;
 } sweep_command;
 
 enum { SWEEP_COMMAND_COUNT = 7, SWEEP_CALIBRATION_KEY_COUNT = 9 };
 extern const sweep_command sweep_commands[SWEEP_COMMAND_COUNT];
+/// The output of command that key names, or NULL. hole receives the text standing for
+/// the output's placeholder (a group name, an index); empty when it has none.
+const sweep_output *sweep_output_find(const sweep_command *command, const char *key, char *hole, size_t size);
 /// The keys of a render frames spec; NULL-terminated.
 extern const char *const sweep_render_keys[];
 
@@ -88,6 +102,9 @@ typedef struct sweep_param {
 
 typedef struct sweep {
 	const char *file;
+	/// Why sweep_load failed: CLI_EXIT_INPUT (a bad sweep), CLI_EXIT_IO (a file it reads
+	/// cannot be read) or CLI_EXIT_LIMIT (more runs than a sweep may have).
+	int failure_code;
 	char base_dir[PATH_MAX];
 	const sweep_command *command;
 	json_t *root; ///< the sweep file
@@ -131,8 +148,10 @@ bool sweep_path_set(json_t *root, const char *path, json_t *value);
 /// The scalar path in root nearest to path (for "did you mean"); best holds 512 bytes.
 void sweep_nearest_path(const json_t *node, const char *prefix, const char *path, char *best, size_t *best_distance);
 
-/// Every grid/list value, and the ends of every distribution's range, through the
-/// command's spec reader (sweep_check.c); false after a message.
+/// $.arguments (refused when the sweep sets them or the command does not take them),
+/// every grid/list value and the ends of every distribution's range through the
+/// command's spec reader, and the outputs the first run's probe resolves (sweep_check.c);
+/// false after a message.
 bool sweep_check(const sweep *s);
 
 // Values of a run (sweep_values.c)
@@ -157,7 +176,8 @@ typedef struct sweep_state {
 } sweep_state;
 
 /// Creates DIR or, when it holds this same sweep, reads the rows already done.
-/// False after a message; *code says why (CLI_EXIT_INPUT: DIR holds another sweep).
+/// False after a message; *code says why (CLI_EXIT_INPUT: DIR holds another sweep;
+/// CLI_EXIT_IO: DIR cannot be written, or writing it would replace files not the sweep's).
 bool sweep_state_begin(int *code, sweep_state *state, const sweep *s, const char *dir);
 void sweep_state_end(sweep_state *state);
 /// Writes the parts to path.tmp, syncs it and renames it over path.
@@ -180,6 +200,19 @@ pid_t sweep_run_start(const sweep *s, const char *dir, int index, char *failure,
 char *sweep_run_finish(const sweep *s, const char *dir, int index, pid_t pid, int wait_status, const char *failure);
 /// Runs every missing run with up to jobs children at once.
 bool sweep_run_local(sweep_state *state, int jobs);
+
+// Run folders DIR/runs/NNNNNN are the sweep's only when they hold this marker; the sweep
+// removes only its own folders and in them only what a run writes (sweep_run.c).
+#define SWEEP_RUN_MARKER ".plume-sweep-run"
+/// DIR/runs/NNNNNN of run index.
+void sweep_run_folder(const char *dir, int index, char *out, size_t size);
+/// Whether folder holds the sweep's marker.
+bool sweep_run_folder_ours(const char *folder);
+/// Removes what the sweep and its run wrote in folder, and folder when that empties it.
+void sweep_run_folder_remove(const char *folder);
+/// Removes the sweep's run folders in DIR/runs, and DIR/runs when the sweep made it and
+/// nothing else is left in it.
+void sweep_runs_remove(const char *dir);
 #ifdef PLUME_WITH_MPI
 /// Whether this process was started by an MPI launcher (mpirun, srun).
 bool sweep_mpi_launched(void);
@@ -191,5 +224,7 @@ void sweep_mpi_work(const sweep *s, const char *dir);
 
 /// DIR/stats.json, DIR/plots/*.png and the summary line (sweep_stats.c).
 bool sweep_write_summary(const sweep_state *state);
+/// The rows with status ok.
+int sweep_ok_count(const sweep_state *state);
 
 #endif

@@ -1,6 +1,7 @@
 // plume sweep: DIR: sweep.json, results.csv (rewritten whole, atomically, as rows
 // arrive, in index order), timings.csv; and resuming a sweep in the DIR it left.
 #define _GNU_SOURCE
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
@@ -132,11 +133,97 @@ bool sweep_row_field(const char *row, int k, const char **start, size_t *length)
 	}
 }
 
+/// One sweep at a time in DIR: the lock goes with the process, however it ends.
+/// False after a message naming the lock file or the folder.
+static bool lock_folder(const char *dir)
+{
+	char path[PATH_MAX + 32];
+	struct stat info;
+	if (stat(dir, &info) != 0 || !S_ISDIR(info.st_mode)) {
+		fprintf(stderr, "plume: %s: not a folder; -o names the folder the sweep writes\n", dir);
+		return false;
+	}
+	snprintf(path, sizeof path, "%s/.sweep.lock", dir);
+	int lock = open(path, O_WRONLY | O_CREAT | O_CLOEXEC, 0666);
+	if (lock < 0) {
+		fprintf(stderr, "plume: %s: cannot create the sweep's lock: %s\n", path, strerror(errno));
+		return false;
+	}
+	if (flock(lock, LOCK_EX | LOCK_NB) != 0) {
+		if (errno == EWOULDBLOCK)
+			fprintf(stderr, "plume: %s: another plume sweep is running in this folder\n", dir);
+		else
+			fprintf(stderr, "plume: %s: cannot lock: %s\n", path, strerror(errno));
+		close(lock);
+		return false;
+	}
+	return true; // held until the process ends
+}
+
+/// A new sweep writes these in DIR: files of the user's by these names are not replaced.
+static bool holds_no_results(const char *dir)
+{
+	static const char *const names[] = {"results.csv", "timings.csv", "stats.json", "plots", NULL};
+	char path[PATH_MAX + 32];
+	for (int i = 0; names[i] != NULL; ++i) {
+		snprintf(path, sizeof path, "%s/%s", dir, names[i]);
+		struct stat info;
+		if (lstat(path, &info) == 0) {
+			fprintf(stderr,
+			        "plume: %s exists, but %s holds no sweep.json: it is not a sweep's, and a sweep would replace "
+			        "it; move it away or choose another folder\n",
+			        path, dir);
+			return false;
+		}
+	}
+	return true;
+}
+
+/// DIR/runs/NNNNNN of a run still to do must be absent or the sweep's own (its marker):
+/// a folder the user made there is refused rather than written into or removed.
+static bool runs_folder_free(const sweep_state *state)
+{
+	char runs[PATH_MAX + 16], folder[PATH_MAX + 300];
+	snprintf(runs, sizeof runs, "%s/runs", state->dir);
+	struct stat info;
+	if (lstat(runs, &info) != 0)
+		return true;
+	if (stat(runs, &info) != 0 || !S_ISDIR(info.st_mode)) { // a link to a folder will do
+		fprintf(stderr, "plume: %s: not a folder; the sweep keeps its runs' folders there\n", runs);
+		return false;
+	}
+	DIR *d = opendir(runs);
+	if (d == NULL) {
+		fprintf(stderr, "plume: %s: cannot read: %s\n", runs, strerror(errno));
+		return false;
+	}
+	bool ok = true;
+	for (struct dirent *e; ok && (e = readdir(d)) != NULL;) {
+		if (strlen(e->d_name) != 6 || strspn(e->d_name, "0123456789") != 6)
+			continue;
+		long index = strtol(e->d_name, NULL, 10);
+		if (index >= state->s->run_count || state->rows[index] != NULL)
+			continue;
+		snprintf(folder, sizeof folder, "%s/%s", runs, e->d_name);
+		if (!sweep_run_folder_ours(folder)) {
+			fprintf(stderr,
+			        "plume: %s: not a run folder of this sweep (it lacks %s), and run %ld would write there: "
+			        "move it away or choose another folder\n",
+			        folder, SWEEP_RUN_MARKER, index);
+			ok = false;
+		}
+	}
+	closedir(d);
+	return ok;
+}
+
 /// Creates DIR or, when it holds this same sweep, reads the rows already done.
-/// False after a message; *code says why (CLI_EXIT_INPUT: DIR holds another sweep).
+/// False after a message; *code says why (CLI_EXIT_INPUT: DIR holds another sweep;
+/// CLI_EXIT_IO: DIR cannot be written, or writing it would replace files not the sweep's).
 bool sweep_state_begin(int *code, sweep_state *state, const sweep *s, const char *dir)
 {
 	memset(state, 0, sizeof *state);
+	*code = CLI_EXIT_IO;
 	state->s = s;
 	state->dir = dir;
 	state->rows = calloc((size_t)s->run_count, sizeof *state->rows);
@@ -157,15 +244,8 @@ bool sweep_state_begin(int *code, sweep_state *state, const sweep *s, const char
 		free(document);
 		return false;
 	}
-	// One sweep at a time in DIR: the lock goes with the process, however it ends.
-	snprintf(path, sizeof path, "%s/.sweep.lock", dir);
-	int lock = open(path, O_WRONLY | O_CREAT | O_CLOEXEC, 0666);
-	if (lock < 0 || flock(lock, LOCK_EX | LOCK_NB) != 0) {
-		fprintf(stderr, "plume: %s: another plume sweep is running in this folder\n", dir);
-		if (lock >= 0)
-			close(lock);
+	if (!lock_folder(dir)) {
 		free(document);
-		*code = CLI_EXIT_IO;
 		return false;
 	}
 	snprintf(path, sizeof path, "%s/sweep.json", dir);
@@ -213,8 +293,16 @@ bool sweep_state_begin(int *code, sweep_state *state, const sweep *s, const char
 			free(line);
 			fclose(file);
 		}
+		if (!runs_folder_free(state)) {
+			free(document);
+			return false;
+		}
 	} else {
 		const char *parts[2] = {document, "\n"};
+		if (!holds_no_results(dir) || !runs_folder_free(state)) {
+			free(document);
+			return false;
+		}
 		if (!sweep_write_atomic(path, parts, 2)) {
 			fprintf(stderr, "plume: %s: cannot write: %s\n", path, strerror(errno));
 			free(document);

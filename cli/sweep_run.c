@@ -11,28 +11,144 @@
 #include <string.h>
 #include <sys/prctl.h>
 #include <sys/stat.h>
+#include <dirent.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include "sweep.h"
 
-static void run_dir(const char *dir, int index, char *out, size_t size)
+// ---------------------------------------------------------------------------
+// Run folders. DIR/runs may hold the user's own files, and a DIR/runs/NNNNNN the
+// user made is not the sweep's: the sweep marks the folders it makes and removes
+// only marked ones, and in them only what a run writes (a file the user put there
+// keeps its folder).
+
+/// What a run writes in its folder, besides the marker.
+static const char *const run_files[] = {"spec.json", "stdout.txt", "stderr.txt", NULL};
+/// The command's output folder in the run's folder, and the prefix of the staging
+/// folders a killed command leaves beside it (cli/output.c).
+#define RUN_OUTPUT "out"
+#define RUN_OUTPUT_STAGING ".out.plume-staging-"
+/// DIR/runs holds this when the sweep made it.
+#define RUNS_MARKER ".plume-sweep-runs"
+
+void sweep_run_folder(const char *dir, int index, char *out, size_t size)
 {
 	snprintf(out, size, "%s/runs/%06d", dir, index);
+}
+
+static bool holds_file(const char *folder, const char *name)
+{
+	char path[PATH_MAX + 64];
+	snprintf(path, sizeof path, "%s/%s", folder, name);
+	struct stat info;
+	return lstat(path, &info) == 0 && S_ISREG(info.st_mode);
+}
+
+bool sweep_run_folder_ours(const char *folder) { return holds_file(folder, SWEEP_RUN_MARKER); }
+
+/// Whether folder holds nothing but its marker.
+static bool only_marker(const char *folder, const char *marker)
+{
+	DIR *d = opendir(folder);
+	if (d == NULL)
+		return false;
+	bool only = true;
+	for (struct dirent *e; only && (e = readdir(d)) != NULL;)
+		only = strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0 || strcmp(e->d_name, marker) == 0;
+	closedir(d);
+	return only;
+}
+
+/// Removes folder's marker and folder when nothing else is in it.
+static void remove_if_only_marker(const char *folder, const char *marker)
+{
+	char path[PATH_MAX + 64];
+	snprintf(path, sizeof path, "%s/%s", folder, marker);
+	if (only_marker(folder, marker) && unlink(path) == 0)
+		rmdir(folder);
+}
+
+void sweep_run_folder_remove(const char *folder)
+{
+	if (!sweep_run_folder_ours(folder))
+		return;
+	char path[PATH_MAX + 64];
+	for (int i = 0; run_files[i] != NULL; ++i) {
+		snprintf(path, sizeof path, "%s/%s", folder, run_files[i]);
+		unlink(path);
+	}
+	// The command's output, and its staging folders where a killed command left them.
+	snprintf(path, sizeof path, "%s/" RUN_OUTPUT, folder);
+	cli_remove_tree(path);
+	DIR *d = opendir(folder);
+	for (struct dirent *e; d != NULL && (e = readdir(d)) != NULL;)
+		if (strncmp(e->d_name, RUN_OUTPUT_STAGING, strlen(RUN_OUTPUT_STAGING)) == 0) {
+			snprintf(path, sizeof path, "%s/%s", folder, e->d_name);
+			if (holds_file(path, ".plume-staging-marker"))
+				cli_remove_tree(path);
+		}
+	if (d != NULL)
+		closedir(d);
+	remove_if_only_marker(folder, SWEEP_RUN_MARKER);
+}
+
+void sweep_runs_remove(const char *dir)
+{
+	char runs[PATH_MAX + 16], folder[PATH_MAX + 300];
+	snprintf(runs, sizeof runs, "%s/runs", dir);
+	DIR *d = opendir(runs);
+	if (d == NULL)
+		return;
+	for (struct dirent *e; (e = readdir(d)) != NULL;)
+		if (strlen(e->d_name) == 6 && strspn(e->d_name, "0123456789") == 6) {
+			snprintf(folder, sizeof folder, "%s/%s", runs, e->d_name);
+			sweep_run_folder_remove(folder);
+		}
+	closedir(d);
+	remove_if_only_marker(runs, RUNS_MARKER);
+}
+
+/// Creates a folder with the sweep's marker, or takes the existing one: any folder when
+/// !ours_only (DIR/runs may be the user's), else only one with the marker (a run's
+/// folder); false (message in failure) otherwise.
+static bool make_own_folder(const char *path, const char *marker, bool ours_only, char *failure, size_t size)
+{
+	char marker_path[PATH_MAX + 64];
+	snprintf(marker_path, sizeof marker_path, "%s/%s", path, marker);
+	if (mkdir(path, 0777) != 0) {
+		struct stat info;
+		if (errno != EEXIST || stat(path, &info) != 0 || !S_ISDIR(info.st_mode)) {
+			snprintf(failure, size, "cannot create %s: %s", path, strerror(errno == EEXIST ? ENOTDIR : errno));
+			return false;
+		}
+		if (ours_only && !holds_file(path, marker)) {
+			snprintf(failure, size, "%s is not this sweep's (it lacks %s): left as it is", path, marker);
+			return false;
+		}
+		return true;
+	}
+	int fd = open(marker_path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+	if (fd < 0) {
+		snprintf(failure, size, "cannot create %s: %s", marker_path, strerror(errno));
+		return false;
+	}
+	close(fd);
+	return true;
 }
 
 /// Writes the run's spec and starts plume on it; the pid, or -1 (message in row).
 pid_t sweep_run_start(const sweep *s, const char *dir, int index, char *failure, size_t size)
 {
 	char folder[PATH_MAX], path[PATH_MAX + 32];
-	run_dir(dir, index, folder, sizeof folder);
-	cli_remove_tree(folder); // what a killed attempt left
+	sweep_run_folder(dir, index, folder, sizeof folder);
+	sweep_run_folder_remove(folder); // what a killed attempt left
 	snprintf(path, sizeof path, "%s/runs", dir);
-	mkdir(path, 0777);
-	if (mkdir(folder, 0777) != 0) {
-		snprintf(failure, size, "cannot create %s: %s", folder, strerror(errno));
+	// DIR/runs may be the user's own (no marker): the sweep then only adds its folders.
+	// (Under MPI the first runs of several ranks may create it at once.)
+	if (!make_own_folder(path, RUNS_MARKER, false, failure, size) ||
+	    !make_own_folder(folder, SWEEP_RUN_MARKER, true, failure, size))
 		return -1;
-	}
 	json_t *spec = sweep_run_spec(s, index);
 	snprintf(path, sizeof path, "%s/spec.json", folder);
 	int failed = json_dump_file(spec, path, JSON_INDENT(2) | JSON_REAL_PRECISION(17));
@@ -130,14 +246,26 @@ pid_t sweep_run_start(const sweep *s, const char *dir, int index, char *failure,
 	return pid;
 }
 
-/// The output at a dotted key in root, as CSV text (empty when absent).
+/// The output at key in root ("a.b", "a[1]", "a[0].b"), as CSV text (empty when absent).
 static void output_value(const json_t *root, const char *key, char *out, size_t size)
 {
-	char copy[128];
-	snprintf(copy, sizeof copy, "%s", key);
+	char name[128];
 	const json_t *node = root;
-	for (char *part = strtok(copy, "."); part != NULL && node != NULL; part = strtok(NULL, "."))
-		node = json_is_object(node) ? json_object_get(node, part) : NULL;
+	for (const char *k = key; *k != '\0' && node != NULL;) {
+		if (*k == '.')
+			++k;
+		if (*k == '[') {
+			char *end = NULL;
+			long i = strtol(k + 1, &end, 10);
+			node = json_is_array(node) && *end == ']' && i >= 0 ? json_array_get(node, (size_t)i) : NULL;
+			k = *end == ']' ? end + 1 : end;
+			continue;
+		}
+		size_t length = strcspn(k, ".[");
+		snprintf(name, sizeof name, "%.*s", (int)length, k);
+		node = json_is_object(node) ? json_object_get(node, name) : NULL;
+		k += length;
+	}
 	sweep_csv_value(out, size, node);
 }
 
@@ -164,7 +292,7 @@ static const char *const row_status_names[] = {"ok", "failed", "signal"};
 char *sweep_run_finish(const sweep *s, const char *dir, int index, pid_t pid, int wait_status, const char *failure)
 {
 	char folder[PATH_MAX], path[PATH_MAX + 64], message[1024] = "";
-	run_dir(dir, index, folder, sizeof folder);
+	sweep_run_folder(dir, index, folder, sizeof folder);
 	row_status status = ROW_OK;
 	if (pid < 0) {
 		status = ROW_FAILED;
@@ -214,7 +342,7 @@ char *sweep_run_finish(const sweep *s, const char *dir, int index, pid_t pid, in
 	snprintf(row + n, capacity - n, ",%s,%s\n", row_status_names[status], quoted);
 	json_decref(result);
 	if (!s->keep_runs && pid >= 0)
-		cli_remove_tree(folder);
+		sweep_run_folder_remove(folder);
 	return row;
 }
 

@@ -83,7 +83,7 @@ static bool csv_field(const char *line, int k, char *out, size_t size)
 }
 
 /// A column of another sweep's results.csv (its rows with status ok) as the values of p.
-static bool read_column(const sweep *s, sweep_param *p, const json_t *item, const char *where, json_t *target)
+static bool read_column(sweep *s, sweep_param *p, const json_t *item, const char *where, json_t *target)
 {
 	const char *file = json_string_value(json_object_get(item, "from_csv"));
 	const char *column = json_string_value(json_object_get(item, "column"));
@@ -95,8 +95,10 @@ static bool read_column(const sweep *s, sweep_param *p, const json_t *item, cons
 	else
 		snprintf(path, sizeof path, "%s/%s", s->base_dir, file);
 	FILE *stream = fopen(path, "r");
-	if (stream == NULL)
-		return sweep_error(s, "%s.from_csv: %s: %s", where, path, strerror(errno));
+	if (stream == NULL) {
+		s->failure_code = CLI_EXIT_IO;
+		return sweep_error(s, "%s.from_csv: %s: cannot read: %s", where, path, strerror(errno));
+	}
 	char *line = NULL;
 	size_t capacity = 0;
 	int value_column = -1, status_column = -1;
@@ -327,12 +329,56 @@ bool sweep_owns_dimension(const sweep_param *p, int i)
 	return p->values != NULL && (p->zip_lead < 0 || p->zip_lead == i);
 }
 
-static bool output_known(const sweep_command *command, const char *key)
+/// A JSON file, told apart: one that cannot be read (*io, with errno's reason) from one
+/// that does not parse (jansson's line and column).
+static json_t *load_json(const char *path, bool *io, json_error_t *jerr)
 {
-	for (int i = 0; command->outputs[i] != NULL; ++i)
-		if (strcmp(command->outputs[i], key) == 0)
-			return true;
+	// jansson reports a missing file as a parse error at line -1; plume says "cannot read".
+	FILE *file = fopen(path, "rb");
+	*io = file == NULL;
+	if (file == NULL)
+		return NULL;
+	json_t *root = json_loadf(file, JSON_REJECT_DUPLICATES, jerr);
+	fclose(file);
+	return root;
+}
+
+/// "$.outputs[i]: no mesh run produces "x"; mesh writes: a, b (when), ..."
+static bool unknown_output(const sweep *s, int i, const char *key)
+{
+	const sweep_command *c = s->command;
+	if (c->outputs[0].key == NULL)
+		return sweep_error(s, "$.outputs[%d]: %s writes no outputs to collect; only status", i, c->name);
+	fprintf(stderr, "plume: %s: $.outputs[%d]: no %s run produces \"%s\"; %s writes:", s->file, i, c->name, key,
+	        c->name);
+	for (int k = 0; c->outputs[k].key != NULL; ++k) {
+		fprintf(stderr, "%s %s", k ? "," : "", c->outputs[k].key);
+		if (c->outputs[k].when != NULL)
+			fprintf(stderr, " (%s)", c->outputs[k].when);
+	}
+	fputc('\n', stderr);
 	return false;
+}
+
+/// $.outputs: keys the command writes, each once (a column each in results.csv).
+static bool read_outputs(sweep *s, const json_t *outputs)
+{
+	if (!json_is_array(outputs) || json_array_size(outputs) > 32)
+		return sweep_error(s, "$.outputs must be an array of at most 32 output keys");
+	s->output_count = (int)json_array_size(outputs);
+	for (int i = 0; i < s->output_count; ++i) {
+		const char *key = json_string_value(json_array_get(outputs, (size_t)i));
+		if (key == NULL || strlen(key) >= sizeof s->outputs[i])
+			return sweep_error(s, "$.outputs[%d] must be a key name", i);
+		char hole[128];
+		if (sweep_output_find(s->command, key, hole, sizeof hole) == NULL)
+			return unknown_output(s, i, key);
+		for (int k = 0; k < i; ++k)
+			if (strcmp(s->outputs[k], key) == 0)
+				return sweep_error(s, "$.outputs[%d]: \"%s\" is already collected by $.outputs[%d]", i, key, k);
+		snprintf(s->outputs[i], sizeof s->outputs[i], "%s", key);
+	}
+	return true;
 }
 
 bool sweep_load(sweep *s, const char *file)
@@ -341,9 +387,15 @@ bool sweep_load(sweep *s, const char *file)
 	                                   "samples",     "seed",    "outputs", "keep_runs", NULL};
 	memset(s, 0, sizeof *s);
 	s->file = file;
+	s->failure_code = CLI_EXIT_INPUT;
 	json_error_t jerr;
-	s->root = json_load_file(file, JSON_REJECT_DUPLICATES, &jerr);
+	bool io = false;
+	s->root = load_json(file, &io, &jerr);
 	if (s->root == NULL) {
+		if (io) {
+			s->failure_code = CLI_EXIT_IO;
+			return sweep_error(s, "cannot read: %s", strerror(errno));
+		}
 		fprintf(stderr, "plume: %s:%d:%d: %s\n", file, jerr.line, jerr.column, jerr.text);
 		return false;
 	}
@@ -385,7 +437,11 @@ bool sweep_load(sweep *s, const char *file)
 			snprintf(path, sizeof path, "%s", text);
 		else
 			snprintf(path, sizeof path, "%s/%s", s->base_dir, text);
-		s->spec = json_load_file(path, JSON_REJECT_DUPLICATES, &jerr);
+		s->spec = load_json(path, &io, &jerr);
+		if (s->spec == NULL && io) {
+			s->failure_code = CLI_EXIT_IO;
+			return sweep_error(s, "$.spec: %s: cannot read: %s", path, strerror(errno));
+		}
 		if (s->spec == NULL)
 			return sweep_error(s, "$.spec: %s:%d:%d: %s", path, jerr.line, jerr.column, jerr.text);
 		char *cut = strrchr(path, '/');
@@ -462,34 +518,19 @@ bool sweep_load(sweep *s, const char *file)
 	for (int i = 0; i < s->param_count; ++i)
 		if (sweep_owns_dimension(s->params + i, i))
 			runs *= (double)json_array_size(s->params[i].values);
-	if (runs > 1000000)
-		return sweep_error(s, "the sweep has %.0f runs; at most 1000000", runs);
+	if (runs > 1000000) {
+		// A resource limit like --max-runs's (docs/cli.md, Limits), but not one to raise.
+		s->failure_code = CLI_EXIT_LIMIT;
+		return sweep_error(
+		    s, "$.samples (%d) x the grids' and lists' values (%.0f) make %.0f runs; a sweep may have at most 1000000",
+		    (int)samples, runs / samples, runs);
+	}
 	s->run_count = (int)runs;
 	s->grid_count = s->run_count / s->samples;
 
 	json_t *outputs = json_object_get(s->root, "outputs");
-	if (outputs != NULL) {
-		if (!json_is_array(outputs) || json_array_size(outputs) > 32)
-			return sweep_error(s, "$.outputs must be an array of at most 32 output keys");
-		s->output_count = (int)json_array_size(outputs);
-		for (int i = 0; i < s->output_count; ++i) {
-			const char *key = json_string_value(json_array_get(outputs, (size_t)i));
-			if (key == NULL || strlen(key) >= sizeof s->outputs[i])
-				return sweep_error(s, "$.outputs[%d] must be a key name", i);
-			if (!output_known(s->command, key)) {
-				if (s->command->outputs[0] == NULL)
-					return sweep_error(s, "$.outputs[%d]: %s writes no outputs to collect; only status", i,
-					                   s->command->name);
-				fprintf(stderr, "plume: %s: $.outputs[%d]: no %s run produces \"%s\"; %s writes:", file, i,
-				        s->command->name, key, s->command->name);
-				for (int k = 0; s->command->outputs[k] != NULL; ++k)
-					fprintf(stderr, "%s %s", k ? "," : "", s->command->outputs[k]);
-				fputc('\n', stderr);
-				return false;
-			}
-			snprintf(s->outputs[i], sizeof s->outputs[i], "%s", key);
-		}
-	}
+	if (outputs != NULL && !read_outputs(s, outputs))
+		return false;
 	json_t *keep = json_object_get(s->root, "keep_runs");
 	if (keep != NULL && !json_is_boolean(keep))
 		return sweep_error(s, "$.keep_runs must be true or false");

@@ -54,6 +54,20 @@ static void sanitize(const char *name, char *out, size_t size)
 	out[n] = '\0';
 }
 
+int sweep_ok_count(const sweep_state *state)
+{
+	const sweep *s = state->s;
+	int field_count = 1 + s->param_count + s->output_count + 2, ok_runs = 0;
+	for (int i = 0; i < s->run_count; ++i) {
+		int index;
+		char status[16];
+		ok_runs += state->rows[i] != NULL &&
+		           sweep_parse_row(state->rows[i], field_count, &index, status, sizeof status) &&
+		           strcmp(status, "ok") == 0;
+	}
+	return ok_runs;
+}
+
 bool sweep_write_summary(const sweep_state *state)
 {
 	const sweep *s = state->s;
@@ -64,15 +78,7 @@ bool sweep_write_summary(const sweep_state *state)
 	double *y = malloc(sizeof(double) * (size_t)s->run_count);
 	json_t *stats = json_object();
 	bool ok = x != NULL && y != NULL;
-	int ok_runs = 0, failed_runs = 0;
-	int field_count = 1 + s->param_count + s->output_count + 2;
-	for (int i = 0; i < s->run_count; ++i) {
-		int index;
-		char status[16];
-		ok_runs +=
-		    sweep_parse_row(state->rows[i], field_count, &index, status, sizeof status) && strcmp(status, "ok") == 0;
-	}
-	failed_runs = s->run_count - ok_runs;
+	int ok_runs = sweep_ok_count(state), failed_runs = s->run_count - ok_runs;
 	json_object_set_new(stats, "runs", json_integer(s->run_count));
 	json_object_set_new(stats, "ok", json_integer(ok_runs));
 	json_object_set_new(stats, "failed", json_integer(failed_runs));

@@ -3,8 +3,9 @@
 # the closed form of thesis eq. 5.2 in every row and the same results.csv bytes with
 # -j 1, -j 2 and under mpirun -n 2 and -n 3; failing runs are recorded; a sweep whose
 # run or whole job is SIGKILLed resumes to the uninterrupted bytes; random samples are
-# reproducible and follow their distributions; bad sweeps write nothing; every output
-# key the sweep accepts is one a real run writes.
+# reproducible and follow their distributions; bad sweeps write nothing; the output
+# keys the sweep accepts are exactly the numbers and booleans a real run writes; files
+# of the user's in DIR (DIR/runs included) are never removed or replaced.
 # Usage: sweep.sh PLUME_BINARY SOURCE_DIR
 source "$(dirname "$0")/../cli_support.sh" "$@"
 py=/usr/bin/python3
@@ -60,6 +61,12 @@ if "$plume" help sweep | grep -q 'This plume was built with MPI' && command -v m
 		check "mpirun -n $n: same results.csv bytes" cmp -s "$scratch/j1/results.csv" "$scratch/mpi$n/results.csv"
 		check "mpirun -n $n: one summary line" test "$(grep -c '^sweep: 6 runs' "$scratch/out.txt")" -eq 1
 	done
+	"$plume" sweep --dry-run "$scratch/grid.json" -o "$scratch/none" >"$scratch/plan.csv" 2>/dev/null
+	mpirun --allow-run-as-root --oversubscribe -n 3 "$plume" sweep --dry-run "$scratch/grid.json" -o "$scratch/none" \
+		>"$scratch/mpi-plan.csv" 2>"$scratch/err.txt"
+	succeeded "mpirun -n 3 --dry-run succeeds"
+	check "mpirun -n 3 --dry-run: the plan printed once" cmp -s "$scratch/plan.csv" "$scratch/mpi-plan.csv"
+	check "mpirun -n 3 --dry-run: nothing written" test ! -e "$scratch/none"
 else
 	echo "SKIP: MPI part: this plume was built without MPI (libopenmpi-dev not found at configure time)"
 fi
@@ -77,6 +84,11 @@ EOF
 check "failing run: the sweep completes" test $? -eq 0
 check "failing run: recorded with its message" grep -q '^0,1,,failed,exit 1: spec.json: traction step 1 of 3 .*Newton did not converge' "$scratch/fail/results.csv"
 check "failing run: the next run is ok" grep -q '^1,50,[0-9.e+]*,ok,$' "$scratch/fail/results.csv"
+# Every run failed: the rows are kept, but the sweep measured nothing and exits 1.
+sed 's/"values": \[1, 50\]/"values": [1]/' "$scratch/fail.json" >"$scratch/all-fail.json"
+expect_failure "every run failed" 1 "every run failed (1 of 1)" "$plume" sweep "$scratch/all-fail.json" -o "$scratch/all-fail"
+check "every run failed: the row kept with its message" grep -q '^0,1,,failed,exit 1: ' "$scratch/all-fail/results.csv"
+check "every run failed: no run folders left" test ! -e "$scratch/all-fail/runs"
 
 # --- a true/false output counts as 1/0 in stats.json ----------------------------
 cat >"$scratch/bool.json" <<EOF
@@ -147,7 +159,52 @@ check "killed sweep: no run outlives it" test -z "$(pgrep -P $job)"
 check "killed sweep: resumed to the uninterrupted bytes" cmp -s "$scratch/whole/results.csv" "$scratch/job/results.csv"
 check "killed sweep: only the missing runs ran again" \
 	test "$(wc -l <"$scratch/job/timings.csv")" -le $((8 + 2))
+check "killed sweep: what its runs left is removed on resume ($(ls -A "$scratch/job/runs" 2>&1 | head -3))" \
+	test ! -e "$scratch/job/runs"
 expect_failure "resume with another sweep" 3 "holds another sweep" "$plume" sweep "$scratch/grid.json" -o "$scratch/job"
+
+# --- files of the user's in DIR are neither removed nor replaced ---------------------
+# A run folder the sweep did not make (no marker) is refused before anything is written.
+mkdir -p "$scratch/own/runs/000000"
+echo mine >"$scratch/own/runs/mine.txt"
+echo keep >"$scratch/own/runs/000000/keep.txt"
+expect_failure "a run folder the user made" 4 "own/runs/000000: not a run folder of this sweep (it lacks .plume-sweep-run)" \
+	"$plume" sweep "$scratch/grid.json" -o "$scratch/own"
+check "a run folder the user made: its file kept" grep -qx keep "$scratch/own/runs/000000/keep.txt"
+check "a run folder the user made: nothing written" test ! -e "$scratch/own/sweep.json" -a ! -e "$scratch/own/results.csv"
+# Other files in DIR/runs stay, and so does DIR/runs with them.
+mv "$scratch/own/runs/000000" "$scratch/own-000000"
+"$plume" sweep "$scratch/grid.json" -o "$scratch/own" -j 2 >/dev/null 2>"$scratch/err.txt"
+succeeded "the user's file in DIR/runs: the sweep runs"
+check "the user's file in DIR/runs: kept" grep -qx mine "$scratch/own/runs/mine.txt"
+check "the user's file in DIR/runs: the sweep's run folders removed" test "$(ls -A "$scratch/own/runs")" = "mine.txt"
+check "the user's file in DIR/runs: same results" cmp -s "$scratch/j1/results.csv" "$scratch/own/results.csv"
+# A file the user put in a run folder of the sweep (kept with keep_runs) keeps that folder.
+sed 's/"outputs"/"keep_runs": true, "outputs"/' "$scratch/grid.json" >"$scratch/keep.json"
+"$plume" sweep "$scratch/keep.json" -o "$scratch/keep" >/dev/null 2>&1
+check "keep_runs: run folders kept" test -f "$scratch/keep/runs/000005/spec.json" -a -f "$scratch/keep/runs/000005/out/traction.json"
+echo note >"$scratch/keep/runs/000002/note.txt"
+sed -i '/^2,/d' "$scratch/keep/results.csv" # run 2 again, into its folder
+"$plume" sweep "$scratch/keep.json" -o "$scratch/keep" >/dev/null 2>&1
+check "a run again in its folder: the user's note kept" grep -qx note "$scratch/keep/runs/000002/note.txt"
+check "a run again in its folder: its row back" cmp -s "$scratch/j1/results.csv" "$scratch/keep/results.csv"
+# A new sweep does not replace a results.csv (or timings.csv, stats.json, plots/) it did not write.
+mkdir -p "$scratch/theirs" && echo theirs >"$scratch/theirs/results.csv"
+expect_failure "a results.csv not a sweep's" 4 "theirs/results.csv exists, but" "$plume" sweep "$scratch/grid.json" -o "$scratch/theirs"
+check "a results.csv not a sweep's: kept" grep -qx theirs "$scratch/theirs/results.csv"
+check "a results.csv not a sweep's: nothing written" test ! -e "$scratch/theirs/sweep.json"
+# -o naming a file, or a folder plume may not write: the real reason, not a held lock.
+echo x >"$scratch/afile"
+expect_failure "-o names a file" 4 "afile: not a folder" "$plume" sweep "$scratch/grid.json" -o "$scratch/afile"
+check "-o names a file: the file kept" grep -qx x "$scratch/afile"
+if [ "$(id -u)" -ne 0 ]; then
+	mkdir "$scratch/readonly" && chmod 555 "$scratch/readonly"
+	expect_failure "an unwritable DIR" 4 "readonly/.sweep.lock: cannot create the sweep's lock: Permission denied" \
+		"$plume" sweep "$scratch/grid.json" -o "$scratch/readonly"
+	chmod 755 "$scratch/readonly"
+else
+	echo "SKIP: unwritable DIR: root writes any folder"
+fi
 
 # --- random samples: reproducible, distributed as asked -----------------------
 cat >"$scratch/random.json" <<'EOF'
@@ -216,6 +273,37 @@ echo "{$base, \"parameters\": [{\"path\": \"\$.material.barb_fraction\", \"value
 expect_no_output "unknown sweep key" 3 '$.sample is not a sweep key; did you mean "samples"?' \
 	"$scratch/bad" "$plume" sweep "$scratch/bad-key.json" -o "$scratch/bad"
 expect_no_output "bad -j" 2 "-j expects a whole number" "$scratch/bad" "$plume" sweep "$scratch/grid.json" -o "$scratch/bad" -j 0
+echo "{$base, \"parameters\": [{\"path\": \"\$.material.barb_fraction\", \"values\": [0.1]}], \"outputs\": [\"slope_pa\", \"steps\", \"slope_pa\"]}" >"$scratch/dup-output.json"
+expect_no_output "an output twice" 3 '$.outputs[2]: "slope_pa" is already collected by $.outputs[0]' \
+	"$scratch/bad" "$plume" sweep "$scratch/dup-output.json" -o "$scratch/bad"
+expect_no_output "a sweep file that is not there" 4 "nonexist.json: cannot read: No such file or directory" \
+	"$scratch/bad" "$plume" sweep "$scratch/nonexist.json" -o "$scratch/bad"
+echo '{"command": "lab traction", "spec": "nospec.json", "parameters": [{"path": "$.x", "values": [1]}]}' >"$scratch/no-spec.json"
+expect_no_output "a base spec that is not there" 4 "\$.spec: $scratch/nospec.json: cannot read: No such file or directory" \
+	"$scratch/bad" "$plume" sweep "$scratch/no-spec.json" -o "$scratch/bad"
+echo "{$base, \"parameters\": [{\"path\": \"\$.material.barb_fraction\", \"grid\": {\"from\": 0.1, \"to\": 0.2, \"count\": 11}}, {\"path\": \"\$.material.E_b\", \"distribution\": \"uniform\", \"min\": 3e4, \"max\": 4e4}], \"samples\": 100000}" >"$scratch/huge.json"
+expect_no_output "more runs than any sweep may have" 5 'make 1100000 runs; a sweep may have at most 1000000' \
+	"$scratch/bad" "$plume" sweep "$scratch/huge.json" -o "$scratch/bad"
+# $.arguments: options the sweep sets, options the command does not take, values
+# missing, words that would be second specs; all before any run.
+arguments_refused() { # arguments_refused NAME ARGUMENTS_JSON MESSAGE
+	echo "{$base, \"parameters\": [{\"path\": \"\$.material.barb_fraction\", \"values\": [0.1, 0.2]}], \"arguments\": $2}" >"$scratch/args.json"
+	expect_no_output "$1" 3 "$3" "$scratch/bad" "$plume" sweep "$scratch/args.json" -o "$scratch/bad"
+}
+arguments_refused "an unknown option" '["--bogus"]' "\$.arguments: plume lab traction refuses them: unknown option '--bogus'"
+arguments_refused "-o in the arguments" '["-o", "/x"]' "\$.arguments[0]: '-o' (--output) is refused in a sweep: the sweep gives each run its own output folder"
+arguments_refused "--output abbreviated" '["--out=/x"]' "'--out=/x' (--output) is refused in a sweep"
+arguments_refused "--help in the arguments" '["--help"]' "'--help' (--help) is refused in a sweep"
+arguments_refused "a value missing" '["--max-memory"]' "\$.arguments[0]: '--max-memory' needs a value after it"
+arguments_refused "a bad value" '["--max-memory", "lots"]' "\$.arguments: plume lab traction refuses them:"
+arguments_refused "a second spec" '["--max-memory", "1G", "other.json"]' "\$.arguments[2]: 'other.json' is neither an option of plume lab traction nor an option's value"
+echo '{"command": "lab calibrate", "spec": {"phi": 0.14, "Eb": 3.92e4, "EB": 2.57e9}, "parameters": [{"path": "$.phi", "values": [0.1, 0.2]}], "arguments": ["--phi", "0.3"]}' >"$scratch/args-cal.json"
+expect_no_output "a calibration option in the arguments" 3 "'--phi' (--phi) is refused in a sweep: set \$.spec.phi instead" \
+	"$scratch/bad" "$plume" sweep "$scratch/args-cal.json" -o "$scratch/bad"
+echo "{$base, \"parameters\": [{\"path\": \"\$.material.barb_fraction\", \"values\": [0.1]}], \"arguments\": [\"--max-memory\", \"1G\"], \"outputs\": [\"slope_pa\"]}" >"$scratch/args-ok.json"
+"$plume" sweep "$scratch/args-ok.json" -o "$scratch/args-ok" >/dev/null 2>"$scratch/err.txt"
+succeeded "arguments the command takes: the sweep runs"
+check "arguments the command takes: the run ok" grep -q '^0,0.1,[0-9.e+]*,ok,$' "$scratch/args-ok/results.csv"
 
 # --- frames: ranges rendered apart (render --frames, a sweep) equal one render -----
 sed 's/"duration": 1.1/"duration": 0.033/' "$source_dir/examples/scenes/figure1-anisotropic.json" |
@@ -243,31 +331,86 @@ check "frames sweep: 2 ranges ok ($(cat "$scratch/err.txt"))" test "$(grep -c ',
 for f in 0000 0001 0002 0003; do
 	check "frames sweep: frame $f equals the whole render's" cmp -s "$scratch/render-all/frames/$f.png" "$scratch/render-sweep/frames/$f.png"
 done
+# Rendering into the simulation's own folder would replace its frames: refused.
+sed 's/"output": "render-sweep"/"output": "sim"/' "$scratch/frames.json" >"$scratch/frames-into-sim.json"
+ls -l "$scratch/sim" "$scratch/sim/frames" >"$scratch/sim-before.txt"
+expect_no_output "frames sweep into the simulation's folder" 3 \
+	"\$.output ($scratch/sim) is the same folder as \$.simulation ($scratch/sim): the rendered frames would replace the simulation's frames" \
+	"$scratch/frames-bad" "$plume" sweep "$scratch/frames-into-sim.json" -o "$scratch/frames-bad"
+sed 's/"output": "render-sweep"/"output": "sim\/frames"/' "$scratch/frames.json" >"$scratch/frames-into-sim.json"
+expect_no_output "frames sweep into the simulation's frames" 3 "is the frames folder of \$.simulation" \
+	"$scratch/frames-bad" "$plume" sweep "$scratch/frames-into-sim.json" -o "$scratch/frames-bad"
+check "frames sweep into the simulation: its files untouched" test "$(ls -l "$scratch/sim" "$scratch/sim/frames")" = "$(cat "$scratch/sim-before.txt")"
 
-# --- every output key the sweep accepts is one a real run writes ---------------
-# The sweep checks output keys against its own lists before any run; here every
-# listed key is asked of a real run and must come back non-empty.
-all_keys() { # all_keys SWEEP_WITHOUT_OUTPUTS: the keys the unknown-output message lists
+# --- the output keys the sweep accepts are the ones a real run writes ------------
+# The sweep checks output keys against its lists (cli/sweep_commands.c) before any run.
+# Here the list is compared with a real run's result file both ways: every number and
+# boolean in the file is a listed key (so a key added to a writer fails here until it is
+# listed), every listed key not marked "(when ...)" is in the file; then a few keys,
+# nested, indexed and named ones among them, come back through results.csv.
+listed_keys() { # listed_keys SWEEP_WITHOUT_OUTPUTS: the keys the unknown-output message lists, one a line
 	sed 's/}$/, "outputs": ["?"]}/' "$1" >"$scratch/keys.json"
-	"$plume" sweep "$scratch/keys.json" -o "$scratch/bad" 2>&1 | sed -n 's/.* writes: //p' | tr -d ' '
+	"$plume" sweep "$scratch/keys.json" -o "$scratch/bad" 2>&1 | sed -n 's/.* writes: //p' | sed 's/, /\n/g'
 }
-every_key_written() { # every_key_written NAME SWEEP_WITHOUT_OUTPUTS
-	local keys
-	keys=$(all_keys "$2")
-	check "$1: keys listed" test -n "$keys"
-	sed "s/}\$/, \"outputs\": [\"${keys//,/\",\"}\"]}/" "$2" >"$scratch/all.json"
+keys_match_writer() { # keys_match_writer NAME SWEEP_WITHOUT_OUTPUTS RESULT_FILE OUTPUTS_JSON
+	listed_keys "$2" >"$scratch/listed.txt"
+	check "$1: keys listed" test -s "$scratch/listed.txt"
+	sed "s/}\$/, \"keep_runs\": true, \"outputs\": $4}/" "$2" >"$scratch/all.json"
 	rm -rf "$scratch/all"
 	"$plume" sweep "$scratch/all.json" -o "$scratch/all" >/dev/null 2>"$scratch/err.txt"
-	check "$1: every listed key has a value ($(tail -1 "$scratch/all/results.csv" 2>/dev/null))" \
-		awk -F, -v n="$(echo "$keys" | tr ',' '\n' | wc -l)" 'NR == 2 { for (i = 3; i < 3 + n; ++i) if ($i == "") bad = 1; if ($(3 + n) != "ok") bad = 1 } END { exit bad || NR != 2 }' "$scratch/all/results.csv"
+	succeeded "$1: the sweep succeeds"
+	check "$1: the listed keys are the result file's numbers and booleans" "$py" - "$scratch/listed.txt" \
+		"$scratch/all/runs/000000/$3" <<'EOF'
+import json, re, sys
+listed = [line.rstrip("\n") for line in open(sys.argv[1]) if line.strip()]
+text = open(sys.argv[2]).read()
+written = {}
+def walk(node, path):
+    if isinstance(node, dict):
+        for k, v in node.items(): walk(v, f"{path}.{k}" if path else k)
+    elif isinstance(node, list):
+        for i, v in enumerate(node): walk(v, f"{path}[{i}]")
+    elif not isinstance(node, str):  # numbers, booleans, null (a measure never defined)
+        written[path] = node
+walk(json.loads(text), "")
+# A Zhang-Kanai summary's list of unsnapped barbs varies in length: not an output.
+written = {k: v for k, v in written.items() if not k.startswith("snapping.unsnapped_barbs")}
+def pattern(key):
+    return re.compile(re.escape(key).replace(re.escape("<group>"), "[A-Za-z0-9_-]+")
+                      .replace(re.escape("<handle>"), "[0-9]+").replace(re.escape("<feather>"), "[0-9]+") + "$")
+keys = [(line.split(" (")[0], " (" in line) for line in listed]
+bad = [k for k in written if not any(pattern(key).match(k) for key, _ in keys)]
+missing = [key for key, conditional in keys if not conditional and not any(pattern(key).match(k) for k in written)]
+if bad or missing:
+    sys.exit(f"written, not listed: {bad}; listed, not written: {missing}")
+EOF
+	check "$1: the outputs asked have values ($(tail -1 "$scratch/all/results.csv" 2>/dev/null))" \
+		awk -F, -v n="$(echo "$4" | tr ',' '\n' | wc -l)" 'NR == 2 { for (i = 3; i < 3 + n; ++i) if ($i == "") bad = 1; if ($(3 + n) != "ok") bad = 1 } END { exit bad || NR != 2 }' "$scratch/all/results.csv"
 }
 echo "{\"command\": \"simulate\", \"spec\": \"$source_dir/examples/scenes/figure1-anisotropic.json\", \"parameters\": [{\"path\": \"\$.duration\", \"values\": [0.011]}]}" >"$scratch/k-simulate.json"
-every_key_written simulate "$scratch/k-simulate.json"
+keys_match_writer simulate "$scratch/k-simulate.json" out/summary.json \
+	'["mesh_vane_min_angle_deg", "mesh_excepted_count", "vane_min_principal_stretch", "seconds_contact", "duration", "handle_max_reaction[1]", "feathers[0].face_count"]'
 echo "{\"command\": \"mesh\", \"spec\": \"$source_dir/examples/meshes/guides.json\", \"parameters\": [{\"path\": \"\$.mesh.edge_length\", \"values\": [0.004]}]}" >"$scratch/k-mesh.json"
-every_key_written mesh "$scratch/k-mesh.json"
+keys_match_writer mesh "$scratch/k-mesh.json" out/report.json \
+	'["vane_min_angle_deg", "excepted_count", "guide_count[1]", "groups.rachis_clamp"]'
 echo "{$base, \"parameters\": [{\"path\": \"\$.material.barb_fraction\", \"values\": [0.14]}]}" >"$scratch/k-traction.json"
-every_key_written "lab traction" "$scratch/k-traction.json"
+keys_match_writer "lab traction" "$scratch/k-traction.json" out/traction.json '["slope_pa", "compression"]'
 echo '{"command": "lab calibrate", "spec": {"phi": 0.14, "Eb": 3.92e4, "EB": 2.57e9, "phases": 1, "elements": 300, "macro_elements": 200}, "parameters": [{"path": "$.phi", "values": [0.14]}]}' >"$scratch/k-calibrate.json"
-every_key_written "lab calibrate" "$scratch/k-calibrate.json"
+keys_match_writer "lab calibrate" "$scratch/k-calibrate.json" stdout.txt \
+	'["slopes.longitudinal", "spread.E_vw.total", "protocol.barb_constraint", "E_vw"]'
+echo "{\"command\": \"generate\", \"spec\": \"$source_dir/examples/zhang-kanai/figure11-expansion.json\", \"arguments\": [\"-f\", \"json\"], \"parameters\": [{\"path\": \"\$.seed\", \"values\": [1]}]}" >"$scratch/k-generate.json"
+keys_match_writer generate "$scratch/k-generate.json" out/summary.json '["barbs.left", "snapping.partial", "expansion"]'
+# What the first run has: a group of its mesh, a handle of its scene; a summary at all.
+sed 's/}$/, "outputs": ["groups.rachis_clamps"]}/' "$scratch/k-mesh.json" >"$scratch/k-bad.json"
+expect_no_output "an output naming a group the mesh lacks" 3 \
+	'$.outputs[0]: the first run'"'"'s mesh has no group "rachis_clamps"; its groups: rachis,' \
+	"$scratch/bad" "$plume" sweep "$scratch/k-bad.json" -o "$scratch/bad"
+sed 's/}$/, "outputs": ["handle_max_reaction[2]"]}/' "$scratch/k-simulate.json" >"$scratch/k-bad.json"
+expect_no_output "an output naming a handle the scene lacks" 3 \
+	"\$.outputs[0]: handle_max_reaction[2]: the first run's scene has 2 handles" \
+	"$scratch/bad" "$plume" sweep "$scratch/k-bad.json" -o "$scratch/bad"
+echo "{\"command\": \"generate\", \"spec\": \"$source_dir/examples/franco-walter/blue.json\", \"parameters\": [{\"path\": \"\$.seed\", \"values\": [1]}], \"outputs\": [\"barbs.left\"]}" >"$scratch/k-bad.json"
+expect_no_output "generate outputs of a feather with no summary" 3 "generate writes its outputs (summary.json) for Zhang-Kanai feathers only" \
+	"$scratch/bad" "$plume" sweep "$scratch/k-bad.json" -o "$scratch/bad"
 
 finish
