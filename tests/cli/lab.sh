@@ -21,6 +21,20 @@ check "traction: SVG root" grep -q '<svg' "$out/traction.svg"
 slope=$(sed -n 's/.*"slope_pa": \([0-9.e+-]*\).*/\1/p' "$out/traction.json")
 check "traction: slope $slope within 1e-3 of eq. 5.5" awk -v s="$slope" 'BEGIN { r = s / (1.2245181125 * 39200); exit !(r > 0.999 && r < 1.001) }'
 check "traction: slope printed" grep -q '^slope: ' "$scratch/out.txt"
+# Numbers for reuse in their shortest round-trip form (a %.10g slope_pa lost digits).
+shortest_numbers() { # shortest_numbers FILE...: every number in the files reads back in as few digits as Python's repr
+	python3 - "$@" <<'PY'
+import re, sys
+def significant(text):
+    digits = re.sub(r"[^0-9]", "", re.split(r"[eE]", text)[0]).lstrip("0").rstrip("0")
+    return len(digits)
+for path in sys.argv[1:]:
+    for token in re.findall(r"(?<![\w.])-?[0-9][0-9.]*(?:e[-+]?[0-9]+)?", open(path).read()):
+        x = float(token)
+        assert significant(token) == significant(repr(x)) and significant(token) <= 17, (path, token, repr(x))
+PY
+}
+check "traction: traction.json and traction.csv in shortest round-trip form" shortest_numbers "$out/traction.json" "$out/traction.csv"
 # Same input, same bytes.
 "$plume" lab traction "$examples/transverse-mesoscale.json" -o "$scratch/again" >/dev/null 2>&1
 for file in traction.csv traction.json traction.png traction.svg; do
@@ -103,7 +117,16 @@ assert r['spread']['E_vw']['width'] > 0 and 0.5 < r['sensitivity'] < 1
 p = r['protocol']
 assert p['name'] == 'custom' and p['tilted_strain_max'] == 0.1 and p['compression_coefficient'] == 0, p
 assert p['barb_constraint'] is False and p['macroscale_elements'] == 'quadratic' and p['barbs_across'] == 10, p
+# Full precision: the moduli are the slopes they match, bit for bit, and slopes.csv holds them too
+# (E_vv was printed as 3.59834e+08, the slope 3.5983371e+08).
+s = r['slopes']
+assert r['E_vv'] == s['longitudinal'] and r['E_ww'] == s['transverse'], (r['E_vv'], s)
+import csv
+rows = {(x['test'], x['model']): float(x['slope_pa']) for x in csv.DictReader(open('$scratch/cal/slopes.csv'))}
+assert rows[('longitudinal', 'mesoscale')] == s['longitudinal'] and rows[('transverse', 'mesoscale')] == s['transverse']
+assert rows[('tilted', 'mesoscale')] == s['tilted_mesoscale'] and rows[('tilted', 'macroscale')] == s['tilted_macroscale']
 "
+check "calibrate: JSON, slopes.csv and curves.csv in shortest round-trip form" shortest_numbers "$scratch/cal.json" "$scratch/cal/slopes.csv" "$scratch/cal/curves.csv"
 
 # No answer: H/W and W/H swapped, the barbs run from clamp to clamp and, under the
 # old protocol (eps_max 0.4 with Kikuuwe's term at kappa = 5.04e7 Pa, linear triangles), the mesoscale tilted slope is below
