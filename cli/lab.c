@@ -372,6 +372,59 @@ static int write_calibration(const char *dir, const plume_calibration_def *def, 
 	return status == PLUME_OK ? CLI_EXIT_OK : cli_fail(&err);
 }
 
+/// The largest magnitude of any number plume reads from a file (src/io/spec.h): a lab file's
+/// E_B of 1e300 is refused, and so is the option's.
+static const double MAX_MAGNITUDE = 1e12;
+
+/// The values of calibrate's options, each against what it is allowed alone and then with the
+/// others (the tilted sample, --width by --aspect x --width, must hold whole barbs that its mesh
+/// resolves): a message naming the options. The library checks the same again (and what the
+/// options cannot reach) in the names of plume_calibration_def's fields.
+static plume_status check_calibrate_options(const plume_calibration_def *def, plume_error *err)
+{
+	const double phi = def->mesoscale.bands.barb_fraction, period = def->mesoscale.bands.period;
+	const double width = def->sample.width, aspect = def->aspect_ratio, height = aspect * width;
+#define REQUIRE(condition, format, ...)                                                                                \
+	if (!(condition))                                                                                                  \
+		return plume_error_set(err, PLUME_ERROR_SPEC, format, __VA_ARGS__);
+	REQUIRE(phi > 0.0 && phi < 1.0, "--phi is %g, allowed in (0, 1)", phi);
+	REQUIRE(def->mesoscale.E_b > 0.0 && def->mesoscale.E_b <= MAX_MAGNITUDE, "--Eb is %g Pa, allowed in (0, 1e12]",
+	        def->mesoscale.E_b);
+	REQUIRE(def->mesoscale.E_B > 0.0 && def->mesoscale.E_B <= MAX_MAGNITUDE, "--EB is %g Pa, allowed in (0, 1e12]",
+	        def->mesoscale.E_B);
+	REQUIRE(def->mesoscale.compression_coefficient >= 0.0 && def->mesoscale.compression_coefficient <= MAX_MAGNITUDE,
+	        "--compression is %g Pa, allowed in [0, 1e12]", def->mesoscale.compression_coefficient);
+	REQUIRE(def->tilted_strain_max > 0.0 && def->tilted_strain_max <= 10.0, "--tilted-strain is %g, allowed in (0, 10]",
+	        def->tilted_strain_max);
+	REQUIRE(width >= 1e-6 && width <= 10.0, "--width is %g m, allowed in [1e-06, 10]", width);
+	REQUIRE(aspect >= 1e-3 && aspect <= 1e3,
+	        "--aspect is %g: the tilted sample's aspect ratio H/W, allowed in [0.001, 1000]", aspect);
+	REQUIRE(height >= 1e-6 && height <= 10.0,
+	        "--aspect %g and --width %g m make the tilted sample %g m high, allowed in [1e-06, 10]", aspect, width,
+	        height);
+	REQUIRE(period > 0.0 && period <= fmin(width, height),
+	        "--period is %g m, allowed in (0, %g]: at most the side of the tilted sample, %g m wide (--width) and %g m "
+	        "high (--aspect x --width), so that it holds a whole barb",
+	        period, fmin(width, height), width, height);
+	// As plume_sample_validate: at most 100000 periods across, no band under 1e-6 of the larger side.
+	REQUIRE((width + height) / period <= 1e5,
+	        "--period is %g m, allowed >= %g m: at most 100000 periods across the %g x %g m tilted sample", period,
+	        (width + height) / 1e5, width, height);
+	double least = 1e-6 * fmax(width, height) / period;
+	REQUIRE(phi >= least && phi <= 1.0 - least,
+	        "--phi is %s, allowed in [%g, %g] at --period %g m: its %s bands would be %g m wide, narrower than a "
+	        "millionth of the %g x %g m tilted sample",
+	        number(phi).text, least, 1.0 - least, period, phi <= 0.5 ? "barb" : "barbule",
+	        period * fmin(phi, 1.0 - phi), width, height);
+	REQUIRE(def->sample.element_count >= 2 && def->sample.element_count <= 4000000,
+	        "--elements is %d, allowed in [2, 4000000]", def->sample.element_count);
+	REQUIRE(def->macroscale_elements >= 2 && def->macroscale_elements <= 4000000,
+	        "--macro-elements is %d, allowed in [2, 4000000]", def->macroscale_elements);
+	REQUIRE(def->phase_count >= 1 && def->phase_count <= 64, "--phases is %d, allowed in [1, 64]", def->phase_count);
+#undef REQUIRE
+	return PLUME_OK;
+}
+
 static int run_calibrate(int argc, char **argv)
 {
 	static const struct option options[] = {
@@ -441,10 +494,8 @@ static int run_calibrate(int argc, char **argv)
 	if (!phi_given || !Eb_given || !EB_given)
 		return cli_usage_error("lab", "calibrate needs --phi, --Eb and --EB");
 	plume_error err = {0};
-	if (!(def.mesoscale.bands.barb_fraction > 0.0 && def.mesoscale.bands.barb_fraction < 1.0)) {
-		fprintf(stderr, "plume: --phi is %g, allowed in (0, 1)\n", def.mesoscale.bands.barb_fraction);
-		return CLI_EXIT_INPUT;
-	}
+	if (check_calibrate_options(&def, &err) != PLUME_OK)
+		return cli_fail(&err);
 	char what[160];
 	snprintf(what, sizeof what, "--elements %d and --macro-elements %d (%s)", def.sample.element_count,
 	         def.macroscale_elements, def.uncertainty ? "twice the larger for the spreads" : "the larger");

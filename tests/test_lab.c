@@ -318,7 +318,19 @@ static void test_sample_errors(void **state)
 	bands = plume_band_default_def();
 	bands.period = 1e-9;
 	assert_int_equal(plume_sample_mesh(&def, &bands, &mesh, &err), PLUME_ERROR_SPEC);
-	assert_non_null(strstr(err.message, "band_period"));
+	assert_non_null(strstr(err.message, "material.band_period is 1e-09 m, allowed >= 2.3e-07 m"));
+	// Bands too narrow to mesh at the default period: the barb fraction is at fault, not the
+	// period (the message blamed band_period), and all its digits are shown (not "is 1").
+	bands = plume_band_default_def();
+	bands.barb_fraction = 1e-9;
+	assert_int_equal(plume_sample_mesh(&def, &bands, &mesh, &err), PLUME_ERROR_SPEC);
+	assert_ptr_equal(strstr(err.message, "material.barb_fraction is 1e-09, allowed in [3.25e-05, 0.999968] at "
+	                                     "material.band_period 0.0004 m: its barb bands"),
+	                 err.message);
+	bands.barb_fraction = 0.9999999999;
+	assert_int_equal(plume_sample_mesh(&def, &bands, &mesh, &err), PLUME_ERROR_SPEC);
+	assert_ptr_equal(strstr(err.message, "material.barb_fraction is 0.9999999999, allowed"), err.message);
+	assert_non_null(strstr(err.message, "its barbule bands"));
 	assert_null(mesh);
 }
 
@@ -1067,6 +1079,8 @@ static void test_lab_spec(void **state)
 	expect_spec_error(dir, "{\"sample\": {\"mesh\": \"delaunay\"}}", "$.sample.mesh");
 	expect_spec_error(dir, "{\"sample\": {\"widht\": 1}}", "width");
 	expect_spec_error(dir, "{\"material\": {\"model\": \"mesoscale\", \"band_period\": 1e-12}}", "band_period");
+	expect_spec_error(dir, "{\"material\": {\"model\": \"mesoscale\", \"barb_fraction\": 1e-9}}",
+	                  "lab.json: $.material.barb_fraction is 1e-09, allowed in [3.25e-05, 0.999968]");
 	expect_spec_error(dir, "{\"sample\": {\"mesh\": \"unaligned\"}, \"material\": {\"barb_constraint\": true}}",
 	                  "aligned");
 	test_remove_tree(dir);
@@ -1096,6 +1110,18 @@ static void test_calibration_errors(void **state)
 	def.mesoscale.bands.period = 1.0; // longer than the sample
 	assert_int_equal(plume_lab_calibrate(&def, &result, &err), PLUME_ERROR_SPEC);
 	assert_non_null(strstr(err.message, "period"));
+	// A sample 0 m wide: the width is at fault (it said "band period 0.0004 m is larger than
+	// the 0 x 0 m sample").
+	def = plume_calibration_default_def();
+	def.sample.width = 0.0;
+	assert_int_equal(plume_lab_calibrate(&def, &result, &err), PLUME_ERROR_SPEC);
+	assert_string_equal(err.message, "sample.width is 0 m, allowed [1e-06, 10]");
+	// Bands too narrow to mesh are refused before the first test, naming the fraction.
+	def = plume_calibration_default_def();
+	def.mesoscale.bands.barb_fraction = 1e-9;
+	assert_int_equal(plume_lab_calibrate(&def, &result, &err), PLUME_ERROR_SPEC);
+	assert_ptr_equal(strstr(err.message, "material.barb_fraction is 1e-09"), err.message);
+	assert_int_equal(result.traction_count, 0);
 }
 
 int main(void)

@@ -57,6 +57,8 @@ bad "zero strain" '{"traction": {"strain_max": 0}}' '$.traction.strain_max is 0'
 bad "unknown key" '{"traction": {"strain_mx": 0.1}}' 'strain_max'
 bad "bad mesh" '{"sample": {"mesh": "random"}}' '$.sample.mesh'
 bad "bad elements" '{"material": {"elements": "cubic"}}' '$.material.elements: is "cubic", allowed "linear" or "quadratic"'
+# Bands too narrow to mesh: the barb fraction is at fault (the message blamed band_period).
+bad "barb fraction 1e-9" '{"material": {"model": "mesoscale", "barb_fraction": 1e-9}}' 'bad.json: $.material.barb_fraction is 1e-09, allowed in [3.25e-05, 0.999968] at material.band_period 0.0004 m'
 bad "quadratic constrained" '{"material": {"elements": "quadratic", "barb_constraint": true}}' 'barb constraint needs the simulator'
 expect_failure "missing file" 4 "missing.json" "$plume" lab traction "$scratch/missing.json" -o "$scratch/x"
 check "missing file: nothing written" test ! -e "$scratch/x"
@@ -68,7 +70,16 @@ expect_failure "unknown action" 2 "unknown action 'pull'" "$plume" lab pull
 expect_failure "calibrate without moduli" 2 "needs --phi, --Eb and --EB" "$plume" lab calibrate --phi 0.14
 expect_failure "calibrate phi 0" 3 "allowed in (0, 1)" "$plume" lab calibrate --phi 0 --Eb 3.92e4 --EB 2.57e9
 expect_failure "calibrate phi 1.5" 3 "allowed in (0, 1)" "$plume" lab calibrate --phi 1.5 --Eb 3.92e4 --EB 2.57e9
-expect_failure "calibrate negative Eb" 3 "E_b is -1" "$plume" lab calibrate --phi 0.14 --Eb -1 --EB 2.57e9
+expect_failure "calibrate negative Eb" 3 "--Eb is -1 Pa, allowed in (0, 1e12]" "$plume" lab calibrate --phi 0.14 --Eb -1 --EB 2.57e9
+# The bounds of a lab file (|x| <= 1e12) hold for the options too: --EB 1e300 diverged (free forces 6.24e+284).
+expect_failure "calibrate EB 1e300" 3 "--EB is 1e+300 Pa, allowed in (0, 1e12]" "$plume" lab calibrate --phi 0.14 --Eb 3.92e4 --EB 1e300
+check "calibrate EB 1e300: nothing on stdout" test ! -s "$scratch/out.txt"
+expect_failure "calibrate compression 1e300" 3 "--compression is 1e+300 Pa, allowed in [0, 1e12]" "$plume" lab calibrate --phi 0.14 --Eb 3.92e4 --EB 2.57e9 --compression 1e300
+# Each value error names its option (--width 0 blamed "band period 0.0004 m").
+expect_failure "calibrate width 0" 3 "--width is 0 m, allowed in [1e-06, 10]" "$plume" lab calibrate --phi 0.14 --Eb 3.92e4 --EB 2.57e9 --width 0
+expect_failure "calibrate period past the sample" 3 "--period is 0.01 m, allowed in (0, 0.004]" "$plume" lab calibrate --phi 0.14 --Eb 3.92e4 --EB 2.57e9 --period 0.01
+expect_failure "calibrate phi 1e-9" 3 "--phi is 1e-09, allowed in [1.3e-05, 0.999987] at --period 0.0004 m" "$plume" lab calibrate --phi 1e-9 --Eb 3.92e4 --EB 2.57e9
+expect_failure "calibrate elements 1" 3 "--elements is 1, allowed in [2, 4000000]" "$plume" lab calibrate --phi 0.14 --Eb 3.92e4 --EB 2.57e9 --elements 1
 expect_failure "calibrate aspect" 3 "aspect ratio" "$plume" lab calibrate --phi 0.14 --Eb 3.92e4 --EB 2.57e9 --aspect 0.0001
 expect_failure "calibrate not a number" 2 "--aspect expects a number" "$plume" lab calibrate --phi 0.14 --Eb 3.92e4 --EB 2.57e9 --aspect tall
 # A coarse, quick calibration: E_vv and E_ww of thesis Table 5.2.
