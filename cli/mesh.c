@@ -58,6 +58,38 @@ static bool parse_length(const char *text, double *out)
 	return true;
 }
 
+/// Parses --format: a comma-separated list of obj, png and glb (the formats a mesh is
+/// written in; cli_parse_formats knows a feather's too). False after the usage message.
+static bool parse_mesh_formats(const char *list, unsigned *formats)
+{
+	static const struct {
+		const char *name;
+		unsigned bit;
+	} names[] = {{"obj", CLI_FORMAT_OBJ}, {"png", CLI_FORMAT_PNG}, {"glb", CLI_FORMAT_GLB}};
+	*formats = 0;
+	for (const char *cursor = list; *cursor != '\0';) {
+		size_t length = strcspn(cursor, ",");
+		size_t i = 0;
+		while (i < sizeof names / sizeof names[0] &&
+		       !(strlen(names[i].name) == length && strncmp(cursor, names[i].name, length) == 0))
+			++i;
+		if (i == sizeof names / sizeof names[0]) {
+			cli_usage_error("mesh", "unknown format '%.*s' in --format: a mesh writes obj, png, glb", (int)length,
+			                cursor);
+			return false;
+		}
+		*formats |= names[i].bit;
+		cursor += length;
+		if (*cursor == ',')
+			++cursor;
+	}
+	if (*formats == 0) {
+		cli_usage_error("mesh", "--format needs at least one of obj, png, glb");
+		return false;
+	}
+	return true;
+}
+
 // ---------------------------------------------------------------------------
 // Picture of the reference mesh
 
@@ -209,10 +241,8 @@ int cli_mesh(int argc, char **argv)
 				return CLI_EXIT_USAGE;
 			break;
 		case 'f':
-			if (!cli_parse_formats("mesh", optarg, &formats))
+			if (!parse_mesh_formats(optarg, &formats))
 				return CLI_EXIT_USAGE;
-			if ((formats & ~(unsigned)(CLI_FORMAT_OBJ | CLI_FORMAT_PNG | CLI_FORMAT_GLB)) != 0)
-				return cli_usage_error("mesh", "--format '%s': a mesh writes obj, png, glb", optarg);
 			break;
 		case 'M':
 			if (!cli_parse_memory("mesh", optarg, &spec_options.max_memory))
