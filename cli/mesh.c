@@ -174,6 +174,13 @@ static plume_status write_report(const plume_mesh *mesh, const plume_mesh_report
 	int rachis_faces = 0;
 	for (int f = 0; f < mesh->face_count; ++f)
 		rachis_faces += mesh->material[f] == PLUME_MATERIAL_RACHIS;
+	// null when every vane face is a junction face (or there is none): no angle to report,
+	// where plume_mesh_report holds pi.
+	int measured_faces = mesh->face_count - rachis_faces - report->excepted_count;
+	char vane_min_angle[32] = "null";
+	if (measured_faces > 0)
+		snprintf(vane_min_angle, sizeof vane_min_angle, "%.6f",
+		         report->vane_min_angle * 180.0 / 3.14159265358979323846);
 	fprintf(stream,
 	        "{\n"
 	        "  \"edge_length\": %.17g,\n"
@@ -183,7 +190,7 @@ static plume_status write_report(const plume_mesh *mesh, const plume_mesh_report
 	        "  \"vane_face_count\": %d,\n"
 	        "  \"barb_edge_count\": %d,\n"
 	        "  \"min_angle_deg\": %.6f,\n"
-	        "  \"vane_min_angle_deg\": %.6f,\n"
+	        "  \"vane_min_angle_deg\": %s,\n"
 	        "  \"excepted_count\": %d,\n"
 	        "  \"aligned_fraction\": %.17g,\n"
 	        "  \"guides_dropped\": %d,\n"
@@ -192,10 +199,9 @@ static plume_status write_report(const plume_mesh *mesh, const plume_mesh_report
 	        "  \"guide_count\": [%d, %d],\n"
 	        "  \"groups\": {",
 	        report->edge_length, mesh->vertex_count, mesh->face_count, rachis_faces, mesh->face_count - rachis_faces,
-	        mesh->barb_edge_count, report->min_angle * 180.0 / 3.14159265358979323846,
-	        report->vane_min_angle * 180.0 / 3.14159265358979323846, report->excepted_count, report->aligned_fraction,
-	        report->guides_dropped, report->barbs_averaged, report->vertices_trimmed, report->guide_count[0],
-	        report->guide_count[1]);
+	        mesh->barb_edge_count, report->min_angle * 180.0 / 3.14159265358979323846, vane_min_angle,
+	        report->excepted_count, report->aligned_fraction, report->guides_dropped, report->barbs_averaged,
+	        report->vertices_trimmed, report->guide_count[0], report->guide_count[1]);
 	for (int g = 0; g < mesh->group_count; ++g)
 		fprintf(stream, "%s\"%s\": %d", g > 0 ? ", " : "", mesh->groups[g].name, mesh->groups[g].count);
 	fprintf(stream, "}\n}\n");

@@ -24,6 +24,19 @@ fine=$(grep -c '^v ' "$scratch/fine/mesh.obj")
 check "fine: more vertices ($fine > 2 x $coarse)" test "$fine" -gt $((2 * coarse))
 check "fine: edge length in report" grep -q '"edge_length": 0.0025' "$scratch/fine/report.json"
 
+# Every vane face a junction face (the filoplume at 5 mm): no angle to report, null (it read
+# 180, the pi the library holds then); a hawk's vane has one.
+"$plume" mesh "$source_dir/examples/streit-heidrich/filoplume.json" -o "$scratch/filoplume" -e 0.005 2>"$scratch/err.txt"
+succeeded "filoplume: exit 0"
+check "filoplume: vane_min_angle_deg null, every vane face excepted" python3 -c "
+import json
+r = json.load(open('$scratch/filoplume/report.json'))
+assert r['vane_face_count'] > 0 and r['excepted_count'] == r['vane_face_count'], r
+assert r['vane_min_angle_deg'] is None, r['vane_min_angle_deg']
+h = json.load(open('$scratch/hawk/report.json'))
+assert h['excepted_count'] < h['vane_face_count'] and 20 <= h['vane_min_angle_deg'] < 60, h
+"
+
 # A guides spec.
 "$plume" mesh "$source_dir/examples/meshes/guides.json" -o "$scratch/guides" 2>"$scratch/err.txt"
 check "guides: exit 0" test $? -eq 0
