@@ -84,6 +84,19 @@ static bool parse_int(const char *option, const char *text, int *out)
 	return true;
 }
 
+/// A number for reuse, as plume_lab_format_number writes it; the text lives until the end
+/// of the full expression that holds the call (a printf's arguments).
+typedef struct number_text {
+	char text[PLUME_LAB_NUMBER_TEXT];
+} number_text;
+
+static number_text number(double value)
+{
+	number_text n;
+	plume_lab_format_number(n.text, sizeof n.text, value);
+	return n;
+}
+
 // ---------------------------------------------------------------------------
 // traction
 
@@ -111,15 +124,15 @@ static plume_status write_traction(cli_output *output, const plume_traction_resu
 	if (status != PLUME_OK)
 		return status;
 	FILE *file = fopen(cli_output_path(output, "traction.json", path, sizeof path), "wb");
-	bool written = file != NULL &&
-	               fprintf(file,
-	                       "{\"slope_pa\": %.10g, \"strain_max\": %.10g, \"steps\": %d, "
-	                       "\"newton_iterations\": %d, \"lateral_strain\": %.6g, "
-	                       "\"model\": \"%s\", \"barb_angle_deg\": %.10g, \"compression\": %s}\n",
-	                       r->slope, spec->traction.strain_max, spec->traction.steps, r->newton_iterations,
-	                       r->lateral_strain, spec->material.model == PLUME_LAB_MESOSCALE ? "mesoscale" : "macroscale",
-	                       spec->sample.barb_angle * 180.0 / 3.14159265358979323846,
-	                       spec->traction.compression ? "true" : "false") >= 0;
+	bool written = file != NULL && fprintf(file,
+	                                       "{\"slope_pa\": %s, \"strain_max\": %s, \"steps\": %d, "
+	                                       "\"newton_iterations\": %d, \"lateral_strain\": %s, "
+	                                       "\"model\": \"%s\", \"barb_angle_deg\": %s, \"compression\": %s}\n",
+	                                       number(r->slope).text, number(spec->traction.strain_max).text,
+	                                       spec->traction.steps, r->newton_iterations, number(r->lateral_strain).text,
+	                                       spec->material.model == PLUME_LAB_MESOSCALE ? "mesoscale" : "macroscale",
+	                                       number(spec->sample.barb_angle * 180.0 / 3.14159265358979323846).text,
+	                                       spec->traction.compression ? "true" : "false") >= 0;
 	if (file != NULL && fclose(file) != 0)
 		written = false;
 	if (!written)
@@ -220,44 +233,48 @@ static int run_traction(int argc, char **argv)
 
 static void print_spread(FILE *out, const char *name, const plume_modulus_spread *p, bool last)
 {
-	fprintf(out, "    \"%s\": {\"phase\": %.4g, \"width\": %.4g, \"mesh\": %.4g, \"total\": %.4g}%s\n", name, p->phase,
-	        p->width, p->mesh, p->total, last ? "" : ",");
+	fprintf(out, "    \"%s\": {\"phase\": %s, \"width\": %s, \"mesh\": %s, \"total\": %s}%s\n", name,
+	        number(p->phase).text, number(p->width).text, number(p->mesh).text, number(p->total).text, last ? "" : ",");
 }
 
 /// The calibration's JSON: moduli with their spreads, the slopes matched, the protocol that
-/// produced them (docs/lab.md) and the counts.
+/// produced them (docs/lab.md) and the counts. Every number as plume_lab_format_number
+/// writes it, so that a sweep or a lab file takes the moduli and slopes bit for bit.
 static void print_calibration(FILE *out, const plume_calibration_def *d, const plume_calibration_result *result)
 {
 	const plume_calibration_def def = *d;
 	const plume_calibration_result r = *result;
-	fprintf(out, "{\n  \"E_vv\": %.6g,\n  \"E_ww\": %.6g,\n  \"E_vw\": %.6g,\n", r.E_vv, r.E_ww, r.E_vw);
+	fprintf(out, "{\n  \"E_vv\": %s,\n  \"E_ww\": %s,\n  \"E_vw\": %s,\n", number(r.E_vv).text, number(r.E_ww).text,
+	        number(r.E_vw).text);
 	if (def.uncertainty) {
 		fprintf(out, "  \"spread\": {\n");
 		print_spread(out, "E_vv", &r.spread_vv, false);
 		print_spread(out, "E_ww", &r.spread_ww, false);
 		print_spread(out, "E_vw", &r.spread_vw, true);
-		fprintf(out, "  },\n  \"sensitivity\": %.4g,\n", r.sensitivity);
+		fprintf(out, "  },\n  \"sensitivity\": %s,\n", number(r.sensitivity).text);
 	}
 	fprintf(out,
-	        "  \"slopes\": {\"longitudinal\": %.8g, \"transverse\": %.8g, \"tilted_mesoscale\": %.8g, "
-	        "\"tilted_macroscale\": %.8g},\n",
-	        r.slope_longitudinal, r.slope_transverse, r.slope_tilted, r.slope_tilted_macroscale);
+	        "  \"slopes\": {\"longitudinal\": %s, \"transverse\": %s, \"tilted_mesoscale\": %s, "
+	        "\"tilted_macroscale\": %s},\n",
+	        number(r.slope_longitudinal).text, number(r.slope_transverse).text, number(r.slope_tilted).text,
+	        number(r.slope_tilted_macroscale).text);
 	fprintf(out,
-	        "  \"phi\": %.6g,\n  \"E_b\": %.6g,\n  \"E_B\": %.6g,\n  \"aspect\": %.6g,\n  \"period\": %.6g,\n"
-	        "  \"phases\": %d,\n",
-	        def.mesoscale.bands.barb_fraction, def.mesoscale.E_b, def.mesoscale.E_B, def.aspect_ratio,
-	        def.mesoscale.bands.period, def.phase_count);
+	        "  \"phi\": %s,\n  \"E_b\": %s,\n  \"E_B\": %s,\n  \"aspect\": %s,\n  \"period\": %s,\n  \"phases\": %d,\n",
+	        number(def.mesoscale.bands.barb_fraction).text, number(def.mesoscale.E_b).text,
+	        number(def.mesoscale.E_B).text, number(def.aspect_ratio).text, number(def.mesoscale.bands.period).text,
+	        def.phase_count);
 	bool quadratic = !def.barb_constraint && def.macroscale_quadratic;
 	fprintf(out,
-	        "  \"protocol\": {\"name\": \"%s\", \"longitudinal_strain_max\": %.6g, \"transverse_strain_max\": %.6g, "
-	        "\"tilted_strain_max\": %.6g, \"steps\": %d, \"compression_coefficient\": %.6g, \"barb_constraint\": %s, "
+	        "  \"protocol\": {\"name\": \"%s\", \"longitudinal_strain_max\": %s, \"transverse_strain_max\": %s, "
+	        "\"tilted_strain_max\": %s, \"steps\": %d, \"compression_coefficient\": %s, \"barb_constraint\": %s, "
 	        "\"macroscale_elements\": \"%s\", \"macroscale_element_count\": %d, \"mesoscale_element_count\": %d, "
-	        "\"width\": %.6g, \"barbs_across\": %.6g, \"aspect\": %.6g, \"phases\": %d},\n",
-	        plume_calibration_protocol_name(&def), def.longitudinal_strain_max, def.transverse_strain_max,
-	        def.tilted_strain_max, def.steps, def.mesoscale.compression_coefficient,
-	        def.barb_constraint ? "true" : "false", quadratic ? "quadratic" : "linear", def.macroscale_elements,
-	        def.sample.element_count, def.sample.width, def.sample.width / def.mesoscale.bands.period, def.aspect_ratio,
-	        def.phase_count);
+	        "\"width\": %s, \"barbs_across\": %s, \"aspect\": %s, \"phases\": %d},\n",
+	        plume_calibration_protocol_name(&def), number(def.longitudinal_strain_max).text,
+	        number(def.transverse_strain_max).text, number(def.tilted_strain_max).text, def.steps,
+	        number(def.mesoscale.compression_coefficient).text, def.barb_constraint ? "true" : "false",
+	        quadratic ? "quadratic" : "linear", def.macroscale_elements, def.sample.element_count,
+	        number(def.sample.width).text, number(def.sample.width / def.mesoscale.bands.period).text,
+	        number(def.aspect_ratio).text, def.phase_count);
 	fprintf(
 	    out,
 	    "  \"barb_constraint\": %s,\n  \"traction_tests\": %d,\n  \"solves\": %d,\n  \"bisection_iterations\": %d\n}\n",
@@ -337,11 +354,12 @@ static int write_calibration(const char *dir, const plume_calibration_def *def, 
 		// Each matched stress-strain slope (Pa) and the modulus it determines.
 		fprintf(csv,
 		        "test,model,slope_pa,determines\n"
-		        "longitudinal,mesoscale,%.9g,E_vv\n"
-		        "transverse,mesoscale,%.9g,E_ww\n"
-		        "tilted,mesoscale,%.9g,target of E_vw\n"
-		        "tilted,macroscale,%.9g,E_vw (matched to the mesoscale slope)\n",
-		        r->slope_longitudinal, r->slope_transverse, r->slope_tilted, r->slope_tilted_macroscale);
+		        "longitudinal,mesoscale,%s,E_vv\n"
+		        "transverse,mesoscale,%s,E_ww\n"
+		        "tilted,mesoscale,%s,target of E_vw\n"
+		        "tilted,macroscale,%s,E_vw (matched to the mesoscale slope)\n",
+		        number(r->slope_longitudinal).text, number(r->slope_transverse).text, number(r->slope_tilted).text,
+		        number(r->slope_tilted_macroscale).text);
 		if (ferror(csv) != 0 || fclose(csv) != 0)
 			status = plume_error_set(&err, PLUME_ERROR_IO, "%s: cannot write", path);
 	}
@@ -352,6 +370,59 @@ static int write_calibration(const char *dir, const plume_calibration_def *def, 
 	else
 		cli_output_abort(&output, &err);
 	return status == PLUME_OK ? CLI_EXIT_OK : cli_fail(&err);
+}
+
+/// The largest magnitude of any number plume reads from a file (src/io/spec.h): a lab file's
+/// E_B of 1e300 is refused, and so is the option's.
+static const double MAX_MAGNITUDE = 1e12;
+
+/// The values of calibrate's options, each against what it is allowed alone and then with the
+/// others (the tilted sample, --width by --aspect x --width, must hold whole barbs that its mesh
+/// resolves): a message naming the options. The library checks the same again (and what the
+/// options cannot reach) in the names of plume_calibration_def's fields.
+static plume_status check_calibrate_options(const plume_calibration_def *def, plume_error *err)
+{
+	const double phi = def->mesoscale.bands.barb_fraction, period = def->mesoscale.bands.period;
+	const double width = def->sample.width, aspect = def->aspect_ratio, height = aspect * width;
+#define REQUIRE(condition, format, ...)                                                                                \
+	if (!(condition))                                                                                                  \
+		return plume_error_set(err, PLUME_ERROR_SPEC, format, __VA_ARGS__);
+	REQUIRE(phi > 0.0 && phi < 1.0, "--phi is %g, allowed in (0, 1)", phi);
+	REQUIRE(def->mesoscale.E_b > 0.0 && def->mesoscale.E_b <= MAX_MAGNITUDE, "--Eb is %g Pa, allowed in (0, 1e12]",
+	        def->mesoscale.E_b);
+	REQUIRE(def->mesoscale.E_B > 0.0 && def->mesoscale.E_B <= MAX_MAGNITUDE, "--EB is %g Pa, allowed in (0, 1e12]",
+	        def->mesoscale.E_B);
+	REQUIRE(def->mesoscale.compression_coefficient >= 0.0 && def->mesoscale.compression_coefficient <= MAX_MAGNITUDE,
+	        "--compression is %g Pa, allowed in [0, 1e12]", def->mesoscale.compression_coefficient);
+	REQUIRE(def->tilted_strain_max > 0.0 && def->tilted_strain_max <= 10.0, "--tilted-strain is %g, allowed in (0, 10]",
+	        def->tilted_strain_max);
+	REQUIRE(width >= 1e-6 && width <= 10.0, "--width is %g m, allowed in [1e-06, 10]", width);
+	REQUIRE(aspect >= 1e-3 && aspect <= 1e3,
+	        "--aspect is %g: the tilted sample's aspect ratio H/W, allowed in [0.001, 1000]", aspect);
+	REQUIRE(height >= 1e-6 && height <= 10.0,
+	        "--aspect %g and --width %g m make the tilted sample %g m high, allowed in [1e-06, 10]", aspect, width,
+	        height);
+	REQUIRE(period > 0.0 && period <= fmin(width, height),
+	        "--period is %g m, allowed in (0, %g]: at most the side of the tilted sample, %g m wide (--width) and %g m "
+	        "high (--aspect x --width), so that it holds a whole barb",
+	        period, fmin(width, height), width, height);
+	// As plume_sample_validate: at most 100000 periods across, no band under 1e-6 of the larger side.
+	REQUIRE((width + height) / period <= 1e5,
+	        "--period is %g m, allowed >= %g m: at most 100000 periods across the %g x %g m tilted sample", period,
+	        (width + height) / 1e5, width, height);
+	double least = 1e-6 * fmax(width, height) / period;
+	REQUIRE(phi >= least && phi <= 1.0 - least,
+	        "--phi is %s, allowed in [%g, %g] at --period %g m: its %s bands would be %g m wide, narrower than a "
+	        "millionth of the %g x %g m tilted sample",
+	        number(phi).text, least, 1.0 - least, period, phi <= 0.5 ? "barb" : "barbule",
+	        period * fmin(phi, 1.0 - phi), width, height);
+	REQUIRE(def->sample.element_count >= 2 && def->sample.element_count <= 4000000,
+	        "--elements is %d, allowed in [2, 4000000]", def->sample.element_count);
+	REQUIRE(def->macroscale_elements >= 2 && def->macroscale_elements <= 4000000,
+	        "--macro-elements is %d, allowed in [2, 4000000]", def->macroscale_elements);
+	REQUIRE(def->phase_count >= 1 && def->phase_count <= 64, "--phases is %d, allowed in [1, 64]", def->phase_count);
+#undef REQUIRE
+	return PLUME_OK;
 }
 
 static int run_calibrate(int argc, char **argv)
@@ -423,10 +494,8 @@ static int run_calibrate(int argc, char **argv)
 	if (!phi_given || !Eb_given || !EB_given)
 		return cli_usage_error("lab", "calibrate needs --phi, --Eb and --EB");
 	plume_error err = {0};
-	if (!(def.mesoscale.bands.barb_fraction > 0.0 && def.mesoscale.bands.barb_fraction < 1.0)) {
-		fprintf(stderr, "plume: --phi is %g, allowed in (0, 1)\n", def.mesoscale.bands.barb_fraction);
-		return CLI_EXIT_INPUT;
-	}
+	if (check_calibrate_options(&def, &err) != PLUME_OK)
+		return cli_fail(&err);
 	char what[160];
 	snprintf(what, sizeof what, "--elements %d and --macro-elements %d (%s)", def.sample.element_count,
 	         def.macroscale_elements, def.uncertainty ? "twice the larger for the spreads" : "the larger");

@@ -58,6 +58,38 @@ static bool parse_length(const char *text, double *out)
 	return true;
 }
 
+/// Parses --format: a comma-separated list of obj, png and glb (the formats a mesh is
+/// written in; cli_parse_formats knows a feather's too). False after the usage message.
+static bool parse_mesh_formats(const char *list, unsigned *formats)
+{
+	static const struct {
+		const char *name;
+		unsigned bit;
+	} names[] = {{"obj", CLI_FORMAT_OBJ}, {"png", CLI_FORMAT_PNG}, {"glb", CLI_FORMAT_GLB}};
+	*formats = 0;
+	for (const char *cursor = list; *cursor != '\0';) {
+		size_t length = strcspn(cursor, ",");
+		size_t i = 0;
+		while (i < sizeof names / sizeof names[0] &&
+		       !(strlen(names[i].name) == length && strncmp(cursor, names[i].name, length) == 0))
+			++i;
+		if (i == sizeof names / sizeof names[0]) {
+			cli_usage_error("mesh", "unknown format '%.*s' in --format: a mesh writes obj, png, glb", (int)length,
+			                cursor);
+			return false;
+		}
+		*formats |= names[i].bit;
+		cursor += length;
+		if (*cursor == ',')
+			++cursor;
+	}
+	if (*formats == 0) {
+		cli_usage_error("mesh", "--format needs at least one of obj, png, glb");
+		return false;
+	}
+	return true;
+}
+
 // ---------------------------------------------------------------------------
 // Picture of the reference mesh
 
@@ -142,6 +174,13 @@ static plume_status write_report(const plume_mesh *mesh, const plume_mesh_report
 	int rachis_faces = 0;
 	for (int f = 0; f < mesh->face_count; ++f)
 		rachis_faces += mesh->material[f] == PLUME_MATERIAL_RACHIS;
+	// null when every vane face is a junction face (or there is none): no angle to report,
+	// where plume_mesh_report holds pi.
+	int measured_faces = mesh->face_count - rachis_faces - report->excepted_count;
+	char vane_min_angle[32] = "null";
+	if (measured_faces > 0)
+		snprintf(vane_min_angle, sizeof vane_min_angle, "%.6f",
+		         report->vane_min_angle * 180.0 / 3.14159265358979323846);
 	fprintf(stream,
 	        "{\n"
 	        "  \"edge_length\": %.17g,\n"
@@ -151,7 +190,7 @@ static plume_status write_report(const plume_mesh *mesh, const plume_mesh_report
 	        "  \"vane_face_count\": %d,\n"
 	        "  \"barb_edge_count\": %d,\n"
 	        "  \"min_angle_deg\": %.6f,\n"
-	        "  \"vane_min_angle_deg\": %.6f,\n"
+	        "  \"vane_min_angle_deg\": %s,\n"
 	        "  \"excepted_count\": %d,\n"
 	        "  \"aligned_fraction\": %.17g,\n"
 	        "  \"guides_dropped\": %d,\n"
@@ -160,10 +199,9 @@ static plume_status write_report(const plume_mesh *mesh, const plume_mesh_report
 	        "  \"guide_count\": [%d, %d],\n"
 	        "  \"groups\": {",
 	        report->edge_length, mesh->vertex_count, mesh->face_count, rachis_faces, mesh->face_count - rachis_faces,
-	        mesh->barb_edge_count, report->min_angle * 180.0 / 3.14159265358979323846,
-	        report->vane_min_angle * 180.0 / 3.14159265358979323846, report->excepted_count, report->aligned_fraction,
-	        report->guides_dropped, report->barbs_averaged, report->vertices_trimmed, report->guide_count[0],
-	        report->guide_count[1]);
+	        mesh->barb_edge_count, report->min_angle * 180.0 / 3.14159265358979323846, vane_min_angle,
+	        report->excepted_count, report->aligned_fraction, report->guides_dropped, report->barbs_averaged,
+	        report->vertices_trimmed, report->guide_count[0], report->guide_count[1]);
 	for (int g = 0; g < mesh->group_count; ++g)
 		fprintf(stream, "%s\"%s\": %d", g > 0 ? ", " : "", mesh->groups[g].name, mesh->groups[g].count);
 	fprintf(stream, "}\n}\n");
@@ -209,10 +247,8 @@ int cli_mesh(int argc, char **argv)
 				return CLI_EXIT_USAGE;
 			break;
 		case 'f':
-			if (!cli_parse_formats("mesh", optarg, &formats))
+			if (!parse_mesh_formats(optarg, &formats))
 				return CLI_EXIT_USAGE;
-			if ((formats & ~(unsigned)(CLI_FORMAT_OBJ | CLI_FORMAT_PNG | CLI_FORMAT_GLB)) != 0)
-				return cli_usage_error("mesh", "--format '%s': a mesh writes obj, png, glb", optarg);
 			break;
 		case 'M':
 			if (!cli_parse_memory("mesh", optarg, &spec_options.max_memory))

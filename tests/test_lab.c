@@ -318,7 +318,19 @@ static void test_sample_errors(void **state)
 	bands = plume_band_default_def();
 	bands.period = 1e-9;
 	assert_int_equal(plume_sample_mesh(&def, &bands, &mesh, &err), PLUME_ERROR_SPEC);
-	assert_non_null(strstr(err.message, "band_period"));
+	assert_non_null(strstr(err.message, "material.band_period is 1e-09 m, allowed >= 2.3e-07 m"));
+	// Bands too narrow to mesh at the default period: the barb fraction is at fault, not the
+	// period (the message blamed band_period), and all its digits are shown (not "is 1").
+	bands = plume_band_default_def();
+	bands.barb_fraction = 1e-9;
+	assert_int_equal(plume_sample_mesh(&def, &bands, &mesh, &err), PLUME_ERROR_SPEC);
+	assert_ptr_equal(strstr(err.message, "material.barb_fraction is 1e-09, allowed in [3.25e-05, 0.999968] at "
+	                                     "material.band_period 0.0004 m: its barb bands"),
+	                 err.message);
+	bands.barb_fraction = 0.9999999999;
+	assert_int_equal(plume_sample_mesh(&def, &bands, &mesh, &err), PLUME_ERROR_SPEC);
+	assert_ptr_equal(strstr(err.message, "material.barb_fraction is 0.9999999999, allowed"), err.message);
+	assert_non_null(strstr(err.message, "its barbule bands"));
 	assert_null(mesh);
 }
 
@@ -934,13 +946,73 @@ static void test_plot_and_csv(void **state)
 	assert_int_equal(plume_lab_write_csv(csv, "strain,stress_pa", columns, 2, 5, &err), PLUME_OK);
 	bytes = test_read_file(csv, &size);
 	assert_non_null(bytes);
-	assert_true(strncmp((const char *)bytes, "strain,stress_pa\n0,0\n0.10000000000000001,1\n", 40) == 0);
+	// Each number in its shortest round-trip form: 0.1, not 0.10000000000000001.
+	assert_string_equal((const char *)bytes, "strain,stress_pa\n0,0\n0.1,1\n0.2,2.1\n0.3,3.3\n0.4,4.6\n");
 	free(bytes);
 	// An unwritable path: an IO error, nothing left behind.
 	snprintf(png, sizeof png, "%s/missing/a.png", dir);
 	assert_int_equal(plume_lab_plot(&plot, png, NULL, &err), PLUME_ERROR_IO);
 	assert_int_equal(test_count_entries(dir), 4);
 	test_remove_tree(dir);
+}
+
+/// The shortest text that reads back as value: it round-trips, and one digit fewer does not.
+static void expect_shortest(double value, const char *expected)
+{
+	char text[PLUME_LAB_NUMBER_TEXT];
+	const char *written = plume_lab_format_number(text, sizeof text, value);
+	assert_ptr_equal(written, text);
+	if (expected != NULL && strcmp(text, expected) != 0)
+		fail_msg("%.17g written as %s, expected %s", value, text, expected);
+	if (!isfinite(value))
+		return;
+	assert_true(strtod(text, NULL) == value);
+	// Its significant digits: those of the mantissa but leading and trailing zeros ("2570000000": 3).
+	int digits = 0, trailing_zeros = 0;
+	for (const char *c = text; *c != '\0' && *c != 'e'; ++c) {
+		if (*c < '0' || *c > '9' || (*c == '0' && digits == 0))
+			continue;
+		++digits;
+		trailing_zeros = *c == '0' ? trailing_zeros + 1 : 0;
+	}
+	digits -= trailing_zeros;
+	assert_true(digits <= 17);
+	char shorter[400]; // "%.16g" of any double fits
+	snprintf(shorter, sizeof shorter, "%.*g", digits - 1, value);
+	if (digits > 1 && strtod(shorter, NULL) == value)
+		fail_msg("%.17g written as %s, but %s reads back too", value, text, shorter);
+}
+
+static void test_format_number(void **state)
+{
+	(void)state;
+	// The calibration's E_vv at 6 digits was 3.59834e+08: the slope it matched is 3.5983371e8.
+	expect_shortest(3.5983371e8, "359833710");
+	expect_shortest(0.1, "0.1");
+	expect_shortest(0.1 + 0.2, "0.30000000000000004");
+	expect_shortest(1.0 / 3.0, "0.3333333333333333");
+	expect_shortest(0.1 + 0.7, "0.7999999999999999");
+	expect_shortest(1e23, "1e+23");
+	expect_shortest(9007199254740993.0, "9007199254740992");
+	expect_shortest(2.57e9, "2570000000");
+	expect_shortest(1e-300, "1e-300");
+	expect_shortest(-4.8e4, "-48000");
+	expect_shortest(0.0, "0");
+	expect_shortest(5e-324, "5e-324"); // subnormals hold fewer digits
+	expect_shortest(2.2250738585072009e-308, "2.225073858507201e-308");
+	expect_shortest(1.5e-310, "1.5e-310");
+	expect_shortest(INFINITY, "inf");
+	// Doubles of every magnitude: each reads back bit for bit, in at most 17 digits.
+	uint64_t bits = 0x9e3779b97f4a7c15u;
+	for (int i = 0; i < 20000; ++i) {
+		bits ^= bits << 13, bits ^= bits >> 7, bits ^= bits << 17;
+		double value;
+		memcpy(&value, &bits, sizeof value);
+		if (isfinite(value))
+			expect_shortest(value, NULL);
+		value = ldexp((double)(bits >> 12), -1074); // subnormal and small normal ones
+		expect_shortest(value, NULL);
+	}
 }
 
 static plume_status load_text(const char *dir, const char *text, plume_lab_spec *spec, plume_error *err)
@@ -1007,6 +1079,8 @@ static void test_lab_spec(void **state)
 	expect_spec_error(dir, "{\"sample\": {\"mesh\": \"delaunay\"}}", "$.sample.mesh");
 	expect_spec_error(dir, "{\"sample\": {\"widht\": 1}}", "width");
 	expect_spec_error(dir, "{\"material\": {\"model\": \"mesoscale\", \"band_period\": 1e-12}}", "band_period");
+	expect_spec_error(dir, "{\"material\": {\"model\": \"mesoscale\", \"barb_fraction\": 1e-9}}",
+	                  "lab.json: $.material.barb_fraction is 1e-09, allowed in [3.25e-05, 0.999968]");
 	expect_spec_error(dir, "{\"sample\": {\"mesh\": \"unaligned\"}, \"material\": {\"barb_constraint\": true}}",
 	                  "aligned");
 	test_remove_tree(dir);
@@ -1036,6 +1110,18 @@ static void test_calibration_errors(void **state)
 	def.mesoscale.bands.period = 1.0; // longer than the sample
 	assert_int_equal(plume_lab_calibrate(&def, &result, &err), PLUME_ERROR_SPEC);
 	assert_non_null(strstr(err.message, "period"));
+	// A sample 0 m wide: the width is at fault (it said "band period 0.0004 m is larger than
+	// the 0 x 0 m sample").
+	def = plume_calibration_default_def();
+	def.sample.width = 0.0;
+	assert_int_equal(plume_lab_calibrate(&def, &result, &err), PLUME_ERROR_SPEC);
+	assert_string_equal(err.message, "sample.width is 0 m, allowed [1e-06, 10]");
+	// Bands too narrow to mesh are refused before the first test, naming the fraction.
+	def = plume_calibration_default_def();
+	def.mesoscale.bands.barb_fraction = 1e-9;
+	assert_int_equal(plume_lab_calibrate(&def, &result, &err), PLUME_ERROR_SPEC);
+	assert_ptr_equal(strstr(err.message, "material.barb_fraction is 1e-09"), err.message);
+	assert_int_equal(result.traction_count, 0);
 }
 
 int main(void)
@@ -1064,6 +1150,7 @@ int main(void)
 	    cmocka_unit_test(test_calibration_table_5_1),
 	    cmocka_unit_test(test_small_locking_study),
 	    cmocka_unit_test(test_plot_and_csv),
+	    cmocka_unit_test(test_format_number),
 	    cmocka_unit_test(test_lab_spec),
 	    cmocka_unit_test(test_calibration_errors),
 	};

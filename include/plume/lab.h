@@ -528,8 +528,19 @@ typedef struct plume_plot {
 /// PLUME_ERROR_UNSUPPORTED when this PLplot lacks a driver, PLUME_ERROR_IO on write failure.
 plume_status plume_lab_plot(const plume_plot *plot, const char *png_path, const char *svg_path, plume_error *err);
 
+/// Bytes plume_lab_format_number needs: "-1.2345678901234567e-308" and the terminator.
+enum { PLUME_LAB_NUMBER_TEXT = 32 };
+
+/// A number as the lab writes every number meant for reuse (CSV tables, traction.json,
+/// calibration.json): the shortest text that strtod reads back as the same double, which
+/// is the first of "%.15g", "%.16g" and "%.17g" that does ("0.1" and "359833710", never
+/// "0.10000000000000001" or a rounded "3.59834e+08"), as in a sweep's results.csv.
+/// Non-finite values as "%g" writes them. text holds size >= PLUME_LAB_NUMBER_TEXT bytes;
+/// returns text.
+const char *plume_lab_format_number(char *text, size_t size, double value);
+
 /// Writes a CSV file: a header line (comma-separated names) and row_count rows of
-/// column_count numbers (%.17g), atomically.
+/// column_count numbers (plume_lab_format_number), atomically.
 plume_status plume_lab_write_csv(const char *path, const char *header, const double *const *columns, int column_count,
                                  int row_count, plume_error *err);
 

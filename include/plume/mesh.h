@@ -103,8 +103,11 @@ typedef struct plume_mesh_report {
 	int vertices_trimmed;
 	/// The target edge length e used, m.
 	double edge_length;
-	/// Smallest interior angle over the vane faces that are not junction faces, radians
-	/// (pi when there are none). The aligned mesher keeps it at or above PLUME_MESH_QUALITY_ANGLE_DEG.
+	/// Smallest interior angle over the vane faces that are not junction faces, radians.
+	/// pi when there are none (every vane face is a junction face, or there is no vane
+	/// face): no triangle has that angle, so vane_min_angle >= pi tells the case apart;
+	/// `plume mesh` writes null in report.json then. The aligned mesher keeps it at or
+	/// above PLUME_MESH_QUALITY_ANGLE_DEG.
 	double vane_min_angle;
 	/// Junction faces: vane faces with an angle under PLUME_MESH_QUALITY_ANGLE_DEG where every such angle
 	/// lies between the face's barb edge and an edge on the vane's border (the rachis

@@ -68,6 +68,9 @@ const char *plume_calibration_protocol_name(const plume_calibration_def *def)
 static plume_status check(const plume_calibration_def *def, plume_error *err)
 {
 	const plume_sample_def *s = &def->sample;
+	// The width first: a sample 0 m wide is the width's fault, not the band period's.
+	if (!(s->width >= 1e-6 && s->width <= 10.0))
+		return plume_error_set(err, PLUME_ERROR_SPEC, "sample.width is %g m, allowed [1e-06, 10]", s->width);
 	if (!(def->aspect_ratio > 0.0 && isfinite(def->aspect_ratio)))
 		return plume_error_set(err, PLUME_ERROR_SPEC, "aspect ratio is %g, allowed > 0", def->aspect_ratio);
 	// The tilted sample must hold at least one barb period across and two mesh rows along.
@@ -80,8 +83,9 @@ static plume_status check(const plume_calibration_def *def, plume_error *err)
 		                       def->aspect_ratio, s->width, height, def->macroscale_elements);
 	if (def->mesoscale.bands.period > fmin(s->width, height))
 		return plume_error_set(err, PLUME_ERROR_SPEC,
-		                       "band period %g m is larger than the %g x %g m sample: it holds no whole barb",
-		                       def->mesoscale.bands.period, s->width, height);
+		                       "band period %g m is larger than the tilted sample, %g m wide (sample.width) and %g m "
+		                       "high (aspect ratio %g): it holds no whole barb",
+		                       def->mesoscale.bands.period, s->width, height, def->aspect_ratio);
 	if (!(def->longitudinal_strain_max > 0.0 && def->longitudinal_strain_max <= 10.0) ||
 	    !(def->transverse_strain_max > 0.0 && def->transverse_strain_max <= 10.0) ||
 	    !(def->tilted_strain_max > 0.0 && def->tilted_strain_max <= 10.0))
@@ -99,7 +103,13 @@ static plume_status check(const plume_calibration_def *def, plume_error *err)
 		                       def->macroscale_elements);
 	plume_lab_material material = def->mesoscale;
 	material.model = PLUME_LAB_MESOSCALE;
-	return plume_lab_validate(&material, s, NULL, err);
+	plume_status status = plume_lab_validate(&material, s, NULL, err);
+	// The tilted sample and its bands, before any test runs (not at the first mesh).
+	plume_sample_def tilted = *s;
+	tilted.height = height;
+	if (status == PLUME_OK)
+		status = plume_sample_validate(&tilted, &material.bands, err);
+	return status;
 }
 
 // Runs one traction test (the mean over phase_count band phases for the mesoscale model)

@@ -1,13 +1,16 @@
 // Plots of the lab's curves with PLplot (a real plotting library, as the issue asks):
 // PNG through the "mem" raster driver (Debian's PLplot has no pngcairo driver) and
 // Cairo's PNG writer, SVG through the "svg" driver. And CSV tables.
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include <plplot/plplot.h>
 
 #include "core/alloc.h"
+#include "core/asserts.h"
 #include "core/atomic_file.h"
 #include "plume/lab.h"
 #include "render/cairo_png.h"
@@ -219,6 +222,21 @@ plume_status plume_lab_plot(const plume_plot *plot, const char *png_path, const 
 	return status;
 }
 
+const char *plume_lab_format_number(char *text, size_t size, double value)
+{
+	PLUME_ASSERT(text != NULL && size >= PLUME_LAB_NUMBER_TEXT);
+	// A normal double whose shortest round-trip form has 15 digits or fewer is given back by
+	// "%.15g" (DBL_DIG is 15, and %g drops the trailing zeros), so trying 15, 16 and 17
+	// digits finds the shortest form: "0.1", not "0.10000000000000001". Subnormals hold
+	// fewer digits (5e-324 is "5e-324", not "4.94065645841247e-324"): they try from 1.
+	for (int digits = fabs(value) < DBL_MIN && value != 0.0 ? 1 : 15; digits <= 17; ++digits) {
+		snprintf(text, size, "%.*g", digits, value);
+		if (!isfinite(value) || strtod(text, NULL) == value)
+			break;
+	}
+	return text;
+}
+
 plume_status plume_lab_write_csv(const char *path, const char *header, const double *const *columns, int column_count,
                                  int row_count, plume_error *err)
 {
@@ -227,8 +245,10 @@ plume_status plume_lab_write_csv(const char *path, const char *header, const dou
 	if (status != PLUME_OK)
 		return status;
 	fprintf(file.stream, "%s\n", header);
+	char number[PLUME_LAB_NUMBER_TEXT];
 	for (int r = 0; r < row_count; ++r)
 		for (int c = 0; c < column_count; ++c)
-			fprintf(file.stream, "%.17g%c", columns[c][r], c + 1 < column_count ? ',' : '\n');
+			fprintf(file.stream, "%s%c", plume_lab_format_number(number, sizeof number, columns[c][r]),
+			        c + 1 < column_count ? ',' : '\n');
 	return plume_atomic_commit(&file, err);
 }

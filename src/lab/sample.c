@@ -462,15 +462,26 @@ plume_status plume_sample_validate(const plume_sample_def *sample, const plume_b
 	if (bands->barbule_divisions < 1 || bands->barbule_divisions > 64)
 		return plume_error_set(err, PLUME_ERROR_SPEC, "material.barbule_divisions is %d, allowed in [1, 64]",
 		                       bands->barbule_divisions);
-	// A band narrower than a millionth of the sample cannot be meshed sensibly, and more
-	// than 100000 bands across it would not fit in memory.
-	double size = fmax(sample->width, sample->height);
-	double narrowest = bands->period * fmin(bands->barb_fraction, 1.0 - bands->barb_fraction);
-	if (narrowest < 1e-6 * size || (sample->width + sample->height) / bands->period > 1e5)
+	// More than 100000 bands across the sample would not fit in memory, and a band narrower
+	// than a millionth of the sample cannot be meshed sensibly. A period that passes the first
+	// is at least 1e-5 of the larger side, so only the barb fraction can fail the second.
+	if ((sample->width + sample->height) / bands->period > 1e5)
 		return plume_error_set(err, PLUME_ERROR_SPEC,
-		                       "material.band_period is %g m: the mesh cannot resolve bands %g m wide in a %g x %g m "
-		                       "sample (at most 100000 periods across it)",
-		                       bands->period, narrowest, sample->width, sample->height);
+		                       "material.band_period is %g m, allowed >= %g m: at most 100000 periods across the "
+		                       "%g x %g m sample (its width + height)",
+		                       bands->period, (sample->width + sample->height) / 1e5, sample->width, sample->height);
+	double size = fmax(sample->width, sample->height), least = 1e-6 * size / bands->period;
+	bool barbs_narrower = bands->barb_fraction <= 0.5;
+	double narrowest = bands->period * (barbs_narrower ? bands->barb_fraction : 1.0 - bands->barb_fraction);
+	if (narrowest < 1e-6 * size) {
+		char fraction[PLUME_LAB_NUMBER_TEXT]; // all its digits: 0.9999999999 is not 1
+		return plume_error_set(err, PLUME_ERROR_SPEC,
+		                       "material.barb_fraction is %s, allowed in [%g, %g] at material.band_period %g m: its %s "
+		                       "bands would be %g m wide, narrower than a millionth of the %g x %g m sample",
+		                       plume_lab_format_number(fraction, sizeof fraction, bands->barb_fraction), least,
+		                       1.0 - least, bands->period, barbs_narrower ? "barb" : "barbule", narrowest,
+		                       sample->width, sample->height);
+	}
 	return PLUME_OK;
 }
 

@@ -212,10 +212,12 @@ static plume_status place_rows(mesher *m)
 	double total_steps = 0.0;
 	for (int i = 0; i + 1 < kept; ++i)
 		total_steps += fmax(1.0, round((breaks[i + 1] - breaks[i]) / e));
+	// The row count is printed to three digits: at edge_length 1e-300 m it has 300.
 	if (total_steps + 1.0 > MESH_MAX_VERTICES / 2)
 		return plume_error_set(m->err, PLUME_ERROR_SPEC,
-		                       "edge_length %g m is too small for a %g m rachis (%.0f rows): use a larger edge length",
-		                       e, end, total_steps + 1.0);
+		                       "edge_length %g m is too small for a %g m rachis (%.3g rows, at most %d): use a larger "
+		                       "edge length",
+		                       e, end, total_steps + 1.0, MESH_MAX_VERTICES / 2);
 	if ((total_steps + 1.0) * row_bytes > m->max_memory) {
 		plume_mesh_estimate rows_only = {.rows = total_steps + 1.0, .vertices = 2.0 * (total_steps + 1.0)};
 		rows_only.faces = 2.0 * rows_only.vertices;

@@ -21,6 +21,20 @@ check "traction: SVG root" grep -q '<svg' "$out/traction.svg"
 slope=$(sed -n 's/.*"slope_pa": \([0-9.e+-]*\).*/\1/p' "$out/traction.json")
 check "traction: slope $slope within 1e-3 of eq. 5.5" awk -v s="$slope" 'BEGIN { r = s / (1.2245181125 * 39200); exit !(r > 0.999 && r < 1.001) }'
 check "traction: slope printed" grep -q '^slope: ' "$scratch/out.txt"
+# Numbers for reuse in their shortest round-trip form (a %.10g slope_pa lost digits).
+shortest_numbers() { # shortest_numbers FILE...: every number in the files reads back in as few digits as Python's repr
+	python3 - "$@" <<'PY'
+import re, sys
+def significant(text):
+    digits = re.sub(r"[^0-9]", "", re.split(r"[eE]", text)[0]).lstrip("0").rstrip("0")
+    return len(digits)
+for path in sys.argv[1:]:
+    for token in re.findall(r"(?<![\w.])-?[0-9][0-9.]*(?:e[-+]?[0-9]+)?", open(path).read()):
+        x = float(token)
+        assert significant(token) == significant(repr(x)) and significant(token) <= 17, (path, token, repr(x))
+PY
+}
+check "traction: traction.json and traction.csv in shortest round-trip form" shortest_numbers "$out/traction.json" "$out/traction.csv"
 # Same input, same bytes.
 "$plume" lab traction "$examples/transverse-mesoscale.json" -o "$scratch/again" >/dev/null 2>&1
 for file in traction.csv traction.json traction.png traction.svg; do
@@ -43,6 +57,8 @@ bad "zero strain" '{"traction": {"strain_max": 0}}' '$.traction.strain_max is 0'
 bad "unknown key" '{"traction": {"strain_mx": 0.1}}' 'strain_max'
 bad "bad mesh" '{"sample": {"mesh": "random"}}' '$.sample.mesh'
 bad "bad elements" '{"material": {"elements": "cubic"}}' '$.material.elements: is "cubic", allowed "linear" or "quadratic"'
+# Bands too narrow to mesh: the barb fraction is at fault (the message blamed band_period).
+bad "barb fraction 1e-9" '{"material": {"model": "mesoscale", "barb_fraction": 1e-9}}' 'bad.json: $.material.barb_fraction is 1e-09, allowed in [3.25e-05, 0.999968] at material.band_period 0.0004 m'
 bad "quadratic constrained" '{"material": {"elements": "quadratic", "barb_constraint": true}}' 'barb constraint needs the simulator'
 expect_failure "missing file" 4 "missing.json" "$plume" lab traction "$scratch/missing.json" -o "$scratch/x"
 check "missing file: nothing written" test ! -e "$scratch/x"
@@ -54,7 +70,16 @@ expect_failure "unknown action" 2 "unknown action 'pull'" "$plume" lab pull
 expect_failure "calibrate without moduli" 2 "needs --phi, --Eb and --EB" "$plume" lab calibrate --phi 0.14
 expect_failure "calibrate phi 0" 3 "allowed in (0, 1)" "$plume" lab calibrate --phi 0 --Eb 3.92e4 --EB 2.57e9
 expect_failure "calibrate phi 1.5" 3 "allowed in (0, 1)" "$plume" lab calibrate --phi 1.5 --Eb 3.92e4 --EB 2.57e9
-expect_failure "calibrate negative Eb" 3 "E_b is -1" "$plume" lab calibrate --phi 0.14 --Eb -1 --EB 2.57e9
+expect_failure "calibrate negative Eb" 3 "--Eb is -1 Pa, allowed in (0, 1e12]" "$plume" lab calibrate --phi 0.14 --Eb -1 --EB 2.57e9
+# The bounds of a lab file (|x| <= 1e12) hold for the options too: --EB 1e300 diverged (free forces 6.24e+284).
+expect_failure "calibrate EB 1e300" 3 "--EB is 1e+300 Pa, allowed in (0, 1e12]" "$plume" lab calibrate --phi 0.14 --Eb 3.92e4 --EB 1e300
+check "calibrate EB 1e300: nothing on stdout" test ! -s "$scratch/out.txt"
+expect_failure "calibrate compression 1e300" 3 "--compression is 1e+300 Pa, allowed in [0, 1e12]" "$plume" lab calibrate --phi 0.14 --Eb 3.92e4 --EB 2.57e9 --compression 1e300
+# Each value error names its option (--width 0 blamed "band period 0.0004 m").
+expect_failure "calibrate width 0" 3 "--width is 0 m, allowed in [1e-06, 10]" "$plume" lab calibrate --phi 0.14 --Eb 3.92e4 --EB 2.57e9 --width 0
+expect_failure "calibrate period past the sample" 3 "--period is 0.01 m, allowed in (0, 0.004]" "$plume" lab calibrate --phi 0.14 --Eb 3.92e4 --EB 2.57e9 --period 0.01
+expect_failure "calibrate phi 1e-9" 3 "--phi is 1e-09, allowed in [1.3e-05, 0.999987] at --period 0.0004 m" "$plume" lab calibrate --phi 1e-9 --Eb 3.92e4 --EB 2.57e9
+expect_failure "calibrate elements 1" 3 "--elements is 1, allowed in [2, 4000000]" "$plume" lab calibrate --phi 0.14 --Eb 3.92e4 --EB 2.57e9 --elements 1
 expect_failure "calibrate aspect" 3 "aspect ratio" "$plume" lab calibrate --phi 0.14 --Eb 3.92e4 --EB 2.57e9 --aspect 0.0001
 expect_failure "calibrate not a number" 2 "--aspect expects a number" "$plume" lab calibrate --phi 0.14 --Eb 3.92e4 --EB 2.57e9 --aspect tall
 # A coarse, quick calibration: E_vv and E_ww of thesis Table 5.2.
@@ -103,7 +128,16 @@ assert r['spread']['E_vw']['width'] > 0 and 0.5 < r['sensitivity'] < 1
 p = r['protocol']
 assert p['name'] == 'custom' and p['tilted_strain_max'] == 0.1 and p['compression_coefficient'] == 0, p
 assert p['barb_constraint'] is False and p['macroscale_elements'] == 'quadratic' and p['barbs_across'] == 10, p
+# Full precision: the moduli are the slopes they match, bit for bit, and slopes.csv holds them too
+# (E_vv was printed as 3.59834e+08, the slope 3.5983371e+08).
+s = r['slopes']
+assert r['E_vv'] == s['longitudinal'] and r['E_ww'] == s['transverse'], (r['E_vv'], s)
+import csv
+rows = {(x['test'], x['model']): float(x['slope_pa']) for x in csv.DictReader(open('$scratch/cal/slopes.csv'))}
+assert rows[('longitudinal', 'mesoscale')] == s['longitudinal'] and rows[('transverse', 'mesoscale')] == s['transverse']
+assert rows[('tilted', 'mesoscale')] == s['tilted_mesoscale'] and rows[('tilted', 'macroscale')] == s['tilted_macroscale']
 "
+check "calibrate: JSON, slopes.csv and curves.csv in shortest round-trip form" shortest_numbers "$scratch/cal.json" "$scratch/cal/slopes.csv" "$scratch/cal/curves.csv"
 
 # No answer: H/W and W/H swapped, the barbs run from clamp to clamp and, under the
 # old protocol (eps_max 0.4 with Kikuuwe's term at kappa = 5.04e7 Pa, linear triangles), the mesoscale tilted slope is below

@@ -24,6 +24,19 @@ fine=$(grep -c '^v ' "$scratch/fine/mesh.obj")
 check "fine: more vertices ($fine > 2 x $coarse)" test "$fine" -gt $((2 * coarse))
 check "fine: edge length in report" grep -q '"edge_length": 0.0025' "$scratch/fine/report.json"
 
+# Every vane face a junction face (the filoplume at 5 mm): no angle to report, null (it read
+# 180, the pi the library holds then); a hawk's vane has one.
+"$plume" mesh "$source_dir/examples/streit-heidrich/filoplume.json" -o "$scratch/filoplume" -e 0.005 2>"$scratch/err.txt"
+succeeded "filoplume: exit 0"
+check "filoplume: vane_min_angle_deg null, every vane face excepted" python3 -c "
+import json
+r = json.load(open('$scratch/filoplume/report.json'))
+assert r['vane_face_count'] > 0 and r['excepted_count'] == r['vane_face_count'], r
+assert r['vane_min_angle_deg'] is None, r['vane_min_angle_deg']
+h = json.load(open('$scratch/hawk/report.json'))
+assert h['excepted_count'] < h['vane_face_count'] and 20 <= h['vane_min_angle_deg'] < 60, h
+"
+
 # A guides spec.
 "$plume" mesh "$source_dir/examples/meshes/guides.json" -o "$scratch/guides" 2>"$scratch/err.txt"
 check "guides: exit 0" test $? -eq 0
@@ -34,6 +47,23 @@ expect_failure "missing -o" 2 "missing -o DIR" "$plume" mesh "$source_dir/exampl
 expect_failure "bad edge length" 2 "--edge-length '-1'" "$plume" mesh "$source_dir/examples/meshes/guides.json" \
 	-o "$scratch/bad" --edge-length -1
 check "bad edge length: nothing written" test ! -e "$scratch/bad"
+# An absurd edge length: refused, its row count to three digits (it printed 300 of them).
+expect_no_output "edge length 1e-300" 3 "edge_length 1e-300 m is too small for a 0.200056 m rachis (2e+299 rows, at most 10000000)" \
+	"$scratch/tiny" "$plume" mesh "$source_dir/examples/franco-walter/hawk.json" -o "$scratch/tiny" --edge-length 1e-300
+check "edge length 1e-300: a short message" test "$(wc -c <"$scratch/err.txt")" -lt 300
+# Small enough to need 26.9 GB: the memory estimate refuses it (exit 5).
+expect_no_output "edge length 1e-5" 5 "the limit is" "$scratch/tiny" \
+	"$plume" mesh "$source_dir/examples/franco-walter/hawk.json" -o "$scratch/tiny" --edge-length 1e-5
+# --format lists what a mesh is written as, not a feather's formats.
+expect_failure "format foo" 2 "unknown format 'foo' in --format: a mesh writes obj, png, glb" \
+	"$plume" mesh "$source_dir/examples/meshes/guides.json" -o "$scratch/bad" --format foo
+check "format foo: no svg offered" bash -c "! grep -q svg '$scratch/err.txt'"
+expect_failure "format svg" 2 "unknown format 'svg' in --format: a mesh writes obj, png, glb" \
+	"$plume" mesh "$source_dir/examples/meshes/guides.json" -o "$scratch/bad" --format png,svg
+check "bad formats: nothing written" test ! -e "$scratch/bad"
+"$plume" mesh "$source_dir/examples/meshes/guides.json" -o "$scratch/glb" --format glb,obj 2>"$scratch/err.txt"
+succeeded "format glb,obj"
+check "format glb,obj: mesh.glb, mesh.obj and report.json only" test "$(ls "$scratch/glb" | tr '\n' ' ')" = "mesh.glb mesh.obj report.json "
 printf '{"guides": [[[0,0],[1,1]]], "rachis": [[0,0],[0,1]], "boundary": [[0,0],[1,0],[1,1]], "mesh": {"edge_lenght": 1}}' \
 	>"$scratch/typo.json"
 expect_failure "typo key" 3 "typo.json: \$.mesh" "$plume" mesh "$scratch/typo.json" -o "$scratch/typo"
