@@ -482,8 +482,14 @@ static plume_status write_summary(cli_output *output, const plume_scene *scene, 
 		json_array_append_new(reactions, json_real(run->max_reaction[h]));
 	json_object_set_new(root, "handle_max_reaction", reactions);
 	json_object_set_new(root, "mesh_min_angle_deg", json_real(scene->mesh_report.min_angle * 180 / acos(-1.0)));
+	// null when every vane face is a junction face, as mesh's report.json (plume_mesh_report holds pi).
+	int vane_faces = 0;
+	for (int f = 0; f < scene->mesh->face_count; ++f)
+		vane_faces += scene->mesh->material[f] == PLUME_MATERIAL_VANE;
 	json_object_set_new(root, "mesh_vane_min_angle_deg",
-	                    json_real(scene->mesh_report.vane_min_angle * 180 / acos(-1.0)));
+	                    vane_faces > scene->mesh_report.excepted_count
+	                        ? json_real(scene->mesh_report.vane_min_angle * 180 / acos(-1.0))
+	                        : json_null());
 	json_object_set_new(root, "mesh_excepted_count", json_integer(scene->mesh_report.excepted_count));
 	json_object_set_new(root, "mesh_aligned_fraction", json_real(scene->mesh_report.aligned_fraction));
 	json_object_set_new(root, "mesh_guides_dropped", json_integer(scene->mesh_report.guides_dropped));

@@ -96,6 +96,19 @@ expect_no_output "a handle stretching a barb held at both ends" 3 \
 	"$scratch/stretch" "$plume" simulate "$scratch/stretch.json" -o "$scratch/stretch"
 check "the stretched barb: the message says what to change" grep -q "hold one end only, or set the vane's barb_constraint to false" "$scratch/err.txt"
 expect_failure "missing scene" 4 "missing.json" "$plume" simulate "$scratch/missing.json" -o "$scratch/none"
+# A mesh whose every vane face is a junction face has no vane angle to report: null, as
+# mesh's report.json (the Streit-Heidrich filoplume at 5 mm: 5 vane faces, all junctions).
+cat >"$scratch/filoplume.json" <<JSON
+{"feather": "$source_dir/examples/streit-heidrich/filoplume.json", "mesh": {"edge_length": 0.005},
+ "handles": [{"group": "rachis_clamp"}], "duration": 0.011}
+JSON
+"$plume" simulate "$scratch/filoplume.json" -o "$scratch/filoplume" >/dev/null 2>&1
+succeeded "the filoplume runs"
+check "no vane angle outside junction faces: null" /usr/bin/python3 -c '
+import json, sys
+s = json.load(open(sys.argv[1]))
+assert s["mesh_vane_min_angle_deg"] is None and s["mesh_excepted_count"] == 5, s
+' "$scratch/filoplume/summary.json"
 check "missing scene: nothing written" test ! -e "$scratch/none"
 expect_failure "no output" 2 "missing -o DIR" "$plume" simulate "$scratch/swing.json"
 # The progress line on a terminal (script(1)): steps, elapsed time and the simulated time.
