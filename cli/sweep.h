@@ -79,8 +79,12 @@ typedef struct calibration_key {
 	const char *key;
 	const char *option;
 	bool integer;
-	double lo; ///< allowed values: (lo, hi), integers >= lo
+	/// Allowed values, as `plume lab calibrate` checks them (cli/lab.c): from lo to hi, each
+	/// end included when closed (integers: both included).
+	double lo;
 	double hi;
+	bool lo_closed;
+	bool hi_closed;
 } calibration_key;
 extern const calibration_key sweep_calibration_keys[SWEEP_CALIBRATION_KEY_COUNT];
 

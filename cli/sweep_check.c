@@ -248,15 +248,12 @@ static bool probe_spec(const sweep *s, json_t *spec, char *message, size_t size,
 			if (v == NULL)
 				continue;
 			double x = json_number_value(v);
-			bool ok = json_is_number(v) &&
-			          (k->integer ? (x == floor(x) && x >= k->lo && x <= k->hi) : (x > k->lo && x < k->hi));
+			bool above = k->lo_closed ? x >= k->lo : x > k->lo, below = k->hi_closed ? x <= k->hi : x < k->hi;
+			bool ok = json_is_number(v) && above && below && (!k->integer || x == floor(x));
 			if (!ok) {
-				if (k->integer)
-					snprintf(message, size, "$.%s is %.10g, allowed a whole number >= %g", k->key, x, k->lo);
-				else if (isinf(k->hi))
-					snprintf(message, size, "$.%s is %.10g, allowed > %g", k->key, x, k->lo);
-				else
-					snprintf(message, size, "$.%s is %.10g, allowed in (%g, %g)", k->key, x, k->lo, k->hi);
+				snprintf(message, size, "$.%s is %.10g, allowed %s in %c%g, %g%c", k->key, x,
+				         k->integer ? "a whole number" : "a number", k->lo_closed ? '[' : '(', k->lo, k->hi,
+				         k->hi_closed ? ']' : ')');
 				return false;
 			}
 		}

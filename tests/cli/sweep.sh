@@ -260,6 +260,13 @@ expect_no_output "bad path" 3 'bad-path2.json: $.parameters[0].path: $.materal.b
 echo '{"command": "lab calibrate", "spec": {"phi": 0.14, "Eb": 3.92e4, "EB": 2.57e9}, "parameters": [{"path": "$.phase", "values": [1]}]}' >"$scratch/bad-cal.json"
 expect_no_output "bad calibration key" 3 '$.phase: not a calibration option; did you mean "phases"?' \
 	"$scratch/bad" "$plume" sweep "$scratch/bad-cal.json" -o "$scratch/bad"
+# The calibration's option ranges are checked before any run, as `plume lab calibrate` checks them.
+echo '{"command": "lab calibrate", "spec": {"phi": 0.14, "Eb": 3.92e4, "EB": 2.57e9}, "parameters": [{"path": "$.EB", "values": [2e9, 2e12]}]}' >"$scratch/bad-cal-range.json"
+expect_no_output "calibration value out of range" 3 'the value 2000000000000 is refused: $.EB is 2e+12, allowed a number in (0, 1e+12]' \
+	"$scratch/bad" "$plume" sweep "$scratch/bad-cal-range.json" -o "$scratch/bad"
+echo '{"command": "lab calibrate", "spec": {"phi": 0.14, "Eb": 3.92e4, "EB": 2.57e9}, "parameters": [{"path": "$.phases", "values": [2, 65]}]}' >"$scratch/bad-cal-phases.json"
+expect_no_output "calibration count out of range" 3 '$.phases is 65, allowed a whole number in [1, 64]' \
+	"$scratch/bad" "$plume" sweep "$scratch/bad-cal-phases.json" -o "$scratch/bad"
 echo "{$base, \"parameters\": [{\"path\": \"\$.material.barb_fraction\", \"distribution\": \"normal\", \"mean\": 0.14, \"std\": 0.02}], \"samples\": 3}" >"$scratch/bad-range.json"
 expect_no_output "distribution outside the range" 3 '$.material.barb_fraction is -0.06, allowed in (0, 1); bound it with "min"/"max"' \
 	"$scratch/bad" "$plume" sweep "$scratch/bad-range.json" -o "$scratch/bad"
