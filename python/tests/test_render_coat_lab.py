@@ -61,7 +61,7 @@ def test_traction_is_the_cli_traction(source, cli, tmp_path):
     assert np.array_equal(table[:, 1], result["stress"])
     assert np.array_equal(table[:, 3], result["iterations"])
     summary = json.loads((tmp_path / "out" / "traction.json").read_text())
-    assert f"{result['slope']:.10g}" == f"{summary['slope_pa']:.10g}"
+    assert result["slope"] == summary["slope_pa"]  # traction.json: the shortest round-trip digits
     assert summary["newton_iterations"] == result["newton_iterations"]
     lab["material"]["E_vw"] = -1
     with pytest.raises(plume.Error) as e:
@@ -75,9 +75,9 @@ def test_calibrate_is_the_cli_calibration(cli, tmp_path):
     expected = json.loads(done.stdout)
     result = plume.calibrate(barb_fraction=0.14, E_b=3.92e4, E_B=2.57e9, element_count=300, macroscale_elements=200,
                              phase_count=1)
-    for key in ("E_vv", "E_ww", "E_vw"):  # the CLI prints %.6g
-        assert f"{result[key]:.6g}" == f"{expected[key]:.6g}", key
-    assert result["slope_tilted"] == pytest.approx(expected["slopes"]["tilted_mesoscale"], rel=1e-7)
+    for key in ("E_vv", "E_ww", "E_vw"):  # the CLI prints the shortest digits that read back the same
+        assert result[key] == expected[key], key
+    assert result["slope_tilted"] == expected["slopes"]["tilted_mesoscale"]
     assert result["solve_count"] == expected["solves"]
     assert result["protocol"] == expected["protocol"]["name"] == "custom"
     for key in ("E_vv", "E_ww", "E_vw"):
@@ -176,7 +176,7 @@ def test_errors_without_a_file_name_none(source):
     assert e.value.message.startswith("render2d: ") and e.value.file is None
     with pytest.raises(plume.Error) as e:
         plume.calibrate(element_count=0)
-    assert e.value.message.startswith("calibration: ") and e.value.file is None
+    assert "elements is 0" in e.value.message and e.value.file is None
 
 
 @pytest.mark.parametrize("message, file", [
