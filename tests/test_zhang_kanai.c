@@ -647,6 +647,38 @@ static void test_bad_definitions(void **state)
 	expect_invalid(&def, "loci must increase");
 }
 
+/// A growth that cannot end is the spec's error, naming the keys that end it. An emitter
+/// too slow for the step passed the step bound; its infinite emission time was stored and
+/// gave barbs at y = inf or NaN (eq. 5), written with exit 0 (1e-9: no barbs, t_end null).
+static void test_runaway_growth_is_a_spec_error(void **state)
+{
+	(void)state;
+	static const double slow[] = {1e-8, 1e-9};
+	for (int k = 0; k < 2; ++k) {
+		plume_zk_def def = plume_zk_default_def();
+		def.emitter_speed = plume_zk_constant(slow[k]);
+		expect_invalid(&def, "$.emitter_speed: the growth does not end: the left emitter needs more than 16000000 "
+		                     "steps of $.step (0.02 s)");
+	}
+	plume_zk_def def = plume_zk_default_def();
+	def.emitter_speed = plume_zk_constant(100.0);
+	expect_invalid(&def, "the left vane emits more than 200000 barbs before its barb 99 matures; lower "
+	                     "$.emitter_speed");
+	def = plume_zk_default_def();
+	def.barb_count = 1;
+	def.barb_speed = plume_zk_constant(1e-8);
+	expect_invalid(&def, "a barb needs more than 2000000 steps of $.step (0.02 s)");
+	// Finite times near 1e299 (V_e about 1e-300 at I_P, reached in one huge step) whose heights
+	// v_grow (t_curr - t) overflow: refused, not built with inf vertices.
+	def = plume_zk_default_def();
+	def.step = 1e6;
+	def.growth_speed = 1e12;
+	def.emitter_speed = (plume_zk_curve){.count = 6,
+	                                     .s = {0.0, 0.48, 0.49, 0.51, 0.52, 1.0},
+	                                     .value = {0.012, 0.012, 1e-300, 1e-300, 0.012, 0.012}};
+	expect_invalid(&def, "the feather's heights overflow: v_grow (t_curr - t) (eq. 5) is not finite");
+}
+
 static void test_curve_stays_positive(void **state)
 {
 	(void)state;
@@ -795,6 +827,7 @@ int main(void)
 	    cmocka_unit_test(test_bezier_collar),
 	    cmocka_unit_test(test_deterministic_and_seeded),
 	    cmocka_unit_test(test_bad_definitions),
+	    cmocka_unit_test(test_runaway_growth_is_a_spec_error),
 	    cmocka_unit_test(test_curve_stays_positive),
 	    cmocka_unit_test(test_spec_stage_options),
 	    cmocka_unit_test(test_estimate_covers_examples),

@@ -513,6 +513,26 @@ static int set_summary(plume_feather *feather, const plume_zk_report *report, co
 	return result;
 }
 
+static bool vec_is_finite(plume_vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
+
+/// Whether every number of the feather that an exporter writes is finite. The growth keeps
+/// its times finite, but a speed near zero at I_P gives finite emission times near 1e300
+/// and heights v_grow (t_curr - t) (eq. 5) past the largest double.
+static bool feather_is_finite(const plume_feather *feather)
+{
+	for (int i = 0; i < feather->shaft_count; ++i) {
+		const plume_shaft_sample *q = feather->shaft + i;
+		if (!vec_is_finite(q->position) || !isfinite(q->width) || !isfinite(q->t))
+			return false;
+	}
+	for (int i = 0; i < feather->point_count; ++i)
+		if (!vec_is_finite(feather->points[i]) || !vec_is_finite(feather->normals[i]) ||
+		    !isfinite(feather->arc_length[i]) || !isfinite(feather->widths[i]) || !isfinite(feather->uv[i].x) ||
+		    !isfinite(feather->uv[i].y))
+			return false;
+	return true;
+}
+
 // ---------------------------------------------------------------------------
 
 plume_status plume_zk_generate(const plume_zk_def *def, uint64_t seed, plume_feather **out, plume_zk_report *report,
@@ -542,7 +562,17 @@ plume_status plume_zk_generate(const plume_zk_def *def, uint64_t seed, plume_fea
 	zk_result result = {.def = def, .growth = &growth, .shape = &shape, .barbules = &barbules};
 	result.base_width =
 	    plume_v3_distance(zk_collar_point(&collar, def->anterior[0]), zk_collar_point(&collar, def->anterior[1]));
-	if ((status = build_feather(&result, &feather)) != PLUME_OK || (status = fill_report(&result, &local)) != PLUME_OK)
+	if ((status = build_feather(&result, &feather)) != PLUME_OK)
+		goto done;
+	if (!feather_is_finite(feather)) {
+		plume_error_set(err, PLUME_ERROR_SPEC,
+		                "the feather's heights overflow: v_grow (t_curr - t) (eq. 5) is not finite with t_end = %g s; "
+		                "raise $.emitter_speed where it is slow (at I_P, $.posterior) or lower $.growth_speed",
+		                growth.t_end);
+		status = PLUME_ERROR_SPEC;
+		goto done;
+	}
+	if ((status = fill_report(&result, &local)) != PLUME_OK)
 		goto done;
 	if (set_summary(feather, &local, def) != 0) {
 		status = PLUME_ERROR_MEMORY;
@@ -561,6 +591,8 @@ done:
 	zk_shape_free(&shape);
 	zk_growth_free(&growth);
 	zk_collar_free(&collar);
+	if (status == PLUME_ERROR_SPEC)
+		return status; // the message is set
 	if (status != PLUME_OK)
 		return plume_error_set(err, status, "out of memory while building a zhang-kanai feather");
 	return PLUME_OK;
