@@ -673,9 +673,8 @@ static void test_runaway_growth_is_a_spec_error(void **state)
 	def = plume_zk_default_def();
 	def.step = 1e6;
 	def.growth_speed = 1e12;
-	def.emitter_speed = (plume_zk_curve){.count = 6,
-	                                     .s = {0.0, 0.48, 0.49, 0.51, 0.52, 1.0},
-	                                     .value = {0.012, 0.012, 1e-300, 1e-300, 0.012, 0.012}};
+	def.emitter_speed = (plume_zk_curve){
+	    .count = 6, .s = {0.0, 0.48, 0.49, 0.51, 0.52, 1.0}, .value = {0.012, 0.012, 1e-300, 1e-300, 0.012, 0.012}};
 	expect_invalid(&def, "the feather's heights overflow: v_grow (t_curr - t) (eq. 5) is not finite");
 }
 

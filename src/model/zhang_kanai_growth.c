@@ -268,7 +268,7 @@ typedef struct vane_run {
 	/// integrating their pathline a second time.
 	path_points kept;
 	int kept_count;
-	zk_runaway runaway; ///< the bound passed, when add_emission failed with PLUME_ERROR_NUMERIC
+	zk_runaway runaway;  ///< the bound passed, when add_emission failed with PLUME_ERROR_NUMERIC
 	int vane_barb_count; ///< N, for fail_runaway's message
 } vane_run;
 
