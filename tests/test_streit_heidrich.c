@@ -747,6 +747,27 @@ static void test_bad_specs(void **state)
 	expect_spec_error("{\"model\": \"streit-heidrich\", \"blend\": {\"feathers\": [\"bad.json\", \"bad.json\"], \"t\": "
 	                  "0.5}}",
 	                  PLUME_ERROR_SPEC, "nest more than");
+	// Inline specs in a blend are part of the file: messages name where they sit in it (they named
+	// the root: "bad.json: $.rachis_length is -1").
+	expect_spec_error("{\"model\": \"streit-heidrich\", \"blend\": {\"feathers\": [{\"model\": \"streit-heidrich\", "
+	                  "\"rachis_length\": -1}, {}], \"t\": 0.5}}",
+	                  PLUME_ERROR_SPEC, "bad.json: $.blend.feathers[0].rachis_length is -1, must be a positive length");
+	expect_spec_error("{\"model\": \"streit-heidrich\", \"blend\": {\"feathers\": [{}, {\"rachis_lenght\": 0.1}], "
+	                  "\"t\": 0.5}}",
+	                  PLUME_ERROR_SPEC, "bad.json: $.blend.feathers[1].rachis_lenght: unknown key");
+	expect_spec_error(
+	    "{\"model\": \"streit-heidrich\", \"blend\": {\"feathers\": [{\"afterfeather\": {\"spacing_tip\": "
+	    "-1}}, {}], \"t\": 0.5}}",
+	    PLUME_ERROR_SPEC, "bad.json: $.blend.feathers[0].afterfeather.spacing_tip is -1");
+	expect_spec_error("{\"model\": \"streit-heidrich\", \"blend\": {\"feathers\": [{\"blend\": {\"feathers\": [{}, "
+	                  "{\"spacing_base\": 0}], \"t\": 0.5}}, {}], \"t\": 0.5}}",
+	                  PLUME_ERROR_SPEC, "bad.json: $.blend.feathers[0].blend.feathers[1].spacing_base is 0");
+	expect_spec_error("{\"model\": \"streit-heidrich\", \"blend\": {\"feathers\": [{}, {\"blend\": {\"t\": 2, "
+	                  "\"feathers\": [{}, {}]}}], \"t\": 0.5}}",
+	                  PLUME_ERROR_SPEC, "bad.json: $.blend.feathers[1].blend.t: is 2, allowed [0, 1]");
+	expect_spec_error("{\"model\": \"streit-heidrich\", \"blend\": {\"feathers\": [{\"model\": \"zhang-kanai\"}, {}], "
+	                  "\"t\": 0.5}}",
+	                  PLUME_ERROR_SPEC, "bad.json: $.blend.feathers[0].model: \"zhang-kanai\" cannot be blended");
 	assert_int_equal(plume_bytes_in_use(), before);
 }
 
