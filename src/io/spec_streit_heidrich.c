@@ -217,10 +217,30 @@ static plume_status read_params(plume_spec_reader *reader, const char *file, con
 	plume_spec_number(reader, object, path, "rachis_front_curvature", &p->rachis_front_curvature);
 	plume_spec_number(reader, object, path, "spacing_base", &p->spacing_base);
 	plume_spec_number(reader, object, path, "spacing_tip", &p->spacing_tip);
-	// Angles: both vanes at once, then either vane on its own.
-	for (int side = 0; side < 2; ++side) {
-		read_angle(reader, object, path, "base_angle_deg", &p->barb_angle[side][0]);
-		read_angle(reader, object, path, "tip_angle_deg", &p->barb_angle[side][1]);
+	// Angles: both vanes at once, then either vane on its own. The validation names the
+	// per-vane keys (left_base_angle_deg), which the spec need not have: the shared keys are
+	// checked here, under the names they were given.
+	static const char *const shared_angles[2] = {"base_angle_deg", "tip_angle_deg"};
+	for (int end = 0; end < 2; ++end) {
+		double degrees = NAN;
+		if (!plume_spec_number(reader, object, path, shared_angles[end], &degrees))
+			continue;
+		if (!(degrees > 0.0 && degrees <= 180.0)) {
+			// The shortest text that reads back as the value: what the spec says (180.0001, not "%g"'s 180).
+			char child[PATH_SIZE], text[32];
+			for (int digits = 6; digits <= 17; ++digits) {
+				snprintf(text, sizeof text, "%.*g", digits, degrees);
+				if (strtod(text, NULL) == degrees)
+					break;
+			}
+			plume_spec_path(child, sizeof child, path, shared_angles[end]);
+			// Worded as the validation words the per-vane keys.
+			if (reader->status == PLUME_OK)
+				reader->status = plume_error_set(reader->err, PLUME_ERROR_SPEC, "%s: %s is %s, allowed (0, 180]",
+				                                 reader->file, child, text);
+		}
+		for (int side = 0; side < 2; ++side)
+			p->barb_angle[side][end] = degrees * PI / 180.0;
 	}
 	read_angle(reader, object, path, "left_base_angle_deg", &p->barb_angle[0][0]);
 	read_angle(reader, object, path, "left_tip_angle_deg", &p->barb_angle[0][1]);
@@ -424,6 +444,32 @@ static void read_texture_mode(plume_spec_reader *reader, const json_t *root, con
 	                plume_spec_nearest(mode, names));
 }
 
+/// Keys of the whole feather (texture_mode, model, ...) put in the afterfeather: named as such,
+/// where "did you mean" would guess a parameter that has nothing to do with them.
+static void check_afterfeather_keys(plume_spec_reader *reader, const json_t *after, const char *base,
+                                    const char *after_path)
+{
+	const char *key;
+	json_t *value;
+	json_object_foreach ((json_t *)after, key, value) {
+		bool feather_key = false, after_key = false;
+		for (const char *const *k = top_keys; *k != NULL; ++k)
+			feather_key = feather_key || strcmp(key, *k) == 0;
+		for (const char *const *k = afterfeather_keys; *k != NULL; ++k)
+			after_key = after_key || strcmp(key, *k) == 0;
+		if (feather_key && !after_key) {
+			char child[PATH_SIZE], top[PATH_SIZE];
+			plume_spec_path(child, sizeof child, after_path, key);
+			plume_spec_path(top, sizeof top, base, key);
+			plume_spec_fail(reader, child,
+			                "is a key of the whole feather, not of its afterfeather: give it at the spec's top level "
+			                "(%s)",
+			                top);
+			return;
+		}
+	}
+}
+
 /// plume_sh_def_validate names the keys from the root of a spec ("$.rachis_length ..."): an inline
 /// spec at base ("$.blend.feathers[0]") gets base in its place, then the file in front.
 static void name_from_base(plume_error *err, const char *file, const char *base)
@@ -488,6 +534,7 @@ plume_status plume_sh_def_from_json(const char *file, const json_t *root, const 
 				def->has_afterfeather = json_is_true(after);
 			} else if (json_is_object(after)) {
 				def->has_afterfeather = true;
+				check_afterfeather_keys(&reader, after, base, after_path);
 				plume_spec_check_keys(&reader, after, after_path, afterfeather_keys);
 				read_params(&reader, file, after, after_path, &def->afterfeather, err);
 			} else {

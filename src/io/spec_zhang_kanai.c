@@ -275,7 +275,7 @@ plume_status plume_zk_spec_generate(const char *file, const json_t *root, const 
 	}
 	status = plume_spec_check_feather_bytes(
 	    file, plume_zk_estimate_bytes(&def), options, err,
-	    "$.barb_count (%d) and the barbs still growing ($.collar_radius or $.collar_points, $.barb_speed, "
+	    "$.barb_count (%d) and the barbs still growing ($.collar.radius or $.collar.points, $.barb_speed, "
 	    "$.emitter_speed, $.ridge_width) x their points ($.step %g, $.downsample %d%s)",
 	    def.barb_count, def.step, def.downsample, def.expansion && def.keep_barbules ? ", barbules kept" : "");
 	if (status != PLUME_OK)

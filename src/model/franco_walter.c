@@ -14,6 +14,7 @@
 // frame between vanes so that S_v gives mirror-image vanes.
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "../core/asserts.h"
@@ -63,9 +64,17 @@ plume_fw_def plume_fw_default_def(void)
 
 static plume_status check_range(double value, double lo, double hi, const char *path, plume_error *err)
 {
-	if (!(value >= lo && value <= hi))
-		return plume_error_set(err, PLUME_ERROR_SPEC, "%s is %g, allowed [%g, %g]", path, value, lo, hi);
-	return PLUME_OK;
+	if (value >= lo && value <= hi)
+		return PLUME_OK;
+	// With the digits it takes to show the value outside: "%g" printed 0.9500001 as 0.95.
+	char text[32];
+	for (int digits = 6; digits <= 17; ++digits) {
+		snprintf(text, sizeof text, "%.*g", digits, value);
+		double printed = strtod(text, NULL);
+		if (printed == value || (printed != lo && printed != hi))
+			break;
+	}
+	return plume_error_set(err, PLUME_ERROR_SPEC, "%s is %s, allowed [%g, %g]", path, text, lo, hi);
 }
 
 static plume_status check_positive(double value, const char *path, plume_error *err)

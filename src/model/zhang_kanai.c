@@ -10,6 +10,7 @@
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "../core/asserts.h"
@@ -68,10 +69,24 @@ plume_zk_def plume_zk_default_def(void)
 // ---------------------------------------------------------------------------
 // Validation: messages name the spec's JSON path.
 
+/// value with the digits it takes to show it outside [lo, hi]: "%g" printed a growth_stage of
+/// 1.0000001 as "1", a value the message then called not allowed.
+static const char *outside(char *out, size_t size, double value, double lo, double hi)
+{
+	for (int digits = 6;; ++digits) {
+		snprintf(out, size, "%.*g", digits, value);
+		double printed = strtod(out, NULL);
+		if (digits >= 17 || printed == value || (printed != lo && printed != hi))
+			return out;
+	}
+}
+
 static plume_status check_range(double value, double lo, double hi, const char *path, plume_error *err)
 {
+	char text[32];
 	if (!(value >= lo && value <= hi))
-		return plume_error_set(err, PLUME_ERROR_SPEC, "%s is %g, allowed [%g, %g]", path, value, lo, hi);
+		return plume_error_set(err, PLUME_ERROR_SPEC, "%s is %s, allowed [%g, %g]", path,
+		                       outside(text, sizeof text, value, lo, hi), lo, hi);
 	return PLUME_OK;
 }
 
@@ -183,14 +198,16 @@ plume_status plume_zk_def_validate(const plume_zk_def *def, plume_error *err)
 	    (status = check_positive(def->barb_width_tip, "$.barb_width_tip", "width in metres", err)) != PLUME_OK ||
 	    (status = check_positive(def->barbule_width, "$.barbule_width", "width in metres", err)) != PLUME_OK)
 		return status;
+	char text[32];
 	if (!(def->rachis_taper > 0.0 && def->rachis_taper <= 1.0))
-		return plume_error_set(err, PLUME_ERROR_SPEC, "$.rachis_taper is %g, allowed (0, 1]", def->rachis_taper);
+		return plume_error_set(err, PLUME_ERROR_SPEC, "$.rachis_taper is %s, allowed (0, 1]",
+		                       outside(text, sizeof text, def->rachis_taper, 0.0, 1.0));
 	if (!(def->theta_distal > 0.0 && def->theta_distal < 180.0 * deg))
-		return plume_error_set(err, PLUME_ERROR_SPEC, "$.theta_distal_deg is %g, allowed (0, 180)",
-		                       def->theta_distal / deg);
+		return plume_error_set(err, PLUME_ERROR_SPEC, "$.theta_distal_deg is %s, allowed (0, 180)",
+		                       outside(text, sizeof text, def->theta_distal / deg, 0.0, 180.0));
 	if (!(def->theta_proximal > 0.0 && def->theta_proximal < 180.0 * deg))
-		return plume_error_set(err, PLUME_ERROR_SPEC, "$.theta_proximal_deg is %g, allowed (0, 180)",
-		                       def->theta_proximal / deg);
+		return plume_error_set(err, PLUME_ERROR_SPEC, "$.theta_proximal_deg is %s, allowed (0, 180)",
+		                       outside(text, sizeof text, def->theta_proximal / deg, 0.0, 180.0));
 	if ((status = check_range(def->azimuth / deg, 0.0, 180.0, "$.azimuth_deg", err)) != PLUME_OK)
 		return status;
 	if (def->split_count < 0 || def->split_count > PLUME_ZK_MAX_SPLITS)
@@ -208,8 +225,8 @@ plume_status plume_zk_def_validate(const plume_zk_def *def, plume_error *err)
 		if ((status = check_range(split->at, 0.0, 1.0, path, err)) != PLUME_OK)
 			return status;
 		if (!(fabs(split->angle) < 180.0 * deg))
-			return plume_error_set(err, PLUME_ERROR_SPEC, "$.splits[%d].angle_deg is %g, allowed (-180, 180)", k,
-			                       split->angle / deg);
+			return plume_error_set(err, PLUME_ERROR_SPEC, "$.splits[%d].angle_deg is %s, allowed (-180, 180)", k,
+			                       outside(text, sizeof text, split->angle / deg, -180.0, 180.0));
 	}
 	return PLUME_OK;
 }
