@@ -678,6 +678,37 @@ static void test_runaway_growth_is_a_spec_error(void **state)
 	expect_invalid(&def, "the feather's heights overflow: v_grow (t_curr - t) (eq. 5) is not finite");
 }
 
+/// Splits that cannot bend anything are refused: each gave the feather without the split.
+static void test_splits_that_do_nothing_are_refused(void **state)
+{
+	(void)state;
+	plume_zk_def def = plume_zk_default_def();
+	def.barb_count = 50;
+	def.expansion = true;
+	def.split_count = 1;
+	def.splits[0] = (plume_zk_split){.side = PLUME_SIDE_RIGHT, .barb = 500, .at = 0.5, .angle = 0.3};
+	expect_invalid(&def, "$.splits[0].barb is 500, allowed [0, 49]: a vane has at most $.barb_count (50) barbs");
+	// The right vane ends with 49 barbs (its barb 49 still developing at t_end): barb 49 is not there.
+	def.splits[0].barb = 49;
+	expect_invalid(&def, "$.splits[0].barb is 49, but the right vane has 49 barbs (0 to 48)");
+	def.splits[0].side = PLUME_SIDE_LEFT; // the left vane has it
+	generated left = generate(&def, 1);
+	assert_int_equal(left.report.barbs[0].snap, PLUME_ZK_SNAP_SPLIT); // the left vane's base barb, emitted last
+	release(&left);
+	// Below stage 1 a split waits for its barb: a growth sequence is not refused for its early frames.
+	def.splits[0] = (plume_zk_split){.side = PLUME_SIDE_RIGHT, .barb = 48, .at = 0.5, .angle = 0.3};
+	def.growth_stage = 0.1;
+	generated young = generate(&def, 1);
+	for (int k = 0; k < young.report.barb_count; ++k)
+		assert_true(young.report.barbs[k].snap != PLUME_ZK_SNAP_SPLIT);
+	release(&young);
+	// Without expansion there is no snapping for a split to come before.
+	def.growth_stage = 1.0;
+	def.expansion = false;
+	expect_invalid(&def, "$.splits: a split bends a barb before snapping (IV-C), which runs with \"expansion\": true "
+	                     "only");
+}
+
 static void test_curve_stays_positive(void **state)
 {
 	(void)state;
@@ -822,6 +853,7 @@ int main(void)
 	    cmocka_unit_test(test_snapped_barbules_touch_the_barb_above),
 	    cmocka_unit_test(test_unsnapped_barbs_are_reported),
 	    cmocka_unit_test(test_split_bends_the_barbs_below),
+	    cmocka_unit_test(test_splits_that_do_nothing_are_refused),
 	    cmocka_unit_test(test_rachis_from_barb_roots),
 	    cmocka_unit_test(test_growth_stages),
 	    cmocka_unit_test(test_crest_stops_before_the_bgz),

@@ -213,14 +213,24 @@ plume_status plume_zk_def_validate(const plume_zk_def *def, plume_error *err)
 	if (def->split_count < 0 || def->split_count > PLUME_ZK_MAX_SPLITS)
 		return plume_error_set(err, PLUME_ERROR_SPEC, "$.splits has %d entries, allowed at most %d", def->split_count,
 		                       PLUME_ZK_MAX_SPLITS);
+	// A split bends a barb before snapping (IV-C, Figure 11 bottom), which only expansion runs: without
+	// it a split did nothing, silently.
+	if (def->split_count > 0 && !def->expansion)
+		return plume_error_set(err, PLUME_ERROR_SPEC,
+		                       "$.splits: a split bends a barb before snapping (IV-C), which runs with "
+		                       "\"expansion\": true only; set $.expansion to true or remove $.splits");
 	for (int k = 0; k < def->split_count; ++k) {
 		const plume_zk_split *split = def->splits + k;
 		char path[64];
 		if (split->side != PLUME_SIDE_LEFT && split->side != PLUME_SIDE_RIGHT)
 			return plume_error_set(err, PLUME_ERROR_SPEC, "$.splits[%d].side must be \"left\" or \"right\"", k);
-		if (split->barb < 0 || split->barb >= PLUME_ZK_MAX_BARBS)
-			return plume_error_set(err, PLUME_ERROR_SPEC, "$.splits[%d].barb is %d, allowed [0, %d)", k, split->barb,
-			                       PLUME_ZK_MAX_BARBS);
+		// A vane of the finished feather has at most N barbs (N = barb_count on the vane that ends
+		// the growth); zk_check_splits checks the vane's own count once it has grown.
+		if (split->barb < 0 || split->barb >= def->barb_count)
+			return plume_error_set(err, PLUME_ERROR_SPEC,
+			                       "$.splits[%d].barb is %d, allowed [0, %d]: a vane has at most $.barb_count (%d) "
+			                       "barbs, numbered in emission order from 0, the most distal",
+			                       k, split->barb, def->barb_count - 1, def->barb_count);
 		snprintf(path, sizeof path, "$.splits[%d].at", k);
 		if ((status = check_range(split->at, 0.0, 1.0, path, err)) != PLUME_OK)
 			return status;
@@ -530,6 +540,27 @@ static int set_summary(plume_feather *feather, const plume_zk_report *report, co
 	return result;
 }
 
+/// A split of a barb the finished feather does not have: refused, where it once gave the feather
+/// without the split. The vane that does not end the growth can have fewer than N barbs (its barb
+/// N - 1 still developing at t_end). Below stage 1 a split waits for its barb to be emitted: a
+/// growth sequence shows it from the frame that has the barb.
+static plume_status check_splits(const plume_zk_def *def, const zk_growth *growth, plume_error *err)
+{
+	if (def->growth_stage < 1.0)
+		return PLUME_OK;
+	for (int k = 0; k < def->split_count; ++k) {
+		const plume_zk_split *split = def->splits + k;
+		int count = growth->side_count[split->side];
+		if (split->barb >= count)
+			return plume_error_set(err, PLUME_ERROR_SPEC,
+			                       "$.splits[%d].barb is %d, but the %s vane has %d barbs (0 to %d): its barb %d is "
+			                       "still developing when the growth ends",
+			                       k, split->barb, split->side == PLUME_SIDE_LEFT ? "left" : "right", count, count - 1,
+			                       count);
+	}
+	return PLUME_OK;
+}
+
 static bool vec_is_finite(plume_vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
 
 /// Whether every number of the feather that an exporter writes is finite. The growth keeps
@@ -570,6 +601,11 @@ plume_status plume_zk_generate(const plume_zk_def *def, uint64_t seed, plume_fea
 	if ((status = zk_collar_init(&collar, def)) != PLUME_OK)
 		return plume_error_set(err, status, "out of memory");
 	if ((status = zk_grow(def, &collar, seed, &growth, err)) != PLUME_OK) {
+		zk_collar_free(&collar);
+		return status;
+	}
+	if ((status = check_splits(def, &growth, err)) != PLUME_OK) {
+		zk_growth_free(&growth);
 		zk_collar_free(&collar);
 		return status;
 	}
