@@ -380,18 +380,48 @@ static double collar_length_bound(const plume_zk_def *def)
 	return length;
 }
 
+/// Points a pathline of at most length metres keeps: its first, every f-th of its whole steps, its
+/// last (pathline()). RK4's increment is h times a mean of V_b at its stages, each at least the
+/// curve's smallest control value v_min, so every whole step moves at least h v_min along the collar:
+/// at most length / (h v_min) whole steps (one more for rounding where that is near a whole number),
+/// and never more than MAX_STEPS_PER_PATH (growth refuses more).
+static double pathline_points(double length, double h, double v_min, double f)
+{
+	return 2.0 + floor(fmin((double)MAX_STEPS_PER_PATH, floor(length / (h * v_min)) + 1.0) / f);
+}
+
 double plume_zk_estimate_bytes(const plume_zk_def *def)
 {
-	double path_time = collar_length_bound(def) / curve_extreme(&def->barb_speed, false);
-	double steps = fmin((double)MAX_STEPS_PER_PATH, ceil(path_time / def->step)) + 1.0;
-	double vertices_per_barb = steps / (double)(def->downsample > 0 ? def->downsample : 1) + 2.0;
-	double spacing = def->ridge_width * (1.0 - def->ridge_width_variation);
-	double developing =
-	    fmin((double)MAX_EMISSIONS_PER_VANE, path_time * curve_extreme(&def->emitter_speed, true) / spacing + 1.0);
-	double barbs = 2.0 * ((double)def->barb_count + developing);
-	double vertices = barbs * vertices_per_barb;
+	double perimeter = collar_length_bound(def), v_min = curve_extreme(&def->barb_speed, false);
+	double h = def->step, f = (double)(def->downsample > 0 ? def->downsample : 1);
+	double d = def->ridge_width, variation = def->ridge_width_variation;
+	int n = def->barb_count > 0 && def->barb_count <= PLUME_ZK_MAX_BARBS ? def->barb_count : 0;
+	if (!(v_min > 0.0 && h > 0.0 && d > 0.0 && perimeter >= 0.0 && variation >= 0.0 && variation < 1.0) || n == 0)
+		return INFINITY; // refused by validation
+	double points = 0.0, barbs = 0.0;
+	for (int side = 0; side < 2; ++side) {
+		// A barb grows from where it was emitted back to I_A: at most this vane's path from I_A to I_P.
+		double path = perimeter * fabs(def->posterior[side] - def->anterior[side]);
+		// Mature barbs: at most N a vane (N of one vane end the growth; below stage 1 fewer are), the
+		// first N emitted, as barbs mature in emission order. Barb i leaves the ridge D_i =
+		// d ((i + 1) + the sum of its r_j) <= d (i + 1) (1 + v) from I_A, or at I_P.
+		for (int i = 0; i < n; ++i)
+			points += pathline_points(fmin(path, d * (i + 1) * (1.0 + variation)), h, v_min, f);
+		barbs += n;
+		if (def->growth_stage >= 1.0)
+			continue; // IV-A Termination: the developing barbs are discarded
+		// Below stage 1 the developing barbs are kept, each as far as it grew: one younger than the
+		// longest pathline time T each, emitted at least delta = d (1 - v) / max V_e apart. Their ages
+		// are below T, T - delta, T - 2 delta, ...: their points sum to less than that series'.
+		double t_max = path / v_min, rate_max = curve_extreme(&def->emitter_speed, true);
+		double delta = d * (1.0 - variation) / rate_max;
+		double count = fmin((double)MAX_EMISSIONS_PER_VANE, ceil(t_max / delta));
+		double ages = count * t_max - delta * count * (count - 1.0) / 2.0;
+		points += 3.0 * count + fmin(ages / h, count * (double)MAX_STEPS_PER_PATH) / f;
+		barbs += count;
+	}
 	bool barbules = def->expansion && def->keep_barbules;
-	return plume_feather_layout_bytes(vertices * (barbules ? 5.0 : 1.0), barbs, barbules ? 2.0 * vertices : 0.0,
+	return plume_feather_layout_bytes(points * (barbules ? 5.0 : 1.0), barbs, barbules ? 2.0 * points : 0.0,
 	                                  def->shaft_samples);
 }
 
