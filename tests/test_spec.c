@@ -219,6 +219,13 @@ static void test_missing_file_is_an_io_error(void **state)
 	plume_error err = {0};
 	assert_int_equal(plume_spec_generate("/nonexistent/spec.json", NULL, &feather, &err), PLUME_ERROR_IO);
 	assert_non_null(strstr(err.message, "/nonexistent/spec.json: cannot read: No such file or directory"));
+	// A folder opens for reading, then its first read fails: it was a syntax error at 1:0.
+	char folder[256];
+	test_make_temp_dir(folder, sizeof folder);
+	assert_int_equal(plume_spec_generate(folder, NULL, &feather, &err), PLUME_ERROR_IO);
+	assert_null(feather);
+	assert_non_null(strstr(err.message, ": cannot read: Is a directory"));
+	test_remove_tree(folder);
 }
 
 static void test_every_preset_generates(void **state)

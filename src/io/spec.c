@@ -8,6 +8,7 @@
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/stat.h>
 
 json_t *plume_spec_load(const char *path, plume_error *err)
 {
@@ -15,6 +16,14 @@ json_t *plume_spec_load(const char *path, plume_error *err)
 	FILE *file = fopen(path, "rb");
 	if (file == NULL) {
 		plume_error_set(err, PLUME_ERROR_IO, "%s: cannot read: %s", path, strerror(errno));
+		return NULL;
+	}
+	// A folder opens for reading; its first read fails, which jansson took for an empty text
+	// ("'[' or '{' expected", a syntax error at 1:0).
+	struct stat info;
+	if (fstat(fileno(file), &info) == 0 && S_ISDIR(info.st_mode)) {
+		fclose(file);
+		plume_error_set(err, PLUME_ERROR_IO, "%s: cannot read: %s (a spec is a JSON file)", path, strerror(EISDIR));
 		return NULL;
 	}
 	json_error_t error;
