@@ -26,6 +26,18 @@ static plume_status write_summary(cli_output *output, const plume_feather *feath
 	return PLUME_OK;
 }
 
+/// cli_parse_formats skips one comma after each name, so "png," passed where "png,,obj" did not:
+/// an empty item is refused wherever it is.
+static bool formats_without_empty_items(const char *command, const char *list)
+{
+	size_t length = strlen(list);
+	if (length > 0 && (list[0] == ',' || list[length - 1] == ',' || strstr(list, ",,") != NULL)) {
+		cli_usage_error(command, "--format '%s' has an empty item; allowed: png, svg, pdf, obj, usda, json, glb", list);
+		return false;
+	}
+	return true;
+}
+
 void cli_help_generate(void)
 {
 	puts("Usage: plume generate SPEC.json -o DIR [options]\n"
@@ -79,7 +91,7 @@ int cli_generate(int argc, char **argv)
 			spec_options.seed_given = true;
 			break;
 		case 'f':
-			if (!cli_parse_formats("generate", optarg, &formats))
+			if (!formats_without_empty_items("generate", optarg) || !cli_parse_formats("generate", optarg, &formats))
 				return CLI_EXIT_USAGE;
 			break;
 		case 'S':

@@ -27,13 +27,26 @@ void cli_help_grow(void)
 	     "  -n, --frames N         number of frames, [1, 10000]\n"
 	     "  -u, --unfurl           unfurling stages instead of growth (zhang-kanai)\n"
 	     "  -s, --seed N           random seed; overrides the spec's \"seed\" (default 1)\n"
-	     "  -f, --format LIST      comma-separated: png,svg,pdf,obj,usda,json (default: png,obj,usda)\n"
+	     "  -f, --format LIST      comma-separated: png,svg,pdf,obj,usda,json,glb (default:\n"
+	     "                         png,obj,usda); every frame is frame-NNNN.<ext>\n"
 	     "      --size WxH         image size in pixels (default: 1200 tall, width to fit);\n"
 	     "                         every frame shares one framing, so the feather grows in it\n"
 	     "      --style STYLE      lines (default) or strips (alpha-faded triangle strips)\n"
 	     "  -h, --help             this help\n"
 	     "\n"
 	     "Example: plume grow examples/streit-heidrich/contour.json -o growth --frames 5");
+}
+
+/// cli_parse_formats skips one comma after each name, so "png," passed where "png,,obj" did not:
+/// an empty item is refused wherever it is.
+static bool formats_without_empty_items(const char *command, const char *list)
+{
+	size_t length = strlen(list);
+	if (length > 0 && (list[0] == ',' || list[length - 1] == ',' || strstr(list, ",,") != NULL)) {
+		cli_usage_error(command, "--format '%s' has an empty item; allowed: png, svg, pdf, obj, usda, json, glb", list);
+		return false;
+	}
+	return true;
 }
 
 static bool parse_frames(const char *text, int *frames)
@@ -51,17 +64,30 @@ static bool parse_frames(const char *text, int *frames)
 
 static double frame_stage(int i, int frames) { return frames > 1 ? (double)i / (frames - 1) : 1.0; }
 
+/// One frame's feather. A model without the stages asked for (franco-walter has none,
+/// streit-heidrich no unfurling) fails with PLUME_ERROR_UNSUPPORTED, which the command
+/// once reported as a failed computation (exit 1): *wrong_stages tells cli_grow it is the
+/// command line's mistake.
+static plume_status generate_frame(const char *spec, const plume_spec_options *options, plume_feather **out,
+                                   bool *wrong_stages, plume_error *err)
+{
+	plume_status status = plume_spec_generate(spec, options, out, err);
+	if (status == PLUME_ERROR_UNSUPPORTED)
+		*wrong_stages = true;
+	return status;
+}
+
 /// The union of every frame's bounds in the feather plane, so that all frames share one framing and the
 /// feather is seen to grow.
 static plume_status frame_bounds(const char *spec, plume_spec_options options, int frames, plume_vec2 *lo,
-                                 plume_vec2 *hi, plume_error *err)
+                                 plume_vec2 *hi, bool *wrong_stages, plume_error *err)
 {
 	*lo = (plume_vec2){1e300, 1e300};
 	*hi = (plume_vec2){-1e300, -1e300};
 	for (int i = 0; i < frames; ++i) {
 		options.stage = frame_stage(i, frames);
 		plume_feather *feather = NULL;
-		plume_status status = plume_spec_generate(spec, &options, &feather, err);
+		plume_status status = generate_frame(spec, &options, &feather, wrong_stages, err);
 		if (status != PLUME_OK)
 			return status;
 		plume_feather_info info = plume_feather_get_info(feather);
@@ -104,11 +130,12 @@ static void release_frame_job(void *data)
 /// as cli_write_feather writes it. The first failure, here or in the writer, is the one
 /// returned.
 static plume_status write_frames(cli_output *output, const char *spec, plume_spec_options options, int frames,
-                                 unsigned formats, plume_render2d_def image, plume_error *err)
+                                 unsigned formats, plume_render2d_def image, bool *wrong_stages, plume_error *err)
 {
 	plume_status status = PLUME_OK;
 	if ((formats & (CLI_FORMAT_PNG | CLI_FORMAT_SVG | CLI_FORMAT_PDF)) != 0) {
-		if ((status = frame_bounds(spec, options, frames, &image.view_min, &image.view_max, err)) != PLUME_OK)
+		if ((status = frame_bounds(spec, options, frames, &image.view_min, &image.view_max, wrong_stages, err)) !=
+		    PLUME_OK)
 			return status;
 		if (image.width == 0) { // 1200 tall, as wide as the framing needs
 			double w = image.view_max.x - image.view_min.x, h = image.view_max.y - image.view_min.y;
@@ -129,7 +156,7 @@ static plume_status write_frames(cli_output *output, const char *spec, plume_spe
 			break;
 		}
 		*job = (frame_job){.image = image};
-		if ((status = plume_spec_generate(spec, &options, &job->feather, err)) != PLUME_OK) {
+		if ((status = generate_frame(spec, &options, &job->feather, wrong_stages, err)) != PLUME_OK) {
 			free(job);
 			break;
 		}
@@ -183,7 +210,7 @@ int cli_grow(int argc, char **argv)
 			spec_options.seed_given = true;
 			break;
 		case 'f':
-			if (!cli_parse_formats("grow", optarg, &formats))
+			if (!formats_without_empty_items("grow", optarg) || !cli_parse_formats("grow", optarg, &formats))
 				return CLI_EXIT_USAGE;
 			break;
 		case 'S':
@@ -205,14 +232,17 @@ int cli_grow(int argc, char **argv)
 		return cli_usage_error("grow", "missing --frames N");
 	cli_output output;
 	plume_error err = {0};
+	bool wrong_stages = false;
 	plume_status status = cli_output_begin(&output, output_dir, &err);
 	if (status == PLUME_OK) {
-		status = write_frames(&output, argv[optind], spec_options, frames, formats, image, &err);
+		status = write_frames(&output, argv[optind], spec_options, frames, formats, image, &wrong_stages, &err);
 		if (status == PLUME_OK)
 			status = cli_output_commit(&output, &err);
 		else
 			cli_output_abort(&output, &err);
 	}
+	if (status != PLUME_OK && wrong_stages)
+		return cli_usage_error("grow", "%s", err.message);
 	if (status != PLUME_OK)
 		return cli_fail(&err);
 	return CLI_EXIT_OK;

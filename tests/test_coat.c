@@ -397,7 +397,16 @@ static void test_bad_coats(void **state)
 	                  PLUME_ERROR_SPEC, "coat key feathers are streit-heidrich feathers");
 	expect_coat_error("\"surface\": {\"type\": \"plane\", \"size\": [0.05, 0.05]}, \"follicles\": {\"spacing\": 0.01},"
 	                  "\"key_feathers\": [{\"at\": [0, 0], \"feather\": {\"rachis_length\": -1}}]",
-	                  PLUME_ERROR_SPEC, "$.rachis_length is -1");
+	                  PLUME_ERROR_SPEC, "bad.json: $.key_feathers[0].feather.rachis_length is -1");
+	// An inline key feather is part of the coat's file: its keys are named from the coat's root.
+	expect_coat_error("\"surface\": {\"type\": \"plane\", \"size\": [0.05, 0.05]}, \"follicles\": {\"spacing\": 0.01},"
+	                  "\"key_feathers\": [{\"at\": [0, 0], \"feather\": \"@plume.json\"}, {\"at\": [0.02, 0], "
+	                  "\"feather\": {\"rachis_lenght\": 0.1}}]",
+	                  PLUME_ERROR_SPEC, "bad.json: $.key_feathers[1].feather.rachis_lenght: unknown key");
+	expect_coat_error("\"surface\": {\"type\": \"plane\", \"size\": [0.05, 0.05]}, \"follicles\": {\"spacing\": 0.01},"
+	                  "\"key_feathers\": [{\"at\": [0, 0], \"feather\": {\"blend\": {\"feathers\": [{}, "
+	                  "{\"spacing_tip\": -1}], \"t\": 0.5}}}]",
+	                  PLUME_ERROR_SPEC, "bad.json: $.key_feathers[0].feather.blend.feathers[1].spacing_tip is -1");
 	expect_coat_error("\"surface\": {\"type\": \"plane\", \"size\": [0.05, 0.05]}, \"follicles\": {\"spacing\": 0.01},"
 	                  "\"key_feathers\": [{\"at\": [0, 0], \"feather\": \"@plume.json\"},"
 	                  "{\"at\": [0.001, 0], \"feather\": \"@plume.json\"}]",

@@ -357,6 +357,51 @@ static void test_ranges_are_enforced(void **state)
 	def = plume_fw_default_def();
 	def.left_outline[2].x = NAN;
 	expect_invalid(def, "$.left_outline[2]");
+	// Base != tip, but far too short: once accepted, with tangents of rounding noise.
+	def = plume_fw_default_def();
+	def.shaft[0] = def.shaft[1] = (plume_vec2){0.0, 0.0};
+	def.shaft[2] = def.shaft[3] = (plume_vec2){0.0, 1e-300};
+	expect_invalid(def, "$.shaft is 1e-300 m long; allowed at least 0.0001 m (0.1 mm)");
+	def.shaft[2] = def.shaft[3] = (plume_vec2){0.0, 9e-5};
+	expect_invalid(def, "$.shaft is 9e-05 m long; allowed at least 0.0001 m");
+	def.shaft[2] = def.shaft[3] = (plume_vec2){0.0, 1e-4};
+	plume_feather_destroy(generate(&def, 1));
+}
+
+/// Coincident control points at the shaft's ends make B' vanish there: the tangent comes
+/// from the next derivative that does not, so every sample has a unit tangent towards the
+/// tip and a unit binormal ([0, 0, 0] at samples 0 and 99 before).
+static void test_shaft_tangents_at_coincident_control_points(void **state)
+{
+	(void)state;
+	static const plume_vec2 shafts[][4] = {
+	    {{0.0, 0.0}, {0.0, 0.0}, {0.0, 0.2}, {0.0, 0.2}},          // P0 = P1, P2 = P3
+	    {{0.0, 0.0}, {0.0, 0.0}, {0.0, 0.0}, {0.01, 0.2}},         // P0 = P1 = P2: B''' gives it
+	    {{0.0, 0.0}, {0.03, 0.1}, {0.01, 0.2}, {0.01, 0.2}},       // curved, P2 = P3
+	    {{0.0, 0.0}, {0.0, 1e-19}, {0.0, 0.2}, {0.0, 0.2}},        // P1 a rounding error from P0
+	    {{0.0, 0.0}, {0.0015, 0.07}, {0.005, 0.14}, {0.004, 0.2}}, // the hawk: unchanged
+	};
+	for (size_t k = 0; k < sizeof shafts / sizeof shafts[0]; ++k) {
+		plume_fw_def def = plume_fw_default_def();
+		memcpy(def.shaft, shafts[k], sizeof def.shaft);
+		def.segments[0].barb_count = 5;
+		def.segments[1].barb_count = 5;
+		plume_feather *feather = generate(&def, 1);
+		int count = plume_feather_get_info(feather).shaft_sample_count;
+		const plume_shaft_sample *shaft = plume_feather_shaft(feather);
+		for (int i = 0; i < count; ++i) {
+			if (fabs(plume_v3_length(shaft[i].tangent) - 1.0) > 1e-12 ||
+			    fabs(plume_v3_length(shaft[i].binormal) - 1.0) > 1e-12)
+				fail_msg("shaft %zu, sample %d: tangent (%g, %g, %g), binormal (%g, %g, %g)", k, i, shaft[i].tangent.x,
+				         shaft[i].tangent.y, shaft[i].tangent.z, shaft[i].binormal.x, shaft[i].binormal.y,
+				         shaft[i].binormal.z);
+			// Towards the tip: along the chord to the next sample (from the one before at the tip).
+			plume_vec3 chord = i + 1 < count ? plume_v3_sub(shaft[i + 1].position, shaft[i].position)
+			                                 : plume_v3_sub(shaft[i].position, shaft[i - 1].position);
+			assert_true(plume_v3_dot(shaft[i].tangent, plume_v3_normalize(chord)) > 0.9);
+		}
+		plume_feather_destroy(feather);
+	}
 }
 
 static void test_extreme_counts(void **state)
@@ -389,6 +434,7 @@ int main(void)
 	    cmocka_unit_test(test_same_seed_same_feather),
 	    cmocka_unit_test(test_ranges_are_enforced),
 	    cmocka_unit_test(test_extreme_counts),
+	    cmocka_unit_test(test_shaft_tangents_at_coincident_control_points),
 	};
 	return cmocka_run_group_tests_name("franco_walter", tests, NULL, NULL);
 }

@@ -292,6 +292,59 @@ static void test_json_refuses_non_finite_numbers(void **state)
 	assert_int_equal(plume_bytes_in_use(), before);
 }
 
+/// OBJ and USD print numbers with "%.9g", which writes "nan" and "inf" that no reader takes:
+/// both writers refuse such a feather (USD also a number past float, which it holds as inf),
+/// name the piece, and leave the file that was there.
+static void test_obj_usda_refuse_non_finite_numbers(void **state)
+{
+	(void)state;
+	int64_t before = plume_bytes_in_use();
+	char dir[256], path[512];
+	test_make_temp_dir(dir, sizeof dir);
+	for (int which = FORMAT_OBJ; which <= FORMAT_USDA; ++which) {
+		snprintf(path, sizeof path, "%s/feather.%s", dir, format_extensions[which]);
+		plume_feather *good = small_feather(1);
+		write_ok((format)which, good, path);
+		uint64_t hash = test_hash_file(path);
+		plume_feather_destroy(good);
+		for (int piece = 0; piece < 4; ++piece) {
+			plume_feather *feather = small_feather(1);
+			plume_feather *after = feather->afterfeather;
+			const char *named = NULL;
+			switch (piece) {
+			case 0:
+				feather->shaft[1].position.y = NAN;
+				named = ": shaft sample 1 has a NaN or infinite number";
+				break;
+			case 1:
+				after->points[after->barbs[2].curve.first + 1].x = INFINITY;
+				named = ": afterfeather's barb 2 (point 1) has a NaN or infinite number";
+				break;
+			case 2:
+				feather->uv[feather->barbules[1].curve.first].y = NAN;
+				named = ": barbule 1 (point 0) has a NaN or infinite number";
+				break;
+			default: // finite, but inf as USD's float (OBJ prints the double)
+				feather->points[feather->barbs[0].curve.first].z = 1e39;
+				named = ": barb 0 (point 0) has a NaN or infinite number (or one past single precision";
+				break;
+			}
+			if (which == FORMAT_USDA || piece < 3) {
+				plume_error err;
+				assert_int_equal(write_format((format)which, feather, path, &err), PLUME_ERROR_NUMERIC);
+				if (strstr(err.message, named) == NULL || strstr(err.message, path) == NULL)
+					fail_msg("%s, piece %d: %s", format_extensions[which], piece, err.message);
+				assert_true(test_hash_file(path) == hash); // the earlier file is kept
+			}
+			plume_feather_destroy(feather);
+		}
+		remove(path);
+	}
+	assert_int_equal(test_count_entries(dir), 0);
+	test_remove_tree(dir);
+	assert_int_equal(plume_bytes_in_use(), before);
+}
+
 static long long file_size(const char *path)
 {
 	struct stat info;
@@ -952,6 +1005,7 @@ int main(void)
 	    cmocka_unit_test(test_json_binary_round_trip),
 	    cmocka_unit_test(test_json_number_text),
 	    cmocka_unit_test(test_json_refuses_non_finite_numbers),
+	    cmocka_unit_test(test_obj_usda_refuse_non_finite_numbers),
 	    cmocka_unit_test(test_json_binary_errors),
 	    cmocka_unit_test(test_same_seed_same_bytes_other_seed_other_bytes),
 	    cmocka_unit_test(test_obj_parses_back_to_the_feather),

@@ -152,6 +152,31 @@ static void test_unknown_key_names_path_and_nearest(void **state)
 	expect_error("{\"model\": \"franco-waltr\"}", PLUME_ERROR_SPEC,
 	             "$.model: unknown model \"franco-waltr\"; did you mean \"franco-walter\"?");
 	expect_error("{\"seed\": 1}", PLUME_ERROR_SPEC, "$.model: missing");
+	// A key cut short gets the key it begins (its nearest by edits was some other short key).
+	expect_error("{\"model\": \"franco-walter\", \"calamus\": 0.1}", PLUME_ERROR_SPEC,
+	             "$.calamus: unknown key; did you mean \"calamus_fraction\"?");
+	// No key is near: no guess ("did you mean" once offered any nearest key), the keys allowed instead.
+	expect_error("{\"model\": \"franco-walter\", \"segments\": [{}, {\"texture\": 1}]}", PLUME_ERROR_SPEC,
+	             "$.segments[1].texture: unknown key; the keys here are: barb_count, length_variation, "
+	             "shape_variation, symmetric_vanes, uniform_shape, uniform_length");
+}
+
+/// Out-of-range values print with the digits it takes to show them out of range ("%g" printed
+/// 0.9500001 as 0.95, "is 0.95, allowed [0, 0.95]").
+static void test_out_of_range_values_show_their_digits(void **state)
+{
+	(void)state;
+	expect_error("{\"model\": \"franco-walter\", \"calamus_fraction\": 0.9500001}", PLUME_ERROR_SPEC,
+	             "$.calamus_fraction is 0.9500001, allowed [0, 0.95]");
+	expect_error("{\"model\": \"zhang-kanai\", \"growth_stage\": 1.0000001}", PLUME_ERROR_SPEC,
+	             "$.growth_stage is 1.0000001, allowed [0, 1]");
+	expect_error("{\"model\": \"zhang-kanai\", \"theta_distal_deg\": 180.00001}", PLUME_ERROR_SPEC,
+	             "$.theta_distal_deg is 180.00001, allowed (0, 180)");
+	expect_error("{\"model\": \"streit-heidrich\", \"left_tip_angle_deg\": 180.0001}", PLUME_ERROR_SPEC,
+	             "$.left_tip_angle_deg is 180.0001, allowed (0, 180]");
+	expect_error("{\"model\": \"streit-heidrich\", \"key_barbs\": [{\"position\": 1.0000001, \"cvs\": [[0, 0, 0], [1, "
+	             "0, 0]]}]}",
+	             PLUME_ERROR_SPEC, "$.key_barbs[0].position is 1.0000001, allowed [0, 1]");
 }
 
 static void test_out_of_range_names_path_and_range(void **state)
@@ -194,6 +219,13 @@ static void test_missing_file_is_an_io_error(void **state)
 	plume_error err = {0};
 	assert_int_equal(plume_spec_generate("/nonexistent/spec.json", NULL, &feather, &err), PLUME_ERROR_IO);
 	assert_non_null(strstr(err.message, "/nonexistent/spec.json: cannot read: No such file or directory"));
+	// A folder opens for reading, then its first read fails: it was a syntax error at 1:0.
+	char folder[256];
+	test_make_temp_dir(folder, sizeof folder);
+	assert_int_equal(plume_spec_generate(folder, NULL, &feather, &err), PLUME_ERROR_IO);
+	assert_null(feather);
+	assert_non_null(strstr(err.message, ": cannot read: Is a directory"));
+	test_remove_tree(folder);
 }
 
 static void test_every_preset_generates(void **state)
@@ -249,6 +281,7 @@ int main(void)
 	    cmocka_unit_test(test_edit_distance),
 	    cmocka_unit_test(test_unknown_key_names_path_and_nearest),
 	    cmocka_unit_test(test_out_of_range_names_path_and_range),
+	    cmocka_unit_test(test_out_of_range_values_show_their_digits),
 	    cmocka_unit_test(test_wrong_types_name_path),
 	    cmocka_unit_test(test_missing_file_is_an_io_error),
 	    cmocka_unit_test(test_every_preset_generates),

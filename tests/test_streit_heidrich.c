@@ -730,8 +730,28 @@ static void test_bad_specs(void **state)
 	                  "1.5e+06 m)");
 	expect_spec_error("{\"model\": \"streit-heidrich\", \"calamus_length\": -0.01}", PLUME_ERROR_SPEC,
 	                  "$.calamus_length is -0.01, must be a non-negative length");
+	// A constant is a number, not an array: no index (it read "$.barb_length[0]").
 	expect_spec_error("{\"model\": \"streit-heidrich\", \"barb_length\": -0.01}", PLUME_ERROR_SPEC,
-	                  "$.barb_length[0] has length -0.01");
+	                  "$.barb_length has length -0.01");
+	expect_spec_error("{\"model\": \"streit-heidrich\", \"barb_length\": [[0, 0.01], [1, -0.01]]}", PLUME_ERROR_SPEC,
+	                  "$.barb_length[1] has length -0.01");
+	// The range is open at 0 (it read "is 0, allowed [0, 100]").
+	expect_spec_error("{\"model\": \"streit-heidrich\", \"calamus_width_ratio\": 0}", PLUME_ERROR_SPEC,
+	                  "$.calamus_width_ratio is 0, allowed (0, 100]");
+	// The key the spec gave, not the per-vane one it sets (it read "$.left_base_angle_deg is 200").
+	expect_spec_error("{\"model\": \"streit-heidrich\", \"base_angle_deg\": 200}", PLUME_ERROR_SPEC,
+	                  "$.base_angle_deg is 200, allowed (0, 180]");
+	expect_spec_error("{\"model\": \"streit-heidrich\", \"afterfeather\": {\"tip_angle_deg\": 180.0001}}",
+	                  PLUME_ERROR_SPEC, "$.afterfeather.tip_angle_deg is 180.0001, allowed (0, 180]");
+	// Keys of the whole feather in the afterfeather: said so, not "did you mean tip_angle_deg?".
+	expect_spec_error("{\"model\": \"streit-heidrich\", \"afterfeather\": {\"texture_mode\": \"vane\"}}",
+	                  PLUME_ERROR_SPEC,
+	                  "$.afterfeather.texture_mode: is a key of the whole feather, not of its afterfeather: give it "
+	                  "at the spec's top level ($.texture_mode)");
+	expect_spec_error("{\"model\": \"streit-heidrich\", \"afterfeather\": {\"model\": \"streit-heidrich\"}}",
+	                  PLUME_ERROR_SPEC, "$.afterfeather.model: is a key of the whole feather");
+	expect_spec_error("{\"model\": \"streit-heidrich\", \"afterfeather\": {\"colour\": 1}}", PLUME_ERROR_SPEC,
+	                  "$.afterfeather.colour: unknown key; the keys here are: calamus_length, ");
 	expect_spec_error("{\"model\": \"streit-heidrich\", \"spacing_tip\": -1}", PLUME_ERROR_SPEC, "$.spacing_tip is -1");
 	expect_spec_error("{\"model\": \"streit-heidrich\", \"afterfeather\": {\"rachis_length\": -2}}", PLUME_ERROR_SPEC,
 	                  "$.afterfeather.rachis_length is -2");
@@ -747,6 +767,27 @@ static void test_bad_specs(void **state)
 	expect_spec_error("{\"model\": \"streit-heidrich\", \"blend\": {\"feathers\": [\"bad.json\", \"bad.json\"], \"t\": "
 	                  "0.5}}",
 	                  PLUME_ERROR_SPEC, "nest more than");
+	// Inline specs in a blend are part of the file: messages name where they sit in it (they named
+	// the root: "bad.json: $.rachis_length is -1").
+	expect_spec_error("{\"model\": \"streit-heidrich\", \"blend\": {\"feathers\": [{\"model\": \"streit-heidrich\", "
+	                  "\"rachis_length\": -1}, {}], \"t\": 0.5}}",
+	                  PLUME_ERROR_SPEC, "bad.json: $.blend.feathers[0].rachis_length is -1, must be a positive length");
+	expect_spec_error("{\"model\": \"streit-heidrich\", \"blend\": {\"feathers\": [{}, {\"rachis_lenght\": 0.1}], "
+	                  "\"t\": 0.5}}",
+	                  PLUME_ERROR_SPEC, "bad.json: $.blend.feathers[1].rachis_lenght: unknown key");
+	expect_spec_error(
+	    "{\"model\": \"streit-heidrich\", \"blend\": {\"feathers\": [{\"afterfeather\": {\"spacing_tip\": "
+	    "-1}}, {}], \"t\": 0.5}}",
+	    PLUME_ERROR_SPEC, "bad.json: $.blend.feathers[0].afterfeather.spacing_tip is -1");
+	expect_spec_error("{\"model\": \"streit-heidrich\", \"blend\": {\"feathers\": [{\"blend\": {\"feathers\": [{}, "
+	                  "{\"spacing_base\": 0}], \"t\": 0.5}}, {}], \"t\": 0.5}}",
+	                  PLUME_ERROR_SPEC, "bad.json: $.blend.feathers[0].blend.feathers[1].spacing_base is 0");
+	expect_spec_error("{\"model\": \"streit-heidrich\", \"blend\": {\"feathers\": [{}, {\"blend\": {\"t\": 2, "
+	                  "\"feathers\": [{}, {}]}}], \"t\": 0.5}}",
+	                  PLUME_ERROR_SPEC, "bad.json: $.blend.feathers[1].blend.t: is 2, allowed [0, 1]");
+	expect_spec_error("{\"model\": \"streit-heidrich\", \"blend\": {\"feathers\": [{\"model\": \"zhang-kanai\"}, {}], "
+	                  "\"t\": 0.5}}",
+	                  PLUME_ERROR_SPEC, "bad.json: $.blend.feathers[0].model: \"zhang-kanai\" cannot be blended");
 	assert_int_equal(plume_bytes_in_use(), before);
 }
 

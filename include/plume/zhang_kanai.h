@@ -171,12 +171,14 @@ plume_zk_def plume_zk_default_def(void);
 plume_status plume_zk_def_validate(const plume_zk_def *def, plume_error *err);
 
 /// Bytes the feather of def takes, counted before the growth and never below the built feather's.
-/// A pathline crosses less than the collar's perimeter L (the circle's 2 pi R, or the Bezier collar's
-/// control polygon, which no Bezier arc outruns) at V_b >= its smallest control value (the curves never
-/// leave their control values' range), so it takes at most T = L / min V_b seconds: T / step steps
-/// (growth refuses more than two million), every downsample-th kept. A vane holds N mature barbs and the
-/// ones emitted in the last T seconds, one per ridge_width (1 - ridge_width_variation) of emitter travel at
-/// V_e <= its largest control value. Barbules (expansion with keep_barbules) add four points a vertex.
+/// A vane keeps at most its first N = barb_count barbs (barbs mature in emission order; below
+/// growth_stage 1 also those still developing). Barb i grows back to I_A from where it left the ridge,
+/// at most d (i + 1) (1 + ridge_width_variation) or the vane's path from I_A to I_P (the collar's
+/// perimeter, or the Bezier collar's control polygon, which no Bezier arc outruns, times the interval);
+/// every RK4 step moves at least step x the smallest control value of V_b (the curves never leave their
+/// control values' range), every downsample-th step is kept (growth refuses more than two million).
+/// Developing barbs are emitted at least d (1 - ridge_width_variation) / max V_e apart and are younger
+/// than the longest pathline. Barbules (expansion with keep_barbules) add four points a vertex.
 /// Past any limit for a def that does not validate.
 double plume_zk_estimate_bytes(const plume_zk_def *def);
 

@@ -8,6 +8,7 @@
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/stat.h>
 
 json_t *plume_spec_load(const char *path, plume_error *err)
 {
@@ -15,6 +16,14 @@ json_t *plume_spec_load(const char *path, plume_error *err)
 	FILE *file = fopen(path, "rb");
 	if (file == NULL) {
 		plume_error_set(err, PLUME_ERROR_IO, "%s: cannot read: %s", path, strerror(errno));
+		return NULL;
+	}
+	// A folder opens for reading; its first read fails, which jansson took for an empty text
+	// ("'[' or '{' expected", a syntax error at 1:0).
+	struct stat info;
+	if (fstat(fileno(file), &info) == 0 && S_ISDIR(info.st_mode)) {
+		fclose(file);
+		plume_error_set(err, PLUME_ERROR_IO, "%s: cannot read: %s (a spec is a JSON file)", path, strerror(EISDIR));
 		return NULL;
 	}
 	json_error_t error;
@@ -119,6 +128,27 @@ void plume_spec_index_path(char *out, size_t size, const char *parent, size_t in
 	snprintf(out, size, "%s[%zu]", parent, index);
 }
 
+bool plume_spec_is_near(const char *word, const char *candidate)
+{
+	// A third of the word's letters, and at least two (a swap, "lenght", is two edits): typos
+	// and plurals, not other words.
+	size_t length = strlen(word), limit = length / 3 > 2 ? length / 3 : 2;
+	return plume_edit_distance(word, candidate) <= limit;
+}
+
+const char *plume_spec_suggest(const char *word, const char *const *allowed)
+{
+	const char *nearest = plume_spec_nearest(word, allowed);
+	if (plume_spec_is_near(word, nearest))
+		return nearest;
+	// A key cut short: "fov" for "fov_deg" (whose nearest by edits was "eye").
+	size_t length = strlen(word);
+	for (const char *const *candidate = allowed; length >= 3 && *candidate != NULL; ++candidate)
+		if (strncmp(*candidate, word, length) == 0)
+			return *candidate;
+	return NULL;
+}
+
 const char *plume_spec_nearest(const char *word, const char *const *allowed)
 {
 	const char *nearest = allowed[0];
@@ -147,7 +177,19 @@ void plume_spec_check_keys(plume_spec_reader *reader, const json_t *object, cons
 		if (!known) {
 			char child[512];
 			plume_spec_path(child, sizeof child, path, key);
-			plume_spec_fail(reader, child, "unknown key; did you mean \"%s\"?", plume_spec_nearest(key, allowed));
+			const char *nearest = plume_spec_suggest(key, allowed);
+			if (nearest != NULL) {
+				plume_spec_fail(reader, child, "unknown key; did you mean \"%s\"?", nearest);
+				return;
+			}
+			// Nothing close: a guess would mislead ("texture_mode" is no "tip_angle_deg"); list what is allowed.
+			char list[600] = "";
+			size_t used = 0;
+			for (const char *const *candidate = allowed; *candidate != NULL && used < sizeof list; ++candidate) {
+				int n = snprintf(list + used, sizeof list - used, "%s%s", used > 0 ? ", " : "", *candidate);
+				used += n > 0 ? (size_t)n : 0;
+			}
+			plume_spec_fail(reader, child, "unknown key; the keys here are: %s", list);
 			return;
 		}
 	}

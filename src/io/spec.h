@@ -53,7 +53,7 @@ void plume_spec_fail(plume_spec_reader *reader, const char *path, const char *fo
     ;
 
 /// Fails on the first key of object not in allowed (NULL-terminated), naming
-/// the nearest allowed key.
+/// the allowed key it suggests (plume_spec_suggest), else listing them.
 void plume_spec_check_keys(plume_spec_reader *reader, const json_t *object, const char *path,
                            const char *const *allowed);
 
@@ -84,5 +84,13 @@ const json_t *plume_spec_array(plume_spec_reader *reader, const json_t *object, 
 
 /// The allowed word nearest to word by edit distance (for "did you mean").
 const char *plume_spec_nearest(const char *word, const char *const *allowed);
+
+/// Whether candidate is near enough to word to be offered as "did you mean": at most a third of
+/// word's letters (and at least 2) edits away.
+bool plume_spec_is_near(const char *word, const char *candidate);
+
+/// What "did you mean" offers for word: the nearest allowed word when it is near, else one that
+/// begins with word (3 letters or more); NULL when none is (a guess would mislead).
+const char *plume_spec_suggest(const char *word, const char *const *allowed);
 
 #endif

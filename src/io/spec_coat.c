@@ -178,7 +178,7 @@ static plume_status read_key_feather(plume_spec_reader *reader, const char *file
 			                model);
 		plume_status status = inner.status;
 		if (status == PLUME_OK)
-			status = plume_sh_def_from_json(other, root, def, seed, NULL, 0, err);
+			status = plume_sh_def_from_json(other, root, "$", def, seed, NULL, 0, err);
 		json_decref(root);
 		return reader->status = status;
 	}
@@ -193,7 +193,8 @@ static plume_status read_key_feather(plume_spec_reader *reader, const char *file
 		plume_spec_fail(reader, model_path, "\"%s\": coat key feathers are streit-heidrich feathers", model);
 		return reader->status;
 	}
-	return reader->status = plume_sh_def_from_json(file, value, def, seed, NULL, 0, err);
+	// An inline spec is part of the coat's file: its messages name where it sits in it.
+	return reader->status = plume_sh_def_from_json(file, value, child, def, seed, NULL, 0, err);
 }
 
 static void read_keys(plume_spec_reader *reader, const char *file, const json_t *root, coat_def *def, plume_error *err)

@@ -13,6 +13,8 @@
 #define PI 3.14159265358979323846
 /// Blends may name feathers that blend others; this deep and no deeper (a file that names itself stops here).
 #define MAX_DEPTH 8
+/// Room for a JSON path: inline specs nest (a coat's key feather blending inline feathers).
+#define PATH_SIZE 600
 
 /// Keys of one feather's parameters: the spec's top level and its "afterfeather" object.
 #define PARAM_KEYS                                                                                                     \
@@ -215,10 +217,30 @@ static plume_status read_params(plume_spec_reader *reader, const char *file, con
 	plume_spec_number(reader, object, path, "rachis_front_curvature", &p->rachis_front_curvature);
 	plume_spec_number(reader, object, path, "spacing_base", &p->spacing_base);
 	plume_spec_number(reader, object, path, "spacing_tip", &p->spacing_tip);
-	// Angles: both vanes at once, then either vane on its own.
-	for (int side = 0; side < 2; ++side) {
-		read_angle(reader, object, path, "base_angle_deg", &p->barb_angle[side][0]);
-		read_angle(reader, object, path, "tip_angle_deg", &p->barb_angle[side][1]);
+	// Angles: both vanes at once, then either vane on its own. The validation names the
+	// per-vane keys (left_base_angle_deg), which the spec need not have: the shared keys are
+	// checked here, under the names they were given.
+	static const char *const shared_angles[2] = {"base_angle_deg", "tip_angle_deg"};
+	for (int end = 0; end < 2; ++end) {
+		double degrees = NAN;
+		if (!plume_spec_number(reader, object, path, shared_angles[end], &degrees))
+			continue;
+		if (!(degrees > 0.0 && degrees <= 180.0)) {
+			// The shortest text that reads back as the value: what the spec says (180.0001, not "%g"'s 180).
+			char child[PATH_SIZE], text[32];
+			for (int digits = 6; digits <= 17; ++digits) {
+				snprintf(text, sizeof text, "%.*g", digits, degrees);
+				if (strtod(text, NULL) == degrees)
+					break;
+			}
+			plume_spec_path(child, sizeof child, path, shared_angles[end]);
+			// Worded as the validation words the per-vane keys.
+			if (reader->status == PLUME_OK)
+				reader->status = plume_error_set(reader->err, PLUME_ERROR_SPEC, "%s: %s is %s, allowed (0, 180]",
+				                                 reader->file, child, text);
+		}
+		for (int side = 0; side < 2; ++side)
+			p->barb_angle[side][end] = degrees * PI / 180.0;
 	}
 	read_angle(reader, object, path, "left_base_angle_deg", &p->barb_angle[0][0]);
 	read_angle(reader, object, path, "left_tip_angle_deg", &p->barb_angle[0][1]);
@@ -286,7 +308,7 @@ static plume_status read_blend_feather(plume_spec_reader *reader, const char *fi
 				                "\"%s\" cannot be blended; feather types blend streit-heidrich feathers", model);
 			status = inner.status;
 			if (status == PLUME_OK)
-				status = plume_sh_def_from_json(other, root, out, &seed, NULL, depth + 1, err);
+				status = plume_sh_def_from_json(other, root, "$", out, &seed, NULL, depth + 1, err);
 		}
 		json_decref(root);
 		reader->status = status;
@@ -296,21 +318,36 @@ static plume_status read_blend_feather(plume_spec_reader *reader, const char *fi
 		plume_spec_fail(reader, path, "expected a spec file name or an inline streit-heidrich spec");
 		return reader->status;
 	}
-	reader->status = plume_sh_def_from_json(file, value, out, &seed, NULL, depth + 1, err);
+	const char *model = NULL;
+	if (plume_spec_string(reader, value, path, "model", &model) && strcmp(model, "streit-heidrich") != 0) {
+		char model_path[PATH_SIZE];
+		plume_spec_path(model_path, sizeof model_path, path, "model");
+		plume_spec_fail(reader, model_path, "\"%s\" cannot be blended; feather types blend streit-heidrich feathers",
+		                model);
+		return reader->status;
+	}
+	if (reader->status != PLUME_OK)
+		return reader->status;
+	// An inline spec is part of this file: its messages name where it sits in it.
+	reader->status = plume_sh_def_from_json(file, value, path, out, &seed, NULL, depth + 1, err);
 	return reader->status;
 }
 
-static plume_status read_blend(plume_spec_reader *reader, const char *file, const json_t *blend, int depth,
-                               plume_sh_def *def, plume_error *err)
+static plume_status read_blend(plume_spec_reader *reader, const char *file, const json_t *blend, const char *base,
+                               int depth, plume_sh_def *def, plume_error *err)
 {
-	const char *path = "$.blend";
+	char path[PATH_SIZE], feathers_path[PATH_SIZE], t_path[PATH_SIZE], weights_path[PATH_SIZE];
+	plume_spec_path(path, sizeof path, base, "blend");
+	plume_spec_path(feathers_path, sizeof feathers_path, path, "feathers");
+	plume_spec_path(t_path, sizeof t_path, path, "t");
+	plume_spec_path(weights_path, sizeof weights_path, path, "weights");
 	plume_spec_check_keys(reader, blend, path, blend_keys);
 	const json_t *feathers = plume_spec_array(reader, blend, path, "feathers");
 	if (reader->status != PLUME_OK)
 		return reader->status;
 	size_t n = feathers != NULL ? json_array_size(feathers) : 0;
 	if (n < 2 || n > 16) {
-		plume_spec_fail(reader, "$.blend.feathers", "expected 2 to 16 feathers to blend, got %zu", n);
+		plume_spec_fail(reader, feathers_path, "expected 2 to 16 feathers to blend, got %zu", n);
 		return reader->status;
 	}
 	double weights[16] = {0};
@@ -325,7 +362,7 @@ static plume_status read_blend(plume_spec_reader *reader, const char *file, cons
 	}
 	if (has_t) {
 		if (!(t >= 0.0 && t <= 1.0)) {
-			plume_spec_fail(reader, "$.blend.t", "is %g, allowed [0, 1]", t);
+			plume_spec_fail(reader, t_path, "is %g, allowed [0, 1]", t);
 			return reader->status;
 		}
 		// A continuum through the feathers in order: t = 0 the first, t = 1 the last.
@@ -338,14 +375,14 @@ static plume_status read_blend(plume_spec_reader *reader, const char *file, cons
 		weights[i + 1] = f;
 	} else {
 		if (json_array_size(weight_array) != n) {
-			plume_spec_fail(reader, "$.blend.weights", "expected %zu weights, one per feather", n);
+			plume_spec_fail(reader, weights_path, "expected %zu weights, one per feather", n);
 			return reader->status;
 		}
 		double total = 0.0;
 		for (size_t i = 0; i < n; ++i) {
 			const json_t *w = json_array_get(weight_array, i);
-			char item[64];
-			plume_spec_index_path(item, sizeof item, "$.blend.weights", i);
+			char item[PATH_SIZE];
+			plume_spec_index_path(item, sizeof item, weights_path, i);
 			if (!json_is_number(w) || json_number_value(w) < 0.0) {
 				plume_spec_fail(reader, item, "expected a weight >= 0");
 				return reader->status;
@@ -354,7 +391,7 @@ static plume_status read_blend(plume_spec_reader *reader, const char *file, cons
 			total += weights[i];
 		}
 		if (!(total > 0.0)) {
-			plume_spec_fail(reader, "$.blend.weights", "the weights sum to 0");
+			plume_spec_fail(reader, weights_path, "the weights sum to 0");
 			return reader->status;
 		}
 	}
@@ -363,8 +400,8 @@ static plume_status read_blend(plume_spec_reader *reader, const char *file, cons
 		return reader->status = plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory");
 	const plume_sh_def *pointers[16];
 	for (size_t i = 0; i < n && reader->status == PLUME_OK; ++i) {
-		char item[64];
-		plume_spec_index_path(item, sizeof item, "$.blend.feathers", i);
+		char item[PATH_SIZE];
+		plume_spec_index_path(item, sizeof item, feathers_path, i);
 		read_blend_feather(reader, file, json_array_get(feathers, i), item, depth, &defs[i], err);
 		pointers[i] = &defs[i];
 	}
@@ -377,21 +414,23 @@ static plume_status read_blend(plume_spec_reader *reader, const char *file, cons
 // ---------------------------------------------------------------------------
 // The spec
 
-static void read_lod(plume_spec_reader *reader, const json_t *root, plume_sh_lod *lod)
+static void read_lod(plume_spec_reader *reader, const json_t *root, const char *base, plume_sh_lod *lod)
 {
-	const json_t *object = plume_spec_object(reader, root, "$", "lod");
+	const json_t *object = plume_spec_object(reader, root, base, "lod");
 	if (object == NULL || lod == NULL)
 		return;
-	plume_spec_check_keys(reader, object, "$.lod", lod_keys);
-	plume_spec_int(reader, object, "$.lod", "barb_elevations", &lod->barb_elevations);
-	plume_spec_int(reader, object, "$.lod", "rachis_elevations", &lod->rachis_elevations);
-	plume_spec_int(reader, object, "$.lod", "calamus_samples", &lod->calamus_samples);
+	char path[PATH_SIZE];
+	plume_spec_path(path, sizeof path, base, "lod");
+	plume_spec_check_keys(reader, object, path, lod_keys);
+	plume_spec_int(reader, object, path, "barb_elevations", &lod->barb_elevations);
+	plume_spec_int(reader, object, path, "rachis_elevations", &lod->rachis_elevations);
+	plume_spec_int(reader, object, path, "calamus_samples", &lod->calamus_samples);
 }
 
-static void read_texture_mode(plume_spec_reader *reader, const json_t *root, plume_sh_def *def)
+static void read_texture_mode(plume_spec_reader *reader, const json_t *root, const char *base, plume_sh_def *def)
 {
 	const char *mode = NULL;
-	if (!plume_spec_string(reader, root, "$", "texture_mode", &mode))
+	if (!plume_spec_string(reader, root, base, "texture_mode", &mode))
 		return;
 	static const char *const names[] = {"barb", "vane", "growth", NULL};
 	for (int i = 0; names[i] != NULL; ++i)
@@ -399,28 +438,71 @@ static void read_texture_mode(plume_spec_reader *reader, const json_t *root, plu
 			def->texture_mode = (plume_sh_texture_mode)i;
 			return;
 		}
-	plume_spec_fail(reader, "$.texture_mode", "unknown mode \"%s\"; did you mean \"%s\"? (allowed: barb, vane, growth)",
-	                mode, plume_spec_nearest(mode, names));
+	char path[PATH_SIZE];
+	plume_spec_path(path, sizeof path, base, "texture_mode");
+	plume_spec_fail(reader, path, "unknown mode \"%s\"; did you mean \"%s\"? (allowed: barb, vane, growth)", mode,
+	                plume_spec_nearest(mode, names));
 }
 
-plume_status plume_sh_def_from_json(const char *file, const json_t *root, plume_sh_def *def, uint64_t *seed,
-                                    plume_sh_lod *lod, int depth, plume_error *err)
+/// Keys of the whole feather (texture_mode, model, ...) put in the afterfeather: named as such,
+/// where "did you mean" would guess a parameter that has nothing to do with them.
+static void check_afterfeather_keys(plume_spec_reader *reader, const json_t *after, const char *base,
+                                    const char *after_path)
+{
+	const char *key;
+	json_t *value;
+	json_object_foreach ((json_t *)after, key, value) {
+		bool feather_key = false, after_key = false;
+		for (const char *const *k = top_keys; *k != NULL; ++k)
+			feather_key = feather_key || strcmp(key, *k) == 0;
+		for (const char *const *k = afterfeather_keys; *k != NULL; ++k)
+			after_key = after_key || strcmp(key, *k) == 0;
+		if (feather_key && !after_key) {
+			char child[PATH_SIZE], top[PATH_SIZE];
+			plume_spec_path(child, sizeof child, after_path, key);
+			plume_spec_path(top, sizeof top, base, key);
+			plume_spec_fail(reader, child,
+			                "is a key of the whole feather, not of its afterfeather: give it at the spec's top level "
+			                "(%s)",
+			                top);
+			return;
+		}
+	}
+}
+
+/// plume_sh_def_validate names the keys from the root of a spec ("$.rachis_length ..."): an inline
+/// spec at base ("$.blend.feathers[0]") gets base in its place, then the file in front.
+static void name_from_base(plume_error *err, const char *file, const char *base)
+{
+	if (err != NULL && strcmp(base, "$") != 0 && err->message[0] == '$') {
+		char message[sizeof err->message];
+		snprintf(message, sizeof message, "%s%s", base, err->message + 1);
+		memcpy(err->message, message, sizeof message);
+	}
+	plume_error_prefix(err, file);
+}
+
+plume_status plume_sh_def_from_json(const char *file, const json_t *root, const char *base, plume_sh_def *def,
+                                    uint64_t *seed, plume_sh_lod *lod, int depth, plume_error *err)
 {
 	*def = plume_sh_default_def();
 	*seed = 1;
 	if (lod != NULL)
 		*lod = plume_sh_default_lod();
 	plume_spec_reader reader = plume_spec_reader_begin(file, err);
+	char blend_path[PATH_SIZE], after_path[PATH_SIZE];
+	plume_spec_path(blend_path, sizeof blend_path, base, "blend");
+	plume_spec_path(after_path, sizeof after_path, base, "afterfeather");
 	if (depth > MAX_DEPTH) {
-		plume_spec_fail(&reader, "$.blend", "blends nest more than %d deep (does a feather blend itself?)", MAX_DEPTH);
+		plume_spec_fail(&reader, blend_path, "blends nest more than %d deep (does a feather blend itself?)", MAX_DEPTH);
 		return reader.status;
 	}
-	plume_spec_check_keys(&reader, root, "$", top_keys);
-	plume_spec_uint64(&reader, root, "$", "seed", seed);
+	plume_spec_check_keys(&reader, root, base, top_keys);
+	plume_spec_uint64(&reader, root, base, "seed", seed);
 	const char *description;
-	plume_spec_string(&reader, root, "$", "description", &description);
-	read_lod(&reader, root, lod);
-	const json_t *blend = plume_spec_object(&reader, root, "$", "blend");
+	plume_spec_string(&reader, root, base, "description", &description);
+	read_lod(&reader, root, base, lod);
+	const json_t *blend = plume_spec_object(&reader, root, base, "blend");
 	if (blend != NULL && reader.status == PLUME_OK) {
 		// A blend is a feather of its own: parameters beside it would be ambiguous.
 		const char *key;
@@ -428,44 +510,45 @@ plume_status plume_sh_def_from_json(const char *file, const json_t *root, plume_
 		json_object_foreach ((json_t *)root, key, value) {
 			if (strcmp(key, "model") != 0 && strcmp(key, "seed") != 0 && strcmp(key, "description") != 0 &&
 			    strcmp(key, "lod") != 0 && strcmp(key, "blend") != 0 && strcmp(key, "texture_mode") != 0) {
-				char child[512];
-				plume_spec_path(child, sizeof child, "$", key);
-				plume_spec_fail(&reader, child, "a blended feather takes its parameters from $.blend.feathers");
+				char child[PATH_SIZE];
+				plume_spec_path(child, sizeof child, base, key);
+				plume_spec_fail(&reader, child, "a blended feather takes its parameters from %s.feathers", blend_path);
 				break;
 			}
 		}
 		if (reader.status == PLUME_OK)
-			read_blend(&reader, file, blend, depth, def, err);
-		read_texture_mode(&reader, root, def);
+			read_blend(&reader, file, blend, base, depth, def, err);
+		read_texture_mode(&reader, root, base, def);
 		if (reader.status != PLUME_OK)
 			return reader.status;
 	} else {
-		if (read_params(&reader, file, root, "$", &def->main, err) != PLUME_OK)
+		if (read_params(&reader, file, root, base, &def->main, err) != PLUME_OK)
 			return reader.status;
 		def->afterfeather = plume_sh_default_afterfeather(&def->main);
-		plume_spec_number(&reader, root, "$", "barb_width_base", &def->barb_width_base);
-		plume_spec_number(&reader, root, "$", "barb_width_tip", &def->barb_width_tip);
-		read_texture_mode(&reader, root, def);
+		plume_spec_number(&reader, root, base, "barb_width_base", &def->barb_width_base);
+		plume_spec_number(&reader, root, base, "barb_width_tip", &def->barb_width_tip);
+		read_texture_mode(&reader, root, base, def);
 		const json_t *after = json_object_get(root, "afterfeather");
 		if (after != NULL && reader.status == PLUME_OK) {
 			if (json_is_boolean(after)) {
 				def->has_afterfeather = json_is_true(after);
 			} else if (json_is_object(after)) {
 				def->has_afterfeather = true;
-				plume_spec_check_keys(&reader, after, "$.afterfeather", afterfeather_keys);
-				read_params(&reader, file, after, "$.afterfeather", &def->afterfeather, err);
+				check_afterfeather_keys(&reader, after, base, after_path);
+				plume_spec_check_keys(&reader, after, after_path, afterfeather_keys);
+				read_params(&reader, file, after, after_path, &def->afterfeather, err);
 			} else {
-				plume_spec_fail(&reader, "$.afterfeather",
+				plume_spec_fail(&reader, after_path,
 				                "expected true, false or an object with the afterfeather's parameters");
 			}
 		}
 		if (reader.status != PLUME_OK)
 			return reader.status;
 	}
-	// Ranges are the library's own check; its messages already name the JSON path.
+	// Ranges are the library's own check; its messages name the JSON path from the spec's root.
 	plume_status status = plume_sh_def_validate(def, err);
 	if (status != PLUME_OK)
-		plume_error_prefix(err, file);
+		name_from_base(err, file, base);
 	return status;
 }
 
@@ -475,7 +558,7 @@ plume_status plume_sh_def_read(const char *path, plume_sh_def *def, uint64_t *se
 	json_t *root = plume_spec_load_model(path, &status, err);
 	if (root == NULL)
 		return status;
-	status = plume_sh_def_from_json(path, root, def, seed, lod, 0, err);
+	status = plume_sh_def_from_json(path, root, "$", def, seed, lod, 0, err);
 	json_decref(root);
 	return status;
 }
@@ -501,7 +584,7 @@ plume_status plume_sh_spec_generate(const char *file, const json_t *root, const 
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory");
 	uint64_t seed;
 	plume_sh_lod lod;
-	plume_status status = plume_sh_def_from_json(file, root, def, &seed, &lod, 0, err);
+	plume_status status = plume_sh_def_from_json(file, root, "$", def, &seed, &lod, 0, err);
 	if (status == PLUME_OK) {
 		if (options != NULL && options->seed_given)
 			seed = options->seed;

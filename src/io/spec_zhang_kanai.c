@@ -185,7 +185,14 @@ static void read_splits(plume_spec_reader *reader, const json_t *root, plume_zk_
 			plume_spec_fail(reader, side_path, "is \"%s\"; allowed \"left\" or \"right\"", side);
 		}
 		split->side = strcmp(side, "right") == 0 ? PLUME_SIDE_RIGHT : PLUME_SIDE_LEFT;
-		plume_spec_int(reader, item, path, "barb", &split->barb);
+		// The barb has no default: one left out bent barb 0, the vane's tip.
+		if (!plume_spec_int(reader, item, path, "barb", &split->barb) && reader->status == PLUME_OK) {
+			char barb_path[80];
+			plume_spec_path(barb_path, sizeof barb_path, path, "barb");
+			plume_spec_fail(reader, barb_path,
+			                "missing; a split names its barb: the index in emission order on its vane, 0 the most "
+			                "distal");
+		}
 		plume_spec_number(reader, item, path, "at", &split->at);
 		read_angle(reader, item, path, "angle_deg", &split->angle);
 	}
@@ -275,7 +282,7 @@ plume_status plume_zk_spec_generate(const char *file, const json_t *root, const 
 	}
 	status = plume_spec_check_feather_bytes(
 	    file, plume_zk_estimate_bytes(&def), options, err,
-	    "$.barb_count (%d) and the barbs still growing ($.collar_radius or $.collar_points, $.barb_speed, "
+	    "$.barb_count (%d) and the barbs still growing ($.collar.radius or $.collar.points, $.barb_speed, "
 	    "$.emitter_speed, $.ridge_width) x their points ($.step %g, $.downsample %d%s)",
 	    def.barb_count, def.step, def.downsample, def.expansion && def.keep_barbules ? ", barbules kept" : "");
 	if (status != PLUME_OK)

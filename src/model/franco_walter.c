@@ -14,6 +14,7 @@
 // frame between vanes so that S_v gives mirror-image vanes.
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "../core/asserts.h"
@@ -63,9 +64,17 @@ plume_fw_def plume_fw_default_def(void)
 
 static plume_status check_range(double value, double lo, double hi, const char *path, plume_error *err)
 {
-	if (!(value >= lo && value <= hi))
-		return plume_error_set(err, PLUME_ERROR_SPEC, "%s is %g, allowed [%g, %g]", path, value, lo, hi);
-	return PLUME_OK;
+	if (value >= lo && value <= hi)
+		return PLUME_OK;
+	// With the digits it takes to show the value outside: "%g" printed 0.9500001 as 0.95.
+	char text[32];
+	for (int digits = 6; digits <= 17; ++digits) {
+		snprintf(text, sizeof text, "%.*g", digits, value);
+		double printed = strtod(text, NULL);
+		if (printed == value || (printed != lo && printed != hi))
+			break;
+	}
+	return plume_error_set(err, PLUME_ERROR_SPEC, "%s is %s, allowed [%g, %g]", path, text, lo, hi);
 }
 
 static plume_status check_positive(double value, const char *path, plume_error *err)
@@ -74,6 +83,11 @@ static plume_status check_positive(double value, const char *path, plume_error *
 		return plume_error_set(err, PLUME_ERROR_SPEC, "%s is %g, must be a positive length in metres", path, value);
 	return PLUME_OK;
 }
+
+/// The shortest shaft accepted, m. Real feathers are millimetres long at least (and plume's
+/// units are metres): a shorter shaft is a unit error, and one of 1e-300 m once passed the
+/// base != tip check with tangents of rounding noise.
+#define MIN_SHAFT_LENGTH 1e-4
 
 static plume_status check_points(const plume_vec2 *points, int count, const char *name, plume_error *err)
 {
@@ -95,6 +109,20 @@ plume_status plume_fw_def_validate(const plume_fw_def *def, plume_error *err)
 	if (def->shaft[0].x == def->shaft[3].x && def->shaft[0].y == def->shaft[3].y)
 		return plume_error_set(err, PLUME_ERROR_SPEC,
 		                       "$.shaft starts and ends at the same point; the shaft needs a length");
+	// Measured on the control points scaled to about 1 (relative to the base), so that a
+	// shaft of 1e-300 m reports its length instead of an underflow to 0.
+	double extent = 0.0;
+	for (int i = 1; i < 4; ++i)
+		extent = fmax(extent, fmax(fabs(def->shaft[i].x - def->shaft[0].x), fabs(def->shaft[i].y - def->shaft[0].y)));
+	plume_vec3 shaft[4];
+	for (int i = 0; i < 4; ++i)
+		shaft[i] =
+		    plume_v3((def->shaft[i].x - def->shaft[0].x) / extent, (def->shaft[i].y - def->shaft[0].y) / extent, 0.0);
+	double length = extent * plume_bezier_length(shaft, 4, 0.0, 1.0);
+	if (!(length >= MIN_SHAFT_LENGTH))
+		return plume_error_set(err, PLUME_ERROR_SPEC,
+		                       "$.shaft is %g m long; allowed at least %g m (0.1 mm): lengths are in metres", length,
+		                       MIN_SHAFT_LENGTH);
 	for (int s = 0; s < 2; ++s) {
 		const plume_fw_segment *segment = def->segments + s;
 		char path[64];
@@ -172,6 +200,27 @@ typedef struct fw_geometry {
 
 static const plume_vec3 vane_normal = {0.0, 0.0, 1.0};
 
+/// Unit tangent of the shaft at u, towards the tip. B'(u) vanishes where control points
+/// coincide (P0 = P1 makes B'(0) = 3 (P1 - P0) = 0), and normalizing it gave [0, 0, 0].
+/// There the curve still has a direction: B(u + h) - B(u) = h B' + h^2/2 B'' + h^3/6 B''',
+/// so the first derivative that does not vanish gives it. In the shaft's upper half the
+/// curve is taken from below (the tip, u = 1, has nothing above it):
+/// B(u) - B(u - h) = h B' - h^2/2 B'' + h^3/6 B''', and B'' turns round. A derivative
+/// "vanishes" below 1e-9 of the shaft's length (u has no unit: every derivative is in
+/// metres), so control points a rounding error apart count as one.
+static plume_vec3 shaft_tangent(const plume_vec3 shaft[4], double u, double length)
+{
+	for (int order = 1; order <= 3; ++order) {
+		plume_vec3 d = plume_bezier_derivative(shaft, 4, order, u);
+		if (order == 2 && u >= 0.5)
+			d = plume_v3_scale(d, -1.0);
+		if (plume_v3_length(d) > 1e-9 * length)
+			return plume_v3_normalize(d);
+	}
+	// Unreachable for a validated shaft (at least MIN_SHAFT_LENGTH long): its chord.
+	return plume_v3_normalize(plume_v3_sub(shaft[3], shaft[0]));
+}
+
 static plume_status build_shaft(plume_feather *feather, const plume_fw_def *def, const fw_geometry *geometry)
 {
 	int count = def->shaft_samples;
@@ -183,7 +232,7 @@ static plume_status build_shaft(plume_feather *feather, const plume_fw_def *def,
 		double u = plume_bezier_arc_param(&geometry->shaft_arc, t);
 		plume_shaft_sample *sample = samples + i;
 		sample->position = plume_bezier_eval(geometry->shaft, 4, u);
-		sample->tangent = plume_v3_normalize(plume_bezier_derivative(geometry->shaft, 4, 1, u));
+		sample->tangent = shaft_tangent(geometry->shaft, u, geometry->shaft_arc.length);
 		sample->normal = vane_normal;
 		sample->binormal = plume_v3_cross(vane_normal, sample->tangent);
 		sample->width = def->shaft_width_base + t * (def->shaft_width_tip - def->shaft_width_base);

@@ -18,6 +18,7 @@
 #include <assert.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "../core/asserts.h"
@@ -124,10 +125,25 @@ plume_sh_lod plume_sh_default_lod(void)
 // ---------------------------------------------------------------------------
 // Validation
 
-static plume_status fail_range(plume_error *err, const char *prefix, const char *key, double value, double lo,
-                               double hi)
+/// value with the digits it takes to show it outside [lo, hi]: "%g" printed 180.0001 as "180",
+/// a value the message then called not allowed (six digits, then more until the text is no bound).
+static const char *outside(char *out, size_t size, double value, double lo, double hi)
 {
-	return plume_error_set(err, PLUME_ERROR_SPEC, "%s.%s is %g, allowed [%g, %g]", prefix, key, value, lo, hi);
+	for (int digits = 6;; ++digits) {
+		snprintf(out, size, "%.*g", digits, value);
+		double printed = strtod(out, NULL);
+		if (digits >= 17 || printed == value || (printed != lo && printed != hi))
+			return out;
+	}
+}
+
+/// "is value, allowed [lo, hi]", with "(" for a range open at lo (value must be above it).
+static plume_status fail_range(plume_error *err, const char *prefix, const char *key, double value, double lo,
+                               double hi, bool open_lo)
+{
+	char text[32];
+	return plume_error_set(err, PLUME_ERROR_SPEC, "%s.%s is %s, allowed %c%g, %g]", prefix, key,
+	                       outside(text, sizeof text, value, lo, hi), open_lo ? '(' : '[', lo, hi);
 }
 
 static plume_status check_length(plume_error *err, const char *prefix, const char *key, double value, bool zero_ok)
@@ -146,15 +162,20 @@ static plume_status check_profile(const plume_sh_length_profile *profile, const 
 		                       profile->count, PLUME_SH_MAX_PROFILE);
 	for (int i = 0; i < profile->count; ++i) {
 		double p = profile->position[i], l = profile->length[i];
+		char text[32];
 		if (profile->count > 1 && !(p >= 0.0 && p <= 1.0))
-			return plume_error_set(err, PLUME_ERROR_SPEC, "%s.%s[%d] is at rachis position %g, allowed [0, 1]", prefix,
-			                       key, i, p);
+			return plume_error_set(err, PLUME_ERROR_SPEC, "%s.%s[%d] is at rachis position %s, allowed [0, 1]", prefix,
+			                       key, i, outside(text, sizeof text, p, 0.0, 1.0));
 		if (profile->count > 1 && i > 0 && !(p > profile->position[i - 1]))
 			return plume_error_set(err, PLUME_ERROR_SPEC, "%s.%s[%d]: rachis positions must increase (%g follows %g)",
 			                       prefix, key, i, p, profile->position[i - 1]);
+		// A constant (one value) is a number in the spec, not an array: no index.
+		char where[16] = "";
+		if (profile->count > 1)
+			snprintf(where, sizeof where, "[%d]", i);
 		if (!(l >= 0.0 && isfinite(l)))
 			return plume_error_set(err, PLUME_ERROR_SPEC,
-			                       "%s.%s[%d] has length %g, must be a non-negative length in metres", prefix, key, i,
+			                       "%s.%s%s has length %g, must be a non-negative length in metres", prefix, key, where,
 			                       l);
 	}
 	return PLUME_OK;
@@ -163,9 +184,10 @@ static plume_status check_profile(const plume_sh_length_profile *profile, const 
 static plume_status check_key_barb(const plume_sh_key_barb *key, const char *prefix, int index, double previous,
                                    plume_error *err)
 {
+	char text[32];
 	if (!(key->position >= 0.0 && key->position <= 1.0))
-		return plume_error_set(err, PLUME_ERROR_SPEC, "%s.key_barbs[%d].position is %g, allowed [0, 1]", prefix, index,
-		                       key->position);
+		return plume_error_set(err, PLUME_ERROR_SPEC, "%s.key_barbs[%d].position is %s, allowed [0, 1]", prefix, index,
+		                       outside(text, sizeof text, key->position, 0.0, 1.0));
 	if (key->position < previous)
 		return plume_error_set(err, PLUME_ERROR_SPEC,
 		                       "%s.key_barbs[%d].position is %g, below the key barb before it (%g); key barbs go "
@@ -179,8 +201,8 @@ static plume_status check_key_barb(const plume_sh_key_barb *key, const char *pre
 			return plume_error_set(err, PLUME_ERROR_SPEC, "%s.key_barbs[%d].cvs[%d] is not a finite point", prefix,
 			                       index, i);
 	if (!(key->plumulaceous >= 0.0 && key->plumulaceous <= 1.0))
-		return plume_error_set(err, PLUME_ERROR_SPEC, "%s.key_barbs[%d].plumulaceous is %g, allowed [0, 1]", prefix,
-		                       index, key->plumulaceous);
+		return plume_error_set(err, PLUME_ERROR_SPEC, "%s.key_barbs[%d].plumulaceous is %s, allowed [0, 1]", prefix,
+		                       index, outside(text, sizeof text, key->plumulaceous, 0.0, 1.0));
 	return PLUME_OK;
 }
 
@@ -194,19 +216,21 @@ plume_status sh_params_validate(const plume_sh_params *p, const char *prefix, pl
 	    (status = check_length(err, prefix, "spacing_tip", p->spacing_tip, false)) != PLUME_OK)
 		return status;
 	if (!(p->calamus_width_ratio > 0.0 && p->calamus_width_ratio <= 100.0))
-		return fail_range(err, prefix, "calamus_width_ratio", p->calamus_width_ratio, 0.0, 100.0);
+		return fail_range(err, prefix, "calamus_width_ratio", p->calamus_width_ratio, 0.0, 100.0, true);
 	if (!(fabs(p->rachis_side_curvature) <= 1.0))
-		return fail_range(err, prefix, "rachis_side_curvature", p->rachis_side_curvature, -1.0, 1.0);
+		return fail_range(err, prefix, "rachis_side_curvature", p->rachis_side_curvature, -1.0, 1.0, false);
 	if (!(fabs(p->rachis_front_curvature) <= 1.0))
-		return fail_range(err, prefix, "rachis_front_curvature", p->rachis_front_curvature, -1.0, 1.0);
+		return fail_range(err, prefix, "rachis_front_curvature", p->rachis_front_curvature, -1.0, 1.0, false);
 	static const char *const angle_keys[2][2] = {{"left_base_angle_deg", "left_tip_angle_deg"},
 	                                             {"right_base_angle_deg", "right_tip_angle_deg"}};
 	for (int side = 0; side < 2; ++side)
 		for (int end = 0; end < 2; ++end) {
 			double angle = p->barb_angle[side][end];
+			char text[32];
 			if (!(angle > 0.0 && angle <= PI))
-				return plume_error_set(err, PLUME_ERROR_SPEC, "%s.%s is %g, allowed (0, 180]", prefix,
-				                       angle_keys[side][end], angle * 180.0 / PI);
+				return plume_error_set(err, PLUME_ERROR_SPEC, "%s.%s is %s, allowed (0, 180]", prefix,
+				                       angle_keys[side][end],
+				                       outside(text, sizeof text, angle * 180.0 / PI, 0.0, 180.0));
 		}
 	static const char *const length_keys[2] = {"barb_length", "barb_length_right"};
 	for (int side = 0; side < 2; ++side)

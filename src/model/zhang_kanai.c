@@ -10,6 +10,7 @@
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "../core/asserts.h"
@@ -68,10 +69,24 @@ plume_zk_def plume_zk_default_def(void)
 // ---------------------------------------------------------------------------
 // Validation: messages name the spec's JSON path.
 
+/// value with the digits it takes to show it outside [lo, hi]: "%g" printed a growth_stage of
+/// 1.0000001 as "1", a value the message then called not allowed.
+static const char *outside(char *out, size_t size, double value, double lo, double hi)
+{
+	for (int digits = 6;; ++digits) {
+		snprintf(out, size, "%.*g", digits, value);
+		double printed = strtod(out, NULL);
+		if (digits >= 17 || printed == value || (printed != lo && printed != hi))
+			return out;
+	}
+}
+
 static plume_status check_range(double value, double lo, double hi, const char *path, plume_error *err)
 {
+	char text[32];
 	if (!(value >= lo && value <= hi))
-		return plume_error_set(err, PLUME_ERROR_SPEC, "%s is %g, allowed [%g, %g]", path, value, lo, hi);
+		return plume_error_set(err, PLUME_ERROR_SPEC, "%s is %s, allowed [%g, %g]", path,
+		                       outside(text, sizeof text, value, lo, hi), lo, hi);
 	return PLUME_OK;
 }
 
@@ -183,33 +198,45 @@ plume_status plume_zk_def_validate(const plume_zk_def *def, plume_error *err)
 	    (status = check_positive(def->barb_width_tip, "$.barb_width_tip", "width in metres", err)) != PLUME_OK ||
 	    (status = check_positive(def->barbule_width, "$.barbule_width", "width in metres", err)) != PLUME_OK)
 		return status;
+	char text[32];
 	if (!(def->rachis_taper > 0.0 && def->rachis_taper <= 1.0))
-		return plume_error_set(err, PLUME_ERROR_SPEC, "$.rachis_taper is %g, allowed (0, 1]", def->rachis_taper);
+		return plume_error_set(err, PLUME_ERROR_SPEC, "$.rachis_taper is %s, allowed (0, 1]",
+		                       outside(text, sizeof text, def->rachis_taper, 0.0, 1.0));
 	if (!(def->theta_distal > 0.0 && def->theta_distal < 180.0 * deg))
-		return plume_error_set(err, PLUME_ERROR_SPEC, "$.theta_distal_deg is %g, allowed (0, 180)",
-		                       def->theta_distal / deg);
+		return plume_error_set(err, PLUME_ERROR_SPEC, "$.theta_distal_deg is %s, allowed (0, 180)",
+		                       outside(text, sizeof text, def->theta_distal / deg, 0.0, 180.0));
 	if (!(def->theta_proximal > 0.0 && def->theta_proximal < 180.0 * deg))
-		return plume_error_set(err, PLUME_ERROR_SPEC, "$.theta_proximal_deg is %g, allowed (0, 180)",
-		                       def->theta_proximal / deg);
+		return plume_error_set(err, PLUME_ERROR_SPEC, "$.theta_proximal_deg is %s, allowed (0, 180)",
+		                       outside(text, sizeof text, def->theta_proximal / deg, 0.0, 180.0));
 	if ((status = check_range(def->azimuth / deg, 0.0, 180.0, "$.azimuth_deg", err)) != PLUME_OK)
 		return status;
 	if (def->split_count < 0 || def->split_count > PLUME_ZK_MAX_SPLITS)
 		return plume_error_set(err, PLUME_ERROR_SPEC, "$.splits has %d entries, allowed at most %d", def->split_count,
 		                       PLUME_ZK_MAX_SPLITS);
+	// A split bends a barb before snapping (IV-C, Figure 11 bottom), which only expansion runs: without
+	// it a split did nothing, silently.
+	if (def->split_count > 0 && !def->expansion)
+		return plume_error_set(err, PLUME_ERROR_SPEC,
+		                       "$.splits: a split bends a barb before snapping (IV-C), which runs with "
+		                       "\"expansion\": true only; set $.expansion to true or remove $.splits");
 	for (int k = 0; k < def->split_count; ++k) {
 		const plume_zk_split *split = def->splits + k;
 		char path[64];
 		if (split->side != PLUME_SIDE_LEFT && split->side != PLUME_SIDE_RIGHT)
 			return plume_error_set(err, PLUME_ERROR_SPEC, "$.splits[%d].side must be \"left\" or \"right\"", k);
-		if (split->barb < 0 || split->barb >= PLUME_ZK_MAX_BARBS)
-			return plume_error_set(err, PLUME_ERROR_SPEC, "$.splits[%d].barb is %d, allowed [0, %d)", k, split->barb,
-			                       PLUME_ZK_MAX_BARBS);
+		// A vane of the finished feather has at most N barbs (N = barb_count on the vane that ends
+		// the growth); zk_check_splits checks the vane's own count once it has grown.
+		if (split->barb < 0 || split->barb >= def->barb_count)
+			return plume_error_set(err, PLUME_ERROR_SPEC,
+			                       "$.splits[%d].barb is %d, allowed [0, %d]: a vane has at most $.barb_count (%d) "
+			                       "barbs, numbered in emission order from 0, the most distal",
+			                       k, split->barb, def->barb_count - 1, def->barb_count);
 		snprintf(path, sizeof path, "$.splits[%d].at", k);
 		if ((status = check_range(split->at, 0.0, 1.0, path, err)) != PLUME_OK)
 			return status;
 		if (!(fabs(split->angle) < 180.0 * deg))
-			return plume_error_set(err, PLUME_ERROR_SPEC, "$.splits[%d].angle_deg is %g, allowed (-180, 180)", k,
-			                       split->angle / deg);
+			return plume_error_set(err, PLUME_ERROR_SPEC, "$.splits[%d].angle_deg is %s, allowed (-180, 180)", k,
+			                       outside(text, sizeof text, split->angle / deg, -180.0, 180.0));
 	}
 	return PLUME_OK;
 }
@@ -513,6 +540,47 @@ static int set_summary(plume_feather *feather, const plume_zk_report *report, co
 	return result;
 }
 
+/// A split of a barb the finished feather does not have: refused, where it once gave the feather
+/// without the split. The vane that does not end the growth can have fewer than N barbs (its barb
+/// N - 1 still developing at t_end). Below stage 1 a split waits for its barb to be emitted: a
+/// growth sequence shows it from the frame that has the barb.
+static plume_status check_splits(const plume_zk_def *def, const zk_growth *growth, plume_error *err)
+{
+	if (def->growth_stage < 1.0)
+		return PLUME_OK;
+	for (int k = 0; k < def->split_count; ++k) {
+		const plume_zk_split *split = def->splits + k;
+		int count = growth->side_count[split->side];
+		if (split->barb >= count)
+			return plume_error_set(err, PLUME_ERROR_SPEC,
+			                       "$.splits[%d].barb is %d, but the %s vane has %d barbs (0 to %d): its barb %d is "
+			                       "still developing when the growth ends",
+			                       k, split->barb, split->side == PLUME_SIDE_LEFT ? "left" : "right", count, count - 1,
+			                       count);
+	}
+	return PLUME_OK;
+}
+
+static bool vec_is_finite(plume_vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
+
+/// Whether every number of the feather that an exporter writes is finite. The growth keeps
+/// its times finite, but a speed near zero at I_P gives finite emission times near 1e300
+/// and heights v_grow (t_curr - t) (eq. 5) past the largest double.
+static bool feather_is_finite(const plume_feather *feather)
+{
+	for (int i = 0; i < feather->shaft_count; ++i) {
+		const plume_shaft_sample *q = feather->shaft + i;
+		if (!vec_is_finite(q->position) || !isfinite(q->width) || !isfinite(q->t))
+			return false;
+	}
+	for (int i = 0; i < feather->point_count; ++i)
+		if (!vec_is_finite(feather->points[i]) || !vec_is_finite(feather->normals[i]) ||
+		    !isfinite(feather->arc_length[i]) || !isfinite(feather->widths[i]) || !isfinite(feather->uv[i].x) ||
+		    !isfinite(feather->uv[i].y))
+			return false;
+	return true;
+}
+
 // ---------------------------------------------------------------------------
 
 plume_status plume_zk_generate(const plume_zk_def *def, uint64_t seed, plume_feather **out, plume_zk_report *report,
@@ -536,13 +604,28 @@ plume_status plume_zk_generate(const plume_zk_def *def, uint64_t seed, plume_fea
 		zk_collar_free(&collar);
 		return status;
 	}
+	if ((status = check_splits(def, &growth, err)) != PLUME_OK) {
+		zk_growth_free(&growth);
+		zk_collar_free(&collar);
+		return status;
+	}
 	if ((status = zk_unfurl(def, &collar, &growth, &shape)) != PLUME_OK ||
 	    (status = zk_expand(def, &growth, &shape, &barbules)) != PLUME_OK)
 		goto done;
 	zk_result result = {.def = def, .growth = &growth, .shape = &shape, .barbules = &barbules};
 	result.base_width =
 	    plume_v3_distance(zk_collar_point(&collar, def->anterior[0]), zk_collar_point(&collar, def->anterior[1]));
-	if ((status = build_feather(&result, &feather)) != PLUME_OK || (status = fill_report(&result, &local)) != PLUME_OK)
+	if ((status = build_feather(&result, &feather)) != PLUME_OK)
+		goto done;
+	if (!feather_is_finite(feather)) {
+		plume_error_set(err, PLUME_ERROR_SPEC,
+		                "the feather's heights overflow: v_grow (t_curr - t) (eq. 5) is not finite with t_end = %g s; "
+		                "raise $.emitter_speed where it is slow (at I_P, $.posterior) or lower $.growth_speed",
+		                growth.t_end);
+		status = PLUME_ERROR_SPEC;
+		goto done;
+	}
+	if ((status = fill_report(&result, &local)) != PLUME_OK)
 		goto done;
 	if (set_summary(feather, &local, def) != 0) {
 		status = PLUME_ERROR_MEMORY;
@@ -561,6 +644,8 @@ done:
 	zk_shape_free(&shape);
 	zk_growth_free(&growth);
 	zk_collar_free(&collar);
+	if (status == PLUME_ERROR_SPEC)
+		return status; // the message is set
 	if (status != PLUME_OK)
 		return plume_error_set(err, status, "out of memory while building a zhang-kanai feather");
 	return PLUME_OK;

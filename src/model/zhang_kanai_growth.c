@@ -25,6 +25,15 @@
 
 /// Upper bounds that turn a runaway spec into an error instead of a hang.
 enum { MAX_STEPS_PER_PATH = 2000000, MAX_EMISSIONS_PER_VANE = 200000 };
+/// An emitter may take this many steps: it crosses the whole I_A-I_P path once, where a pathline crosses part.
+#define MAX_EMITTER_STEPS (8L * MAX_STEPS_PER_PATH)
+
+/// Which bound a runaway growth passed: fail_runaway names the keys that move it.
+typedef enum zk_runaway {
+	RUNAWAY_PATHLINE,  ///< a barb needs more than MAX_STEPS_PER_PATH steps to reach I_A
+	RUNAWAY_EMISSIONS, ///< a vane emits more than MAX_EMISSIONS_PER_VANE barbs before barb N - 1 matures
+	RUNAWAY_EMITTER,   ///< an emitter needs more than MAX_EMITTER_STEPS steps to its next emission
+} zk_runaway;
 
 typedef struct zk_flow {
 	const zk_curve *speed;
@@ -183,15 +192,16 @@ typedef struct emitter {
 	double clamp_time;
 	double variation_sum; ///< sum of the r_i drawn so far
 	int emitted;
+	double goal; ///< the distance from I_A it was moving to when it passed MAX_EMITTER_STEPS (the message's)
 } emitter;
 
 /// Advances the emitter's steps until its locus reaches target; returns the
-/// time, or INFINITY when the step grid passes t_limit first.
+/// time, or INFINITY when the step grid passes t_limit or MAX_EMITTER_STEPS first.
 static double advance_to(const zk_vane *vane, emitter *em, double target, double t_limit)
 {
 	const double sigma = vane->emitter.scale > 0.0 ? 1.0 : -1.0, h = vane->h;
 	for (;;) {
-		if ((double)em->k * h > t_limit || em->k >= (long)MAX_STEPS_PER_PATH * 8)
+		if ((double)em->k * h > t_limit || em->k >= MAX_EMITTER_STEPS)
 			return INFINITY;
 		if (!em->have_next) {
 			em->next = rk4_step(&vane->emitter, em->s, h);
@@ -205,8 +215,12 @@ static double advance_to(const zk_vane *vane, emitter *em, double target, double
 	}
 }
 
-/// Emission i: P_0.t and P_0.locus (eq. 3-4 with the thresholds D_i).
-static void emit(zk_vane *vane, emitter *em, double *t0, double *s0)
+/// Emission i: P_0.t and P_0.locus (eq. 3-4 with the thresholds D_i). Fails
+/// (PLUME_ERROR_NUMERIC) when the emission time is not finite: an emitter so slow
+/// for the step that it passed MAX_EMITTER_STEPS before reaching D_i. That time
+/// was once stored as the emission time, and an infinite P_0.t gave barbs at
+/// y = v_grow (t_curr - t) = inf or NaN (eq. 5) and a feather written with exit 0.
+static plume_status emit(zk_vane *vane, emitter *em, double *t0, double *s0)
 {
 	double r = vane->variation > 0.0 ? plume_rng_range(&vane->rng, -vane->variation, vane->variation) : 0.0;
 	em->variation_sum += r;
@@ -214,20 +228,24 @@ static void emit(zk_vane *vane, emitter *em, double *t0, double *s0)
 	em->emitted++;
 	double sigma = vane->emitter.scale > 0.0 ? 1.0 : -1.0;
 	double target = vane->s_anterior + sigma * distance / vane->length;
+	double clamp_distance = vane->length * fabs(vane->s_posterior - vane->s_anterior);
+	em->goal = fmin(distance, clamp_distance);
 	if (!em->clamped && sigma * (target - vane->s_posterior) < 0.0) {
 		*t0 = advance_to(vane, em, target, INFINITY);
 		*s0 = target;
-		return;
+		return isfinite(*t0) ? PLUME_OK : PLUME_ERROR_NUMERIC;
 	}
 	if (!em->clamped) {
 		em->clamp_time = advance_to(vane, em, vane->s_posterior, INFINITY);
+		if (!isfinite(em->clamp_time))
+			return PLUME_ERROR_NUMERIC;
 		em->clamped = true;
 	}
 	// Clamped at I_P, the emitter keeps "moving" at V_e(I_P) for emission.
-	double clamp_distance = vane->length * fabs(vane->s_posterior - vane->s_anterior);
 	double extra = fmax(0.0, distance - clamp_distance);
 	*t0 = em->clamp_time + extra / zk_curve_eval(vane->emitter.speed, vane->s_posterior);
 	*s0 = vane->s_posterior;
+	return isfinite(*t0) ? PLUME_OK : PLUME_ERROR_NUMERIC;
 }
 
 // ---------------------------------------------------------------------------
@@ -250,16 +268,22 @@ typedef struct vane_run {
 	/// integrating their pathline a second time.
 	path_points kept;
 	int kept_count;
+	zk_runaway runaway;  ///< the bound passed, when add_emission failed with PLUME_ERROR_NUMERIC
+	int vane_barb_count; ///< N, for fail_runaway's message
 } vane_run;
 
 static plume_status add_emission(vane_run *run)
 {
+	run->runaway = RUNAWAY_EMISSIONS;
 	if (run->count >= MAX_EMISSIONS_PER_VANE)
 		return PLUME_ERROR_NUMERIC;
 	if (PLUME_GROW(run->list, run->capacity, run->count + 1) != 0)
 		return PLUME_ERROR_MEMORY;
 	emission *e = run->list + run->count;
-	emit(&run->vane, &run->em, &e->t0, &e->s0);
+	run->runaway = RUNAWAY_EMITTER;
+	if (emit(&run->vane, &run->em, &e->t0, &e->s0) != PLUME_OK)
+		return PLUME_ERROR_NUMERIC;
+	run->runaway = RUNAWAY_PATHLINE;
 	e->point_first = -1;
 	if (e->s0 == run->vane.s_posterior && run->have_cache) {
 		e->end = run->cache;
@@ -307,6 +331,8 @@ static void vane_setup(vane_run *run, const plume_zk_def *def, const zk_collar *
 	};
 	run->em.s = run->vane.s_anterior;
 	run->em.clamp_time = INFINITY;
+	run->runaway = RUNAWAY_PATHLINE;
+	run->vane_barb_count = def->barb_count;
 	run->kept.grows = true;
 }
 
@@ -354,29 +380,83 @@ static double collar_length_bound(const plume_zk_def *def)
 	return length;
 }
 
+/// Points a pathline of at most length metres keeps: its first, every f-th of its whole steps, its
+/// last (pathline()). RK4's increment is h times a mean of V_b at its stages, each at least the
+/// curve's smallest control value v_min, so every whole step moves at least h v_min along the collar:
+/// at most length / (h v_min) whole steps (one more for rounding where that is near a whole number),
+/// and never more than MAX_STEPS_PER_PATH (growth refuses more).
+static double pathline_points(double length, double h, double v_min, double f)
+{
+	return 2.0 + floor(fmin((double)MAX_STEPS_PER_PATH, floor(length / (h * v_min)) + 1.0) / f);
+}
+
 double plume_zk_estimate_bytes(const plume_zk_def *def)
 {
-	double path_time = collar_length_bound(def) / curve_extreme(&def->barb_speed, false);
-	double steps = fmin((double)MAX_STEPS_PER_PATH, ceil(path_time / def->step)) + 1.0;
-	double vertices_per_barb = steps / (double)(def->downsample > 0 ? def->downsample : 1) + 2.0;
-	double spacing = def->ridge_width * (1.0 - def->ridge_width_variation);
-	double developing =
-	    fmin((double)MAX_EMISSIONS_PER_VANE, path_time * curve_extreme(&def->emitter_speed, true) / spacing + 1.0);
-	double barbs = 2.0 * ((double)def->barb_count + developing);
-	double vertices = barbs * vertices_per_barb;
+	double perimeter = collar_length_bound(def), v_min = curve_extreme(&def->barb_speed, false);
+	double h = def->step, f = (double)(def->downsample > 0 ? def->downsample : 1);
+	double d = def->ridge_width, variation = def->ridge_width_variation;
+	int n = def->barb_count > 0 && def->barb_count <= PLUME_ZK_MAX_BARBS ? def->barb_count : 0;
+	if (!(v_min > 0.0 && h > 0.0 && d > 0.0 && perimeter >= 0.0 && variation >= 0.0 && variation < 1.0) || n == 0)
+		return INFINITY; // refused by validation
+	double points = 0.0, barbs = 0.0;
+	for (int side = 0; side < 2; ++side) {
+		// A barb grows from where it was emitted back to I_A: at most this vane's path from I_A to I_P.
+		double path = perimeter * fabs(def->posterior[side] - def->anterior[side]);
+		// Mature barbs: at most N a vane (N of one vane end the growth; below stage 1 fewer are), the
+		// first N emitted, as barbs mature in emission order. Barb i leaves the ridge D_i =
+		// d ((i + 1) + the sum of its r_j) <= d (i + 1) (1 + v) from I_A, or at I_P.
+		for (int i = 0; i < n; ++i)
+			points += pathline_points(fmin(path, d * (i + 1) * (1.0 + variation)), h, v_min, f);
+		barbs += n;
+		if (def->growth_stage >= 1.0)
+			continue; // IV-A Termination: the developing barbs are discarded
+		// Below stage 1 the developing barbs are kept, each as far as it grew: one younger than the
+		// longest pathline time T each, emitted at least delta = d (1 - v) / max V_e apart. Their ages
+		// are below T, T - delta, T - 2 delta, ...: their points sum to less than that series'.
+		double t_max = path / v_min, rate_max = curve_extreme(&def->emitter_speed, true);
+		double delta = d * (1.0 - variation) / rate_max;
+		double count = fmin((double)MAX_EMISSIONS_PER_VANE, ceil(t_max / delta));
+		double ages = count * t_max - delta * count * (count - 1.0) / 2.0;
+		points += 3.0 * count + fmin(ages / h, count * (double)MAX_STEPS_PER_PATH) / f;
+		barbs += count;
+	}
 	bool barbules = def->expansion && def->keep_barbules;
-	return plume_feather_layout_bytes(vertices * (barbules ? 5.0 : 1.0), barbs, barbules ? 2.0 * vertices : 0.0,
+	return plume_feather_layout_bytes(points * (barbules ? 5.0 : 1.0), barbs, barbules ? 2.0 * points : 0.0,
 	                                  def->shaft_samples);
 }
 
-static plume_status fail_runaway(plume_status status, plume_error *err)
+/// A runaway growth is the spec's doing (a speed too slow or too fast for the step and the
+/// ridge width): PLUME_ERROR_SPEC, naming the keys that end it.
+static plume_status fail_runaway(plume_status status, const vane_run *runs, plume_error *err)
 {
 	if (status == PLUME_ERROR_MEMORY)
 		return plume_error_set(err, status, "out of memory while growing the barbs");
-	return plume_error_set(err, status,
-	                       "the growth does not end: a pathline needs more than %d steps or a vane more than %d "
-	                       "emissions; raise $.step, $.barb_speed or $.ridge_width",
-	                       (int)MAX_STEPS_PER_PATH, (int)MAX_EMISSIONS_PER_VANE);
+	if (status != PLUME_ERROR_NUMERIC)
+		return status; // the message is set
+	int side = runs[PLUME_SIDE_LEFT].runaway != RUNAWAY_PATHLINE ? PLUME_SIDE_LEFT : PLUME_SIDE_RIGHT;
+	const vane_run *run = runs + side;
+	const char *name = side == PLUME_SIDE_LEFT ? "left" : "right";
+	switch (run->runaway) {
+	case RUNAWAY_EMITTER:
+		return plume_error_set(
+		    err, PLUME_ERROR_SPEC,
+		    "$.emitter_speed: the growth does not end: the %s emitter needs more than %ld steps of $.step (%g s) to "
+		    "move %g m along the collar from I_A (for its barb %d); V_e is %g m/s where it stopped, too slow for the "
+		    "step; raise $.emitter_speed or $.step",
+		    name, MAX_EMITTER_STEPS, run->vane.h, run->em.goal, run->count,
+		    zk_curve_eval(run->vane.emitter.speed, run->em.s));
+	case RUNAWAY_EMISSIONS:
+		return plume_error_set(err, PLUME_ERROR_SPEC,
+		                       "the growth does not end: the %s vane emits more than %d barbs before its barb %d "
+		                       "matures; lower $.emitter_speed, or raise $.ridge_width or $.barb_speed",
+		                       name, (int)MAX_EMISSIONS_PER_VANE, run->vane_barb_count - 1);
+	case RUNAWAY_PATHLINE:
+	default:
+		return plume_error_set(err, PLUME_ERROR_SPEC,
+		                       "the growth does not end: a barb needs more than %d steps of $.step (%g s) to grow "
+		                       "from where it was emitted to I_A; raise $.step or $.barb_speed",
+		                       (int)MAX_STEPS_PER_PATH, run->vane.h);
+	}
 }
 
 plume_status zk_grow(const plume_zk_def *def, const zk_collar *collar, uint64_t seed, zk_growth *growth,
@@ -413,6 +493,15 @@ plume_status zk_grow(const plume_zk_def *def, const zk_collar *collar, uint64_t 
 	if (status != PLUME_OK)
 		goto fail;
 	double t_end = fmin(runs[0].list[def->barb_count - 1].mature_time, runs[1].list[def->barb_count - 1].mature_time);
+	// emit() refuses an infinite P_0.t, so this holds; it is checked because every
+	// height is v_grow (t_curr - t) (eq. 5): a t_end that is not finite makes no feather.
+	if (!isfinite(t_end)) {
+		status = plume_error_set(err, PLUME_ERROR_SPEC,
+		                         "the growth does not end: barb %d of either vane never matures (t_end is %g s); "
+		                         "raise $.emitter_speed, $.barb_speed or $.step",
+		                         def->barb_count - 1, t_end);
+		goto fail;
+	}
 	double t_curr = def->growth_stage >= 1.0 ? t_end : def->growth_stage * t_end;
 	bool final = def->growth_stage >= 1.0;
 	// Barbs emitted up to t_curr are there (developing ones are kept below the final stage).
@@ -516,5 +605,5 @@ fail:
 	for (int side = 0; side < 2; ++side)
 		vane_free(runs + side);
 	zk_growth_free(growth);
-	return fail_runaway(status, err);
+	return fail_runaway(status, runs, err);
 }

@@ -64,6 +64,15 @@ check "out of range writes nothing" test ! -e "$scratch/x3"
 expect_failure "missing spec" 4 "no-such.json: cannot read: No such file or directory" \
 	"$plume" generate "$scratch/no-such.json" -o "$scratch/x4"
 check "missing spec writes nothing" test ! -e "$scratch/x4"
+# A folder opens for reading: jansson read it as an empty text (exit 3, "/tmp:1:0: '[' or '{' expected").
+mkdir -p "$scratch/a-folder"
+expect_no_output "a folder for the spec" 4 "a-folder: cannot read: Is a directory" "$scratch/x4b" \
+	"$plume" generate "$scratch/a-folder" -o "$scratch/x4b"
+# An empty --format item is refused wherever it is ("png," once passed, "png,,obj" did not).
+for list in png, ,png png,,obj; do
+	expect_no_output "--format '$list'" 2 "--format '$list' has an empty item" "$scratch/x4c" \
+		"$plume" generate "$presets/blue.json" -o "$scratch/x4c" --format "$list"
+done
 touch "$scratch/a-file"
 expect_failure "unwritable output" 4 "cannot write the output folder" \
 	"$plume" generate "$presets/blue.json" -o "$scratch/a-file/out"

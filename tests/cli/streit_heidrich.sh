@@ -51,8 +51,17 @@ expect_no_output "grow: a write the background writer cannot finish" 4 \
 	"plume: $scratch/too-large/frame-0004.usda: write failed: File too large" "$scratch/too-large" \
 	bash -c "trap '' XFSZ; ulimit -f 300; exec '$plume' grow '$presets/contour.json' -o '$scratch/too-large' --frames 5 --size 160x240"
 
-expect_no_output "grow: --unfurl on streit-heidrich" 1 "no unfurling" "$scratch/g1" \
+# A model without the stages asked for is the command line's mistake (it read exit 1, a failed computation).
+expect_no_output "grow: --unfurl on streit-heidrich" 2 "plume: grow: $presets/contour.json: the streit-heidrich model has growth stages but no unfurling" "$scratch/g1" \
 	"$plume" grow "$presets/contour.json" -o "$scratch/g1" --frames 3 --unfurl
+expect_no_output "grow: franco-walter" 2 "the franco-walter model has no growth or unfurling stages" "$scratch/g1b" \
+	"$plume" grow "$source_dir/examples/franco-walter/hawk.json" -o "$scratch/g1b" --frames 3
+expect_no_output "grow: an empty --format item" 2 "--format 'obj,' has an empty item" "$scratch/g1c" \
+	"$plume" grow "$presets/contour.json" -o "$scratch/g1c" --frames 3 --format obj,
+# glb frames, as generate writes them, and the help says so.
+"$plume" grow "$presets/contour.json" -o "$scratch/g-glb" --frames 2 --format glb 2>/dev/null
+check "grow --format glb" test -s "$scratch/g-glb/frame-0001.glb"
+check "help grow lists glb" bash -c "'$plume' help grow | grep -q 'png,svg,pdf,obj,usda,json,glb'"
 expect_no_output "grow: frames missing" 2 "missing --frames" "$scratch/g2" \
 	"$plume" grow "$presets/contour.json" -o "$scratch/g2"
 expect_no_output "grow: frames 0" 2 "--frames '0'" "$scratch/g3" \

@@ -85,5 +85,18 @@ bad barb-count '$.barb_count is 0, allowed [1, 5000]' '"barb_count": 0'
 bad collar '$.collar.points: has 3 control points' '"collar": {"points": [[0, -0.01], [0.01, 0], [0, 0.01]]}'
 bad unknown-key 'did you mean "barb_speed"' '"barb_sped": 0.01'
 bad angle '$.theta_distal_deg is 0, allowed (0, 180)' '"theta_distal_deg": 0'
+# Splits that bend nothing were ignored: the feather came out as without them.
+bad split-no-barb '$.splits[0].barb is 500, allowed [0, 99]' '"expansion": true, "splits": [{"side": "right", "barb": 500}]'
+bad split-no-expansion '$.splits: a split bends a barb before snapping' '"splits": [{"side": "right", "barb": 60}]'
+bad split-barb-missing '$.splits[0].barb: missing; a split names its barb' '"expansion": true, "splits": [{"at": 0.3}]'
+# An emitter too slow for the step once wrote "v 0 inf 0" and "v 0 -nan 0" with exit 0 (1e-9: no barbs).
+bad slow-emitter '$.emitter_speed: the growth does not end: the left emitter needs more than' '"emitter_speed": 1e-8'
+bad slower-emitter '$.emitter_speed: the growth does not end' '"emitter_speed": 1e-9'
+bad fast-emitter 'the left vane emits more than 200000 barbs' '"emitter_speed": 100'
+printf '{"model": "zhang-kanai", "emitter_speed": 1e-8}\n' >"$scratch/slow.json"
+"$plume" generate "$scratch/slow.json" -o "$scratch/out-slow" --format obj,usda,glb,json >/dev/null 2>&1
+code=$?
+check "slow emitter, every format: exit 3 (got $code)" test "$code" -eq 3
+check "slow emitter, every format: nothing written" test ! -e "$scratch/out-slow"
 
 finish
