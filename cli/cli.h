@@ -81,6 +81,11 @@ const char *cli_output_path(cli_output *output, const char *name, char *buffer, 
 plume_status cli_output_commit(cli_output *output, plume_error *err);
 /// Removes the staging folder; with err, first names DIR instead of it in err's message.
 void cli_output_abort(cli_output *output, plume_error *err);
+/// Records in DIR's run manifest (cli/output.c) the files folder/names[i] that a run moved
+/// into DIR itself (plume render --frames joining DIR/frames/), so that the next run into
+/// DIR replaces them as plume's; nothing to do when DIR has no manifest.
+plume_status cli_output_manifest_add(const char *dir, const char *folder, const char *const *names, int count,
+                                     plume_error *err);
 /// Removes a file or a folder and everything in it (links removed, not followed).
 void cli_remove_tree(const char *path);
 

@@ -171,18 +171,22 @@ bool cli_parse_memory(const char *command, const char *text, uint64_t *bytes)
 // A run writes into a staging folder beside DIR, ".NAME.plume-staging-PID-XXXXXX"
 // (same parent, so the same file system). When every file is written:
 //  - a new DIR: the staging folder is renamed to DIR;
-//  - an existing DIR: every entry of DIR the run does not write is hard-linked
+//  - an existing DIR: every entry of DIR the run does not write, and the earlier
+//    run did not write either (its manifest, RUN_MANIFEST, below), is hard-linked
 //    into the staging folder (a folder the run writes too, such as frames/, is
-//    merged: the user's files in it are linked, the earlier run's frames are
-//    not), then renameat2(RENAME_EXCHANGE) swaps the two folders in one step and
+//    merged: the user's files in it are linked, the earlier run's are not), then
+//    renameat2(RENAME_EXCHANGE) swaps the two folders in one step and
 //    the earlier run, now under the staging name, is removed. The user's files
 //    live on through their second link; nothing plume did not write is lost,
 //    and a reader sees the whole earlier run or the whole new one, never a mix.
 // Without RENAME_EXCHANGE (a kernel or file system without it) DIR is renamed
 // aside and the staging folder renamed into place: two renames with a moment
-// in between where DIR is absent, but never mixed. Without hard links (vfat)
-// the run fails and DIR keeps the earlier run. When the parent folder is not
-// writable, the staging folder goes inside DIR and entries move one by one.
+// in between where DIR is absent, but never mixed. Without hard links (vfat),
+// or for another user's file the kernel will not let plume link
+// (fs.protected_hardlinks), the run fails and DIR keeps the earlier run. When
+// the parent folder is not writable, the staging folder goes inside DIR and
+// entries move one by one (the user's files in the run's folders linked in
+// first), and then the earlier run's other files are removed.
 //
 // Interrupted runs. Each staging folder holds a marker file, STAGING_MARKER, that
 // says "plume staging", the PID and that process's start time. SIGINT and SIGTERM
@@ -538,19 +542,254 @@ const char *cli_output_path(cli_output *output, const char *name, char *buffer, 
 	return buffer;
 }
 
-/// Whether name is one plume writes inside a folder of a run (frames/0012.obj,
-/// 0012-rt.png, ...): a digit first. An earlier run's files of that kind are
-/// replaced by the new run's folder; anything else in it is the user's.
+// ---------------------------------------------------------------------------
+// The run manifest: RUN_MANIFEST in DIR lists every file and folder the last run
+// wrote (paths relative to DIR, folders with a trailing '/', one a line, sorted),
+// so that the next run into DIR replaces exactly those and keeps everything else,
+// whatever its name. A DIR without one (written by a plume that wrote none, or only
+// by `plume render --frames`) falls back to the old rule: in a folder of the run, a
+// file whose name starts with a digit is an earlier run's frame.
+
+#define RUN_MANIFEST ".plume-run"
+#define RUN_MANIFEST_HEADER "plume run manifest 1"
+
+typedef struct manifest {
+	bool present;     ///< DIR had a manifest (otherwise the old rule applies)
+	bool keep_all;    ///< its run was another command's: nothing in it is replaced but by name
+	char command[32]; ///< the command that wrote it ("simulate", "render", ...), or ""
+	char **paths;     ///< sorted
+	size_t count, capacity;
+} manifest;
+
+/// This run's command, argv[1] ("generate", "render", ...), from /proc/self/cmdline; ""
+/// where that cannot be read (then every earlier run counts as this command's).
+static const char *run_command(void)
+{
+	static char command[32];
+	static bool known;
+	if (known)
+		return command;
+	known = true;
+	char text[512];
+	FILE *file = fopen("/proc/self/cmdline", "rb");
+	size_t n = file != NULL ? fread(text, 1, sizeof text - 1, file) : 0;
+	if (file != NULL)
+		fclose(file);
+	text[n] = '\0';
+	size_t first = strlen(text); // argv[0], then its NUL
+	if (first + 1 < n)
+		snprintf(command, sizeof command, "%s", text + first + 1);
+	if (strspn(command, "abcdefghijklmnopqrstuvwxyz-") != strlen(command))
+		command[0] = '\0';
+	return command;
+}
+
+static void manifest_free(manifest *m)
+{
+	for (size_t i = 0; i < m->count; ++i)
+		free(m->paths[i]);
+	free(m->paths);
+	memset(m, 0, sizeof *m);
+}
+
+/// Adds a copy of path. 0 or ENOMEM.
+static int manifest_add(manifest *m, const char *path)
+{
+	if (m->count == m->capacity) {
+		size_t capacity = m->capacity > 0 ? 2 * m->capacity : 64;
+		char **grown = realloc(m->paths, capacity * sizeof *grown);
+		if (grown == NULL)
+			return ENOMEM;
+		m->paths = grown;
+		m->capacity = capacity;
+	}
+	if ((m->paths[m->count] = strdup(path)) == NULL)
+		return ENOMEM;
+	m->count++;
+	return 0;
+}
+
+static int compare_paths(const void *a, const void *b)
+{
+	return strcmp(*(const char *const *)a, *(const char *const *)b);
+}
+
+static bool manifest_has(const manifest *m, const char *path)
+{
+	return m->count > 0 && bsearch(&path, m->paths, m->count, sizeof *m->paths, compare_paths) != NULL;
+}
+
+/// Reads DIR's manifest; a DIR without one (or with one plume cannot read) leaves m
+/// not present. 0 or ENOMEM.
+static int manifest_read(const char *dir, manifest *m)
+{
+	memset(m, 0, sizeof *m);
+	char path[4352], line[4352];
+	snprintf(path, sizeof path, "%s/" RUN_MANIFEST, dir);
+	struct stat info;
+	if (lstat(path, &info) != 0 || !S_ISREG(info.st_mode))
+		return 0;
+	FILE *file = fopen(path, "r");
+	if (file == NULL)
+		return 0;
+	// "plume run manifest 1 COMMAND" (COMMAND absent: unknown).
+	size_t prefix = strlen(RUN_MANIFEST_HEADER);
+	bool header = fgets(line, sizeof line, file) != NULL && strncmp(line, RUN_MANIFEST_HEADER, prefix) == 0 &&
+	              (line[prefix] == '\n' || line[prefix] == ' ');
+	if (header && line[prefix] == ' ')
+		snprintf(m->command, sizeof m->command, "%.*s", (int)strcspn(line + prefix + 1, "\n"), line + prefix + 1);
+	int failure = 0;
+	while (header && failure == 0 && fgets(line, sizeof line, file) != NULL) {
+		size_t length = strlen(line);
+		if (length > 0 && line[length - 1] != '\n' && !feof(file)) { // an overlong line names nothing of ours
+			while (fgets(line, sizeof line, file) != NULL && line[strlen(line) - 1] != '\n')
+				;
+			continue;
+		}
+		if (length < 2 || line[length - 1] != '\n')
+			continue; // an empty line, or the last one cut short
+		line[length - 1] = '\0';
+		failure = manifest_add(m, line);
+	}
+	fclose(file);
+	m->present = header && failure == 0;
+	if (m->present)
+		qsort(m->paths, m->count, sizeof *m->paths, compare_paths);
+	else
+		manifest_free(m);
+	return failure;
+}
+
+/// Lists the tree at dir into m (relative to the run's folder, after prefix), leaving
+/// out the staging marker and the manifest. 0 or an errno.
+static int manifest_list(const char *dir, const char *prefix, manifest *m)
+{
+	DIR *folder = opendir(dir);
+	if (folder == NULL)
+		return errno;
+	int failure = 0;
+	struct dirent *entry;
+	while (failure == 0 && (entry = readdir(folder)) != NULL) {
+		const char *name = entry->d_name;
+		if (strcmp(name, ".") == 0 || strcmp(name, "..") == 0 || strchr(name, '\n') != NULL ||
+		    (prefix[0] == '\0' && (strcmp(name, STAGING_MARKER) == 0 || strcmp(name, RUN_MANIFEST) == 0)))
+			continue;
+		char path[4608], relative[4352];
+		snprintf(path, sizeof path, "%s/%s", dir, name);
+		struct stat info;
+		if (lstat(path, &info) != 0)
+			continue;
+		bool folder_entry = S_ISDIR(info.st_mode);
+		snprintf(relative, sizeof relative, "%s%s%s", prefix, name, folder_entry ? "/" : "");
+		failure = manifest_add(m, relative);
+		if (failure == 0 && folder_entry)
+			failure = manifest_list(path, relative, m);
+	}
+	closedir(folder);
+	return failure;
+}
+
+/// Writes the manifest of what the staging folder holds into it. 0 or an errno.
+static int write_manifest(const char *stage)
+{
+	manifest m = {0};
+	int failure = manifest_list(stage, "", &m);
+	if (failure == 0) {
+		qsort(m.paths, m.count, sizeof *m.paths, compare_paths);
+		char path[4352];
+		snprintf(path, sizeof path, "%s/" RUN_MANIFEST, stage);
+		FILE *file = fopen(path, "w");
+		if (file == NULL) {
+			failure = errno;
+		} else {
+			fprintf(file, RUN_MANIFEST_HEADER "%s%s\n", run_command()[0] != '\0' ? " " : "", run_command());
+			for (size_t i = 0; i < m.count; ++i)
+				fprintf(file, "%s\n", m.paths[i]);
+			if (fclose(file) != 0)
+				failure = errno;
+		}
+	}
+	manifest_free(&m);
+	return failure;
+}
+
+plume_status cli_output_manifest_add(const char *dir, const char *folder, const char *const *names, int count,
+                                     plume_error *err)
+{
+	char path[4352];
+	snprintf(path, sizeof path, "%s/" RUN_MANIFEST, dir);
+	// Only a manifest of this command's run: another command's keeps to its own files
+	// (other_command), and these stay files it does not replace.
+	manifest earlier;
+	if (manifest_read(dir, &earlier) != 0)
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory");
+	bool ours = earlier.present && strcmp(earlier.command, run_command()) == 0;
+	manifest_free(&earlier);
+	if (!ours)
+		return PLUME_OK;
+	int fd = open(path, O_WRONLY | O_APPEND | O_NOFOLLOW | O_CLOEXEC);
+	if (fd < 0)
+		return errno == ENOENT ? PLUME_OK
+		                       : plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write: %s", path, strerror(errno));
+	// One write for all the lines: runs appending at once (ranges rendered in parallel) do not interleave.
+	// The folder too (listed again when the earlier run had it: the reader takes either).
+	size_t size = 0, capacity = (size_t)count * 80 + strlen(folder) + 80;
+	char *text = malloc(capacity);
+	plume_status status = text != NULL ? PLUME_OK : plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory");
+	if (status == PLUME_OK)
+		size = (size_t)sprintf(text, "%s/\n", folder);
+	for (int i = 0; i < count && status == PLUME_OK; ++i) {
+		size_t need = strlen(folder) + strlen(names[i]) + 3;
+		if (size + need > capacity) {
+			capacity = 2 * capacity + need;
+			char *grown = realloc(text, capacity);
+			if (grown == NULL) {
+				status = plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory");
+				break;
+			}
+			text = grown;
+		}
+		size += (size_t)sprintf(text + size, "%s/%s\n", folder, names[i]);
+	}
+	if (status == PLUME_OK && write(fd, text, size) != (ssize_t)size)
+		status = plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write: %s", path, strerror(errno));
+	free(text);
+	close(fd);
+	return status;
+}
+
+// ---------------------------------------------------------------------------
+// Commit
+
+/// The old rule, for a DIR without a manifest: a file plume writes inside a folder of a
+/// run (frames/0012.obj, 0012-rt.png, ...) has a digit first.
 static bool plume_frame_name(const char *name) { return name[0] >= '0' && name[0] <= '9'; }
 
-/// Hard-links the tree at from to to (folders recreated with their mode). 0 or an errno.
-static int link_tree(const char *from, const char *to)
+/// Whether the entry relative (in a folder `depth` deep in DIR; folders with a trailing
+/// '/') is the earlier run's: listed in DIR's manifest, or without one by the old rule.
+static bool earlier_run(const manifest *earlier, const char *relative, const char *name, int depth, bool folder)
+{
+	if (earlier->keep_all)
+		return false;
+	if (earlier->present)
+		return manifest_has(earlier, relative);
+	return depth > 0 && !folder && plume_frame_name(name);
+}
+
+/// Hard-links the tree at from to to (folders recreated with their mode). 0 or an errno;
+/// the path that failed in failed.
+static int link_tree(const char *from, const char *to, char *failed, size_t failed_size)
 {
 	struct stat info;
 	if (lstat(from, &info) != 0)
 		return errno;
-	if (!S_ISDIR(info.st_mode))
-		return linkat(AT_FDCWD, from, AT_FDCWD, to, 0) == 0 ? 0 : errno;
+	if (!S_ISDIR(info.st_mode)) {
+		if (linkat(AT_FDCWD, from, AT_FDCWD, to, 0) == 0)
+			return 0;
+		int failure = errno;
+		snprintf(failed, failed_size, "%s", from);
+		return failure;
+	}
 	if (mkdir(to, info.st_mode & 07777) != 0)
 		return errno;
 	DIR *dir = opendir(from);
@@ -564,16 +803,18 @@ static int link_tree(const char *from, const char *to)
 		char a[4608], b[4608];
 		snprintf(a, sizeof a, "%s/%s", from, entry->d_name);
 		snprintf(b, sizeof b, "%s/%s", to, entry->d_name);
-		failure = link_tree(a, b);
+		failure = link_tree(a, b, failed, failed_size);
 	}
 	closedir(dir);
 	return failure;
 }
 
-/// Carries every entry of old (DIR or a folder in it) that the run did not
-/// write into stage, by hard links. 0, an errno, or -1 when a folder of DIR
-/// has the name of a file of the run (or the reverse): plume will not delete it.
-static int carry_over(const char *old, const char *stage, int depth, char *conflict, size_t conflict_size)
+/// Carries every entry of old (DIR, or the folder `prefix` in it, `depth` deep) that the
+/// run did not write and the earlier run did not write either into stage, by hard links.
+/// 0, an errno (the path in `failed`), or -1 when a folder of DIR has the name of a file
+/// of the run (or the reverse), named in `failed`: plume will not delete it.
+static int carry_over(const char *old, const char *stage, const char *prefix, int depth, const manifest *earlier,
+                      char *failed, size_t failed_size)
 {
 	DIR *dir = opendir(old);
 	if (dir == NULL)
@@ -582,39 +823,186 @@ static int carry_over(const char *old, const char *stage, int depth, char *confl
 	struct dirent *entry;
 	while (failure == 0 && (entry = readdir(dir)) != NULL) {
 		const char *name = entry->d_name;
-		if (strcmp(name, ".") == 0 || strcmp(name, "..") == 0 || strncmp(name, ".plume-staging-", 15) == 0)
+		if (strcmp(name, ".") == 0 || strcmp(name, "..") == 0 || strncmp(name, ".plume-staging-", 15) == 0 ||
+		    (depth == 0 && strcmp(name, RUN_MANIFEST) == 0))
 			continue;
-		char a[4608], b[4608];
+		char a[4608], b[4608], relative[4352];
 		snprintf(a, sizeof a, "%s/%s", old, name);
 		snprintf(b, sizeof b, "%s/%s", stage, name);
 		struct stat old_info, new_info;
 		if (lstat(a, &old_info) != 0)
 			continue;
+		bool folder = S_ISDIR(old_info.st_mode);
+		snprintf(relative, sizeof relative, "%s%s%s", prefix, name, folder ? "/" : "");
 		if (lstat(b, &new_info) == 0) {
-			if (S_ISDIR(old_info.st_mode) && S_ISDIR(new_info.st_mode)) {
-				failure = carry_over(a, b, depth + 1, conflict, conflict_size);
-			} else if (S_ISDIR(old_info.st_mode) != S_ISDIR(new_info.st_mode)) {
-				snprintf(conflict, conflict_size, "%s", a);
+			if (folder && S_ISDIR(new_info.st_mode)) {
+				failure = carry_over(a, b, relative, depth + 1, earlier, failed, failed_size);
+			} else if (folder != S_ISDIR(new_info.st_mode)) {
+				snprintf(failed, failed_size, "%s", a);
 				failure = -1;
 			}
 			continue; // the run's file replaces the earlier one
 		}
-		if (depth > 0 && plume_frame_name(name) && !S_ISDIR(old_info.st_mode))
-			continue; // an earlier run's frame: the new frames/ replaces it
-		failure = link_tree(a, b);
+		if (folder && earlier->present) {
+			// A folder the run does not write: what in it is not the earlier run's stays.
+			if (mkdir(b, old_info.st_mode & 07777) != 0) {
+				failure = errno;
+				continue;
+			}
+			failure = carry_over(a, b, relative, depth + 1, earlier, failed, failed_size);
+			if (failure == 0 && !earlier->keep_all && manifest_has(earlier, relative))
+				rmdir(b); // the earlier run's folder goes when nothing of the user's is in it
+			continue;
+		}
+		if (earlier_run(earlier, relative, name, depth, folder))
+			continue; // the earlier run's file: the new run replaces it
+		failure = link_tree(a, b, failed, failed_size);
 	}
 	closedir(dir);
 	return failure;
 }
 
+/// Removes from the folder dir (`prefix` in DIR) the earlier run's entries that the run
+/// did not write (written: the new run's manifest), keeping what is not the earlier
+/// run's; for the per-entry commit, which has nothing to carry over.
+static void drop_earlier(const char *dir, const char *prefix, const manifest *earlier, const manifest *written)
+{
+	DIR *folder = opendir(dir);
+	if (folder == NULL)
+		return;
+	struct dirent *entry;
+	while ((entry = readdir(folder)) != NULL) {
+		const char *name = entry->d_name;
+		if (strcmp(name, ".") == 0 || strcmp(name, "..") == 0 || strncmp(name, ".plume-staging-", 15) == 0 ||
+		    (prefix[0] == '\0' && strcmp(name, RUN_MANIFEST) == 0))
+			continue;
+		char path[4608], relative[4352];
+		snprintf(path, sizeof path, "%s/%s", dir, name);
+		struct stat info;
+		if (lstat(path, &info) != 0)
+			continue;
+		bool is_folder = S_ISDIR(info.st_mode);
+		snprintf(relative, sizeof relative, "%s%s%s", prefix, name, is_folder ? "/" : "");
+		if (is_folder) {
+			drop_earlier(path, relative, earlier, written);
+			if (manifest_has(earlier, relative) && !manifest_has(written, relative))
+				rmdir(path); // only when empty
+		} else if (manifest_has(earlier, relative) && !manifest_has(written, relative)) {
+			unlink(path);
+		}
+	}
+	closedir(folder);
+}
+
+/// Whether the staging folder holds nothing but its marker.
+static bool stage_empty(const char *stage)
+{
+	DIR *dir = opendir(stage);
+	if (dir == NULL)
+		return false;
+	bool empty = true;
+	struct dirent *entry;
+	while (empty && (entry = readdir(dir)) != NULL)
+		empty = strcmp(entry->d_name, ".") == 0 || strcmp(entry->d_name, "..") == 0 ||
+		        strcmp(entry->d_name, STAGING_MARKER) == 0;
+	closedir(dir);
+	return empty;
+}
+
+/// Removes the staging folder of a run that left nothing in it to commit.
+static void drop_stage(cli_output *output)
+{
+	char marker[4672];
+	snprintf(marker, sizeof marker, "%s/" STAGING_MARKER, output->stage);
+	begin_critical();
+	unlink(marker);
+	rmdir(output->stage);
+	untrack_stage(output);
+	end_critical();
+}
+
+/// err set for a failed carry_over (failure, the path in failed): why the earlier
+/// folder's other files could not be kept in the new run.
+static plume_status carry_failed(const cli_output *output, int failure, const char *failed, plume_error *err)
+{
+	if (failure == -1)
+		return plume_error_set(err, PLUME_ERROR_IO,
+		                       "%s: the run writes a file or folder of that name; move it away first", failed);
+	struct stat info;
+	if (failure == EPERM && failed[0] != '\0' && lstat(failed, &info) == 0 && info.st_uid != geteuid()) {
+		// fs.protected_hardlinks (Linux's default): only a file's owner, or one who may read
+		// and write it, may hard-link it.
+		return plume_error_set(err, PLUME_ERROR_IO,
+		                       "%s: owned by another user (uid %ld), and this system lets no one else hard-link it "
+		                       "(fs.protected_hardlinks), which plume needs to keep it beside the new run; nothing was "
+		                       "changed: write to another folder, or have its owner move it",
+		                       failed, (long)info.st_uid);
+	}
+	if (failure == EPERM || failure == ENOTSUP || failure == EXDEV || failure == EMLINK)
+		// No hard links here (vfat, some network file systems): keeping the earlier
+		// run intact matters more than this run; say how to get it.
+		return plume_error_set(
+		    err, PLUME_ERROR_IO,
+		    "%s: this file system cannot hard-link the folder's other files into the new run (%s: %s); "
+		    "write to a new folder instead",
+		    output->dir, failed[0] != '\0' ? failed : output->dir, strerror(failure));
+	return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write: %s", failed[0] != '\0' ? failed : output->dir,
+	                       strerror(failure));
+}
+
+/// An earlier run of another command (plume render into a folder of plume simulate's,
+/// generate into one of render's) is not this run's to replace: its files are kept as
+/// the user's (earlier->keep_all), and a run that would overwrite one of them fails
+/// instead (PLUME_ERROR_IO, naming it). 0 when the earlier run is this command's.
+static plume_status other_command(const cli_output *output, manifest *earlier, const char *stage, plume_error *err)
+{
+	const char *command = run_command();
+	if (!earlier->present || earlier->command[0] == '\0' || command[0] == '\0' ||
+	    strcmp(earlier->command, command) == 0)
+		return PLUME_OK;
+	earlier->keep_all = true;
+	manifest written;
+	if (manifest_read(stage, &written) != 0)
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory");
+	plume_status status = PLUME_OK;
+	for (size_t i = 0; i < written.count && status == PLUME_OK; ++i) {
+		const char *path = written.paths[i];
+		if (path[strlen(path) - 1] != '/' && manifest_has(earlier, path))
+			status = plume_error_set(err, PLUME_ERROR_IO,
+			                         "%s/%s: written by plume %s, which this plume %s would replace; nothing was "
+			                         "changed: write to another folder, or move it away first",
+			                         output->dir, path, earlier->command, command);
+	}
+	manifest_free(&written);
+	return status;
+}
+
 /// The per-entry commit, for an existing DIR whose parent plume may not write (so
-/// nothing can be staged beside it): each staged entry replaces its namesake.
+/// nothing can be staged beside it): each staged entry replaces its namesake (a
+/// folder of the run keeps the user's files in it), then the earlier run's other
+/// entries go.
 static plume_status commit_by_moves(cli_output *output, plume_error *err)
 {
-	DIR *stage = opendir(output->stage);
-	if (stage == NULL) {
-		plume_error_set(err, PLUME_ERROR_IO, "%s: cannot read the staging folder: %s", output->stage, strerror(errno));
+	manifest earlier = {0}, written = {0};
+	int failure = write_manifest(output->stage);
+	if (failure == 0)
+		failure = manifest_read(output->dir, &earlier);
+	if (failure == 0)
+		failure = manifest_read(output->stage, &written);
+	plume_status other = failure == 0 ? other_command(output, &earlier, output->stage, err) : PLUME_OK;
+	if (other != PLUME_OK) {
 		cli_output_abort(output, NULL);
+		manifest_free(&earlier);
+		manifest_free(&written);
+		return other;
+	}
+	DIR *stage = failure == 0 ? opendir(output->stage) : NULL;
+	if (stage == NULL) {
+		plume_error_set(err, PLUME_ERROR_IO, "%s: cannot read the staging folder: %s", output->stage,
+		                strerror(failure != 0 ? failure : errno));
+		cli_output_abort(output, NULL);
+		manifest_free(&earlier);
+		manifest_free(&written);
 		return PLUME_ERROR_IO;
 	}
 	struct dirent *entry;
@@ -624,11 +1012,24 @@ static plume_status commit_by_moves(cli_output *output, plume_error *err)
 		if (strcmp(entry->d_name, ".") == 0 || strcmp(entry->d_name, "..") == 0 ||
 		    strcmp(entry->d_name, STAGING_MARKER) == 0)
 			continue;
-		char from[4608], to[4608], aside[4608];
+		char from[4608], to[4608], aside[4608], failed[4608] = "", relative[4352];
 		snprintf(from, sizeof from, "%s/%s", output->stage, entry->d_name);
 		snprintf(to, sizeof to, "%s/%s", output->dir, entry->d_name);
-		struct stat info;
-		bool replace_folder = stat(to, &info) == 0 && S_ISDIR(info.st_mode);
+		snprintf(relative, sizeof relative, "%s/", entry->d_name);
+		struct stat info, staged;
+		bool replace_folder = lstat(to, &info) == 0 && S_ISDIR(info.st_mode);
+		bool staged_folder = lstat(from, &staged) == 0 && S_ISDIR(staged.st_mode);
+		if (replace_folder != staged_folder && lstat(to, &info) == 0) {
+			status = carry_failed(output, -1, to, err); // a folder for a file, or the reverse: never deleted
+			break;
+		}
+		if (replace_folder) {
+			failure = carry_over(to, from, relative, 1, &earlier, failed, sizeof failed);
+			if (failure != 0) {
+				status = carry_failed(output, failure, failed, err);
+				break;
+			}
+		}
 		if (replace_folder) {
 			snprintf(aside, sizeof aside, "%s/.%s.plume-old", output->dir, entry->d_name);
 			if (rename(to, aside) != 0)
@@ -646,8 +1047,14 @@ static plume_status commit_by_moves(cli_output *output, plume_error *err)
 	if (status != PLUME_OK) {
 		cli_output_abort(output, NULL);
 		end_critical();
+		manifest_free(&earlier);
+		manifest_free(&written);
 		return status;
 	}
+	if (earlier.present && !earlier.keep_all)
+		drop_earlier(output->dir, "", &earlier, &written);
+	manifest_free(&earlier);
+	manifest_free(&written);
 	char marker[4672];
 	snprintf(marker, sizeof marker, "%s/" STAGING_MARKER, output->stage);
 	unlink(marker);
@@ -680,10 +1087,22 @@ static int exchange(const char *stage, const char *dir)
 
 plume_status cli_output_commit(cli_output *output, plume_error *err)
 {
+	struct stat info;
+	bool dir_exists = stat(output->dir, &info) == 0;
+	if (dir_exists && stage_empty(output->stage)) {
+		// Nothing to commit (render --frames moved its frames into DIR itself): DIR stays as it is.
+		drop_stage(output);
+		return PLUME_OK;
+	}
+	int failure = write_manifest(output->stage);
+	if (failure != 0) {
+		plume_error_set(err, PLUME_ERROR_IO, "%s/" RUN_MANIFEST ": cannot write: %s", output->dir, strerror(failure));
+		cli_output_abort(output, NULL);
+		return PLUME_ERROR_IO;
+	}
 	if (output->stage_inside)
 		return commit_by_moves(output, err);
-	struct stat info;
-	if (!output->dir_existed || stat(output->dir, &info) != 0) {
+	if (!output->dir_existed || !dir_exists) {
 		// mkdtemp made the folder 0700; a results folder is ordinary.
 		mode_t mask = umask(0);
 		umask(mask);
@@ -703,29 +1122,26 @@ plume_status cli_output_commit(cli_output *output, plume_error *err)
 		unlink(marker); // killed before this, DIR keeps a marker that the next run drops
 		return PLUME_OK;
 	}
-	char conflict[4608] = "";
-	int failure = carry_over(output->dir, output->stage, 0, conflict, sizeof conflict);
-	if (failure == EPERM || failure == ENOTSUP || failure == EXDEV || failure == EMLINK) {
-		// No hard links here (vfat, some network file systems): keeping the earlier
-		// run intact matters more than this run; say how to get it.
-		plume_error_set(err, PLUME_ERROR_IO,
-		                "%s: this file system cannot hard-link the folder's other files into the new run (%s); "
-		                "write to a new folder instead",
-		                output->dir, strerror(failure));
+	manifest earlier;
+	char failed[4608] = "";
+	failure = manifest_read(output->dir, &earlier);
+	plume_status other = failure == 0 ? other_command(output, &earlier, output->stage, err) : PLUME_OK;
+	if (other != PLUME_OK) {
+		manifest_free(&earlier);
 		cli_output_abort(output, NULL);
-		return PLUME_ERROR_IO;
+		return other;
 	}
-	if (failure == -1) {
-		plume_error_set(err, PLUME_ERROR_IO, "%s: the run writes a file or folder of that name; move it away first",
-		                conflict);
+	if (failure == 0)
+		failure = carry_over(output->dir, output->stage, "", 0, &earlier, failed, sizeof failed);
+	manifest_free(&earlier);
+	if (failure != 0) {
+		carry_failed(output, failure, failed, err);
 		cli_output_abort(output, NULL);
 		return PLUME_ERROR_IO;
 	}
 	begin_critical();
-	if (failure == 0) {
-		chmod(output->stage, info.st_mode & 07777);
-		failure = exchange(output->stage, output->dir);
-	}
+	chmod(output->stage, info.st_mode & 07777);
+	failure = exchange(output->stage, output->dir);
 	if (failure != 0) {
 		plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write: %s", output->dir, strerror(failure));
 		cli_output_abort(output, NULL);

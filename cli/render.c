@@ -37,7 +37,10 @@ void cli_help_render(void)
 	     "        NNNN.obj and NNNN.usda (barb-level curves). A run of many feathers\n"
 	     "        (feathers.json): every feather in its own piece of the shell, the curves in\n"
 	     "        NNNN-NAME.obj and .usda, and the body (frames/body-NNNN.obj) as a surface.\n"
-	     "All files appear together, or none when anything fails.\n"
+	     "        The frames are taken by number (0000 ... 9999, 10000, ...), all of them\n"
+	     "        (a missing one is an error); DIR may not be the simulation folder itself.\n"
+	     "All files appear together, or none when anything fails; a render into a folder\n"
+	     "it wrote before replaces that run (the files you added are kept).\n"
 	     "\n"
 	     "Options:\n"
 	     "  -o, --output DIR       output folder (created if missing)\n"
@@ -55,7 +58,7 @@ void cli_help_render(void)
 	     "      --shell            also draw the simulated shell (simulation folders)\n"
 	     "      --strip N          simulation folders: also DIR/strip.png, N frames evenly spaced\n"
 	     "                         from the first to the last, side by side\n"
-	     "  -f, --format LIST      simulation folders: png,obj,usda (default: all three)\n"
+	     "  -f, --format LIST      simulation folders only: png,obj,usda (default: all three)\n"
 	     "      --frames A:B[:S]   simulation folders: only frames A, A+S, ... up to B (frame\n"
 	     "                         numbers NNNN); the camera still frames the whole sequence,\n"
 	     "                         so ranges rendered apart (plume sweep) match, and the\n"
@@ -69,7 +72,8 @@ typedef struct render_options {
 	bool seed_given, shell;
 	uint64_t seed;
 	unsigned formats;
-	bool frames_given; ///< --frames: render frame numbers first, first + step, ... <= last
+	bool formats_given; ///< -f/--format (simulation folders only)
+	bool frames_given;  ///< --frames: render frame numbers first, first + step, ... <= last
 	int frame_first, frame_last, frame_step;
 	uint64_t max_memory; ///< --max-memory (0: PLUME_DEFAULT_MAX_MEMORY)
 } render_options;
@@ -140,6 +144,7 @@ static int parse_options(int argc, char **argv, render_options *o)
 			break;
 		case 'f': {
 			o->formats = 0;
+			o->formats_given = true;
 			char list[256];
 			snprintf(list, sizeof list, "%s", optarg);
 			for (char *name = strtok(list, ","); name != NULL; name = strtok(NULL, ",")) {
@@ -229,17 +234,66 @@ static plume_status make_def(const render_options *o, const plume_texture *textu
 	return PLUME_OK;
 }
 
-/// A subfolder of the staging folder, registered as one output name.
+/// The checks the ray tracer makes of a camera (src/render/camera.c), made before anything
+/// is written, so that they name the camera file and its key rather than an image.
+static plume_status check_camera(const render_options *o, const plume_camera *camera, plume_error *err)
+{
+	if (o->camera_path == NULL)
+		return PLUME_OK; // the defaults and --size are valid
+	const char *file = o->camera_path;
+	if (!(camera->margin >= 0.0 && camera->margin < 0.45))
+		return plume_error_set(err, PLUME_ERROR_SPEC, "%s: $.camera.margin: is %g, allowed [0, 0.45)", file,
+		                       camera->margin);
+	if (camera->automatic)
+		return PLUME_OK; // the framing chooses eye, target and up, and fits ortho_height
+	plume_vec3 forward = plume_v3_sub(camera->target, camera->eye);
+	if (!(plume_v3_length(plume_v3_cross(forward, camera->up)) >
+	      1e-12 * plume_v3_length(forward) * plume_v3_length(camera->up)))
+		return plume_error_set(err, PLUME_ERROR_SPEC,
+		                       "%s: $.camera.up: (%g, %g, %g) is parallel to the view direction (from eye to "
+		                       "target); give an up across it",
+		                       file, camera->up.x, camera->up.y, camera->up.z);
+	if (camera->orthographic && !(camera->ortho_height > 0.0 && isfinite(camera->ortho_height)))
+		return plume_error_set(err, PLUME_ERROR_SPEC,
+		                       "%s: $.camera.ortho_height: missing; an orthographic camera placed by eye and target "
+		                       "needs its visible height in m (> 0); automatic framing fits it",
+		                       file);
+	return PLUME_OK;
+}
+
+/// Ray-traces one image into image and writes it to path as PNG. A camera that the
+/// scene shows to be wrong (its eye inside the scene, or seeing none of it) is named
+/// by its file and key; other errors name the image.
+static plume_status render_image(const render_options *o, const plume_raytrace_scene *scene,
+                                 const plume_raytrace_def *def, uint8_t *image, const char *path, plume_error *err)
+{
+	plume_status status = plume_raytrace_render(scene, def, image, NULL, err);
+	if (status == PLUME_OK)
+		return plume_write_rgba_png(def->camera.width, def->camera.height, image, path, err);
+	static const char view[] = "raytrace: the camera at";
+	const char *at = strstr(err->message, view);
+	if (status == PLUME_ERROR_SPEC && at != NULL) {
+		char message[sizeof err->message];
+		snprintf(message, sizeof message, "%s", at + strlen("raytrace: "));
+		if (o->camera_path != NULL)
+			plume_error_set(err, status, "%s: $.camera.%s: %s", o->camera_path,
+			                strstr(message, "is inside") != NULL ? "eye" : "target", message);
+		else
+			plume_error_set(err, status, "%s: %s", o->input, message);
+	} else {
+		plume_error_prefix(err, path);
+	}
+	return status;
+}
+
+/// A subfolder of the staging folder, registered as one output name. An earlier run's
+/// folder of that name in DIR is replaced at the commit, the user's files in it kept
+/// (cli/output.c).
 static plume_status stage_folder(cli_output *output, const char *name, char *path, size_t size, plume_error *err)
 {
 	cli_output_path(output, name, path, size);
 	if (mkdir(path, 0777) != 0)
 		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot create: %s", path, strerror(errno));
-	char final[4352];
-	snprintf(final, sizeof final, "%s/%s", output->dir, name);
-	struct stat info;
-	if (output->dir_existed && stat(final, &info) == 0)
-		return plume_error_set(err, PLUME_ERROR_IO, "%s: already exists; choose another output folder", final);
 	return PLUME_OK;
 }
 
@@ -292,9 +346,12 @@ static plume_status render_spec(const render_options *o, const plume_raytrace_de
 	scene.feathers = list;
 	char path[4608];
 	status = check_images(o, def, o->turntable > 0 ? o->turntable : 1, 0, "--turntable", err);
+	uint8_t *image = malloc(4 * (size_t)def->camera.width * (size_t)def->camera.height);
+	if (status == PLUME_OK && image == NULL)
+		status = plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory for the image");
 	if (status == PLUME_OK && o->turntable == 0) {
 		cli_output_path(output, "feather.png", path, sizeof path);
-		status = plume_raytrace_render_png(&scene, def, path, NULL, err);
+		status = render_image(o, &scene, def, image, path, err);
 	} else if (status == PLUME_OK) {
 		char folder[4352];
 		status = stage_folder(output, "turntable", folder, sizeof folder, err);
@@ -308,11 +365,12 @@ static plume_status render_spec(const render_options *o, const plume_raytrace_de
 		for (int i = 0; i < o->turntable && status == PLUME_OK; ++i) {
 			frame.camera.turntable = 2.0 * 3.14159265358979323846 * i / o->turntable;
 			snprintf(path, sizeof path, "%s/%04d.png", folder, i);
-			status = plume_raytrace_render_png(&scene, &frame, path, NULL, err);
+			status = render_image(o, &scene, &frame, image, path, err);
 			if (status == PLUME_OK)
 				cli_progress_update(&progress, i + 1);
 		}
 	}
+	free(image);
 	free(list);
 	plume_feather_destroy(feather);
 	plume_coat_destroy(coat);
@@ -332,7 +390,8 @@ typedef struct sim_input {
 	plume_mesh *rest;
 	plume_mesh *body; ///< body.obj at rest, or NULL
 	int frame_count;
-	char (*frame_names)[64];
+	char (*frame_names)[64];     ///< "NNNN.obj", in the order of their numbers
+	int *frame_numbers;          ///< NNNN of each: 0, 1, ... frame_count - 1 (read_sim checks)
 	plume_vec3 **positions;      ///< per frame, rest vertex order
 	plume_vec3 **body_positions; ///< per frame (frames/body-NNNN.obj), when there is a body
 } sim_input;
@@ -353,6 +412,7 @@ static void sim_input_free(sim_input *in)
 	free(in->positions);
 	free(in->body_positions);
 	free(in->frame_names);
+	free(in->frame_numbers);
 }
 
 static plume_status sim_input_reserve(sim_input *in, int count, plume_error *err)
@@ -427,9 +487,16 @@ static plume_status read_feathers(const char *dir, const char *index_path, sim_i
 	return status;
 }
 
-static int compare_names(const void *a, const void *b) { return strcmp(a, b); }
+/// A frame file's number: the digits of "NNNN.obj" (simulate writes %04d, so 10000.obj follows 9999.obj).
+static int frame_number(const char *name) { return (int)strtol(name, NULL, 10); }
 
-/// Names "NNNN.obj" in dir, sorted.
+static int compare_frames(const void *a, const void *b)
+{
+	int x = frame_number(a), y = frame_number(b);
+	return x < y ? -1 : x > y ? 1 : strcmp(a, b);
+}
+
+/// Names "NNNN.obj" in dir, in the order of their numbers.
 static plume_status list_frames(const char *dir, sim_input *in, plume_error *err)
 {
 	DIR *folder = opendir(dir);
@@ -440,7 +507,8 @@ static plume_status list_frames(const char *dir, sim_input *in, plume_error *err
 	plume_status status = PLUME_OK;
 	while ((entry = readdir(folder)) != NULL) {
 		size_t length = strlen(entry->d_name);
-		if (length < 5 || length >= 64 || strcmp(entry->d_name + length - 4, ".obj") != 0 ||
+		// At most 9 digits: every number fits an int.
+		if (length < 5 || length > 13 || strcmp(entry->d_name + length - 4, ".obj") != 0 ||
 		    strspn(entry->d_name, "0123456789") != length - 4)
 			continue;
 		if (in->frame_count == capacity) {
@@ -457,7 +525,48 @@ static plume_status list_frames(const char *dir, sim_input *in, plume_error *err
 	closedir(folder);
 	if (status == PLUME_OK && in->frame_count == 0)
 		return plume_error_set(err, PLUME_ERROR_IO, "%s: no frames (NNNN.obj) in the frames folder", dir);
-	qsort(in->frame_names, (size_t)in->frame_count, sizeof *in->frame_names, compare_names);
+	if (status != PLUME_OK)
+		return status;
+	qsort(in->frame_names, (size_t)in->frame_count, sizeof *in->frame_names, compare_frames);
+	in->frame_numbers = malloc((size_t)in->frame_count * sizeof *in->frame_numbers);
+	if (in->frame_numbers == NULL)
+		return plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory");
+	for (int i = 0; i < in->frame_count; ++i)
+		in->frame_numbers[i] = frame_number(in->frame_names[i]);
+	return PLUME_OK;
+}
+
+/// The frames of a simulation are numbered 0, 1, ... without a gap, as many as its
+/// summary.json says (when it has one): a missing or extra frame is named.
+static plume_status check_frames(const char *dir, const char *frames_dir, const sim_input *in, plume_error *err)
+{
+	for (int i = 0; i < in->frame_count; ++i) {
+		int n = in->frame_numbers[i];
+		if (n == i)
+			continue;
+		if (n < i) // the same number twice, as in 5.obj and 0005.obj
+			return plume_error_set(err, PLUME_ERROR_SPEC, "%s/%s and %s: both are frame %d", frames_dir,
+			                       in->frame_names[i - 1], in->frame_names[i], n);
+		return plume_error_set(err, PLUME_ERROR_IO,
+		                       "%s/%04d.obj: missing; a simulation's frames run from 0000 without a gap (this folder "
+		                       "has %d frame files, %s to %s)",
+		                       frames_dir, i, in->frame_count, in->frame_names[0],
+		                       in->frame_names[in->frame_count - 1]);
+	}
+	char path[4608];
+	snprintf(path, sizeof path, "%s/summary.json", dir);
+	json_t *summary = json_load_file(path, 0, NULL);
+	json_t *frames = json_object_get(summary, "frames");
+	plume_status status = PLUME_OK;
+	if (json_is_integer(frames) && json_integer_value(frames) > in->frame_count)
+		status = plume_error_set(err, PLUME_ERROR_IO, "%s/%04d.obj: missing; %s says the run wrote %lld frames",
+		                         frames_dir, in->frame_count, path, (long long)json_integer_value(frames));
+	else if (json_is_integer(frames) && json_integer_value(frames) < in->frame_count)
+		status = plume_error_set(err, PLUME_ERROR_SPEC,
+		                         "%s/%s: not of this run; %s says the run wrote %lld frames (0000 to %04lld)",
+		                         frames_dir, in->frame_names[json_integer_value(frames)], path,
+		                         (long long)json_integer_value(frames), (long long)json_integer_value(frames) - 1);
+	json_decref(summary);
 	return status;
 }
 
@@ -531,7 +640,8 @@ static plume_status read_sim(const char *dir, sim_input *in, plume_error *err)
 	snprintf(frames_dir, sizeof frames_dir, "%s/frames", dir);
 	int names = 0;
 	in->frame_count = 0;
-	if ((status = list_frames(frames_dir, in, err)) != PLUME_OK)
+	if ((status = list_frames(frames_dir, in, err)) != PLUME_OK ||
+	    (status = check_frames(dir, frames_dir, in, err)) != PLUME_OK)
 		return status;
 	names = in->frame_count;
 	in->positions = calloc((size_t)names, sizeof *in->positions);
@@ -572,52 +682,88 @@ static void grow_bounds(plume_vec3 *lo, plume_vec3 *hi, plume_vec3 a, plume_vec3
 	hi->x = fmax(hi->x, b.x), hi->y = fmax(hi->y, b.y), hi->z = fmax(hi->z, b.z);
 }
 
-/// Which strip slot frame i fills: frames round(k (count - 1) / (slots - 1)) for k = 0 .. slots - 1; -1 for none.
-static int strip_slot(int slots, int count, int i)
+/// Which strip slot frame number n fills, of frames first .. last: the frames
+/// first + round(k (last - first) / (slots - 1)) for k = 0 .. slots - 1; -1 for none.
+static int strip_slot(int slots, int first, int last, int n)
 {
 	if (slots <= 0)
 		return -1;
 	if (slots == 1)
-		return i == count - 1 ? 0 : -1;
+		return n == last ? 0 : -1;
 	for (int k = 0; k < slots; ++k)
-		if ((int)((double)k * (count - 1) / (slots - 1) + 0.5) == i)
+		if (first + (int)((double)k * (last - first) / (slots - 1) + 0.5) == n)
 			return k;
 	return -1;
 }
 
-/// Whether --frames selects the frame file name ("0042.obj").
-static bool frame_selected(const render_options *o, const char *name)
+/// Whether --frames selects frame number n.
+static bool frame_selected(const render_options *o, int n)
 {
 	if (!o->frames_given)
 		return true;
-	long number = strtol(name, NULL, 10);
-	return number >= o->frame_first && number <= o->frame_last && (number - o->frame_first) % o->frame_step == 0;
+	return n >= o->frame_first && n <= o->frame_last && (n - o->frame_first) % o->frame_step == 0;
 }
 
-/// --frames into a DIR/frames that exists (another range's): the staged frames join it
-/// file by file (each rename atomic), and the staged folder goes.
+/// --frames, once every selected frame is rendered into the staging folder: DIR and
+/// DIR/frames are made if missing (ranges rendered by other processes may share them),
+/// the staged frames join DIR/frames file by file (each rename atomic) and DIR's run
+/// manifest, and the staged folder goes. Nothing is made outside the staging folder
+/// before this, so bad input leaves no folder behind.
 static plume_status merge_frames(cli_output *output, const char *staged, plume_error *err)
 {
 	char final[4352];
 	snprintf(final, sizeof final, "%s/frames", output->dir);
+	bool made_dir = mkdir(output->dir, 0777) == 0;
+	if (!made_dir && errno != EEXIST)
+		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot create: %s", output->dir, strerror(errno));
 	struct stat info;
-	if (stat(final, &info) != 0 || !S_ISDIR(info.st_mode))
-		return PLUME_OK; // the commit moves the whole folder in
+	if (mkdir(final, 0777) != 0 && (errno != EEXIST || stat(final, &info) != 0 || !S_ISDIR(info.st_mode))) {
+		plume_error_set(err, PLUME_ERROR_IO, "%s: cannot create the frames folder: %s", final,
+		                errno == EEXIST ? "a file has that name" : strerror(errno));
+		if (made_dir)
+			rmdir(output->dir);
+		return PLUME_ERROR_IO;
+	}
 	DIR *folder = opendir(staged);
 	if (folder == NULL)
 		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot read: %s", staged, strerror(errno));
 	struct dirent *entry;
 	plume_status status = PLUME_OK;
+	char(*names)[256] = NULL;
+	const char **list = NULL;
+	int count = 0, capacity = 0;
 	while (status == PLUME_OK && (entry = readdir(folder)) != NULL) {
 		if (entry->d_name[0] == '.')
 			continue;
 		char from[4608], to[4608];
 		snprintf(from, sizeof from, "%s/%s", staged, entry->d_name);
 		snprintf(to, sizeof to, "%s/%s", final, entry->d_name);
+		if (count == capacity) {
+			capacity = capacity > 0 ? 2 * capacity : 64;
+			void *grown = realloc(names, (size_t)capacity * sizeof *names);
+			if (grown == NULL) {
+				status = plume_error_set(err, PLUME_ERROR_MEMORY, "out of memory");
+				break;
+			}
+			names = grown;
+		}
 		if (rename(from, to) != 0)
 			status = plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write: %s", to, strerror(errno));
+		else
+			snprintf(names[count++], sizeof names[0], "%s", entry->d_name);
 	}
 	closedir(folder);
+	list = count > 0 ? malloc((size_t)count * sizeof *list) : NULL;
+	for (int i = 0; i < count && list != NULL; ++i)
+		list[i] = names[i];
+	plume_error note;
+	if (count > 0 && (list == NULL || cli_output_manifest_add(output->dir, "frames", list, count, &note) != PLUME_OK))
+		fprintf(stderr,
+		        "plume: %s: the frames are written, but the folder's run manifest could not list them: a "
+		        "later run into it keeps them as files of yours\n",
+		        output->dir);
+	free(list);
+	free(names);
 	if (status == PLUME_OK && rmdir(staged) != 0)
 		status = plume_error_set(err, PLUME_ERROR_IO, "%s: cannot remove: %s", staged, strerror(errno));
 	return status;
@@ -648,7 +794,7 @@ static plume_status render_sim(const render_options *o, const plume_raytrace_def
 	char folder[4352];
 	int selected = 0;
 	for (int i = 0; i < in.frame_count; ++i)
-		selected += frame_selected(o, in.frame_names[i]);
+		selected += frame_selected(o, in.frame_numbers[i]);
 	if (status == PLUME_OK && selected == 0)
 		status = plume_error_set(
 		    err, PLUME_ERROR_SPEC, "%s: no frame in --frames %d:%d:%d (the frames are %.*s to %.*s)", o->input,
@@ -657,11 +803,7 @@ static plume_status render_sim(const render_options *o, const plume_raytrace_def
 	const int slots = o->strip < in.frame_count ? o->strip : in.frame_count;
 	if (status == PLUME_OK)
 		status = check_images(o, &frame_def, selected + (slots > 0), slots, "the frames, --frames, --strip", err);
-	if (status == PLUME_OK && o->frames_given) {
-		cli_output_path(output, "frames", folder, sizeof folder);
-		if (mkdir(folder, 0777) != 0)
-			status = plume_error_set(err, PLUME_ERROR_IO, "%s: cannot create: %s", folder, strerror(errno));
-	} else if (status == PLUME_OK)
+	if (status == PLUME_OK)
 		status = stage_folder(output, "frames", folder, sizeof folder, err);
 	const int w = frame_def.camera.width, h = frame_def.camera.height;
 	uint8_t *image = malloc(4 * (size_t)w * (size_t)h);
@@ -672,7 +814,7 @@ static plume_status render_sim(const render_options *o, const plume_raytrace_def
 	cli_progress progress;
 	cli_progress_begin(&progress, "render frames", in.frame_count);
 	for (int i = 0; i < in.frame_count && status == PLUME_OK; ++i) {
-		if (!frame_selected(o, in.frame_names[i]))
+		if (!frame_selected(o, in.frame_numbers[i]))
 			continue;
 		plume_raytrace_scene scene;
 		if ((status = cli_carried_pose(&carried, in.positions[i], in.body_positions[i], &scene, err)) != PLUME_OK)
@@ -681,13 +823,9 @@ static plume_status render_sim(const render_options *o, const plume_raytrace_def
 		snprintf(stem, sizeof stem, "%.*s", (int)(strlen(in.frame_names[i]) - 4), in.frame_names[i]);
 		if (status == PLUME_OK && (o->formats & CLI_FORMAT_PNG)) {
 			snprintf(path, sizeof path, "%s/%s.png", folder, stem);
-			status = plume_raytrace_render(&scene, &frame_def, image, NULL, err);
-			if (status == PLUME_OK)
-				status = plume_write_rgba_png(w, h, image, path, err);
-			else
-				plume_error_prefix(err, path);
+			status = render_image(o, &scene, &frame_def, image, path, err);
 		}
-		int slot = strip_slot(slots, in.frame_count, i);
+		int slot = strip_slot(slots, in.frame_numbers[0], in.frame_numbers[in.frame_count - 1], in.frame_numbers[i]);
 		if (status == PLUME_OK && slot >= 0 && strip != NULL) {
 			for (int y = 0; y < h; ++y)
 				memcpy(strip + 4 * ((size_t)y * (size_t)(w * slots) + (size_t)(slot * w)),
@@ -726,45 +864,99 @@ static plume_status render_sim(const render_options *o, const plume_raytrace_def
 	return status;
 }
 
+/// Whether the paths a and b name the same existing file or folder (device and inode, so
+/// that "sim", "./sim/" and a link to it are one).
+static bool same_file(const char *a, const char *b)
+{
+	struct stat x, y;
+	return stat(a, &x) == 0 && stat(b, &y) == 0 && x.st_dev == y.st_dev && x.st_ino == y.st_ino;
+}
+
+/// A spec without "model": a scene (for plume simulate), or a spec that names no generator.
+static plume_status check_spec_kind(const char *path, plume_error *err)
+{
+	json_t *root = json_load_file(path, 0, NULL);
+	plume_status status = PLUME_OK;
+	if (json_is_object(root) && json_object_get(root, "model") == NULL) { // anything else: the spec reader says
+		if (json_object_get(root, "feather") != NULL || json_object_get(root, "feathers") != NULL)
+			status = plume_error_set(err, PLUME_ERROR_SPEC,
+			                         "%s: a scene (docs/scene.md), which plume render does not take: simulate it "
+			                         "(plume simulate %s -o DIR) and render the simulation folder DIR",
+			                         path, path);
+		else
+			status = plume_error_set(err, PLUME_ERROR_SPEC,
+			                         "%s: $.model: missing; plume render takes a feather spec (\"model\": one of "
+			                         "franco-walter, streit-heidrich, zhang-kanai), a coat spec (\"model\": \"coat\") "
+			                         "or a simulation folder (written by plume simulate)",
+			                         path);
+	}
+	json_decref(root);
+	return status;
+}
+
 int cli_render(int argc, char **argv)
 {
 	render_options o = {.formats = CLI_FORMAT_PNG | CLI_FORMAT_OBJ | CLI_FORMAT_USDA};
 	int code = parse_options(argc, argv, &o);
 	if (code != CLI_EXIT_OK)
 		return code < 0 ? CLI_EXIT_OK : code;
+	plume_error err = {0};
 	struct stat info;
 	if (stat(o.input, &info) != 0) {
-		plume_error err;
 		plume_error_set(&err, PLUME_ERROR_IO, "%s: cannot read: %s", o.input, strerror(errno));
 		return cli_fail(&err);
 	}
 	bool sim = S_ISDIR(info.st_mode);
 	if (!sim && o.shell)
 		return cli_usage_error("render", "--shell needs a simulation folder as INPUT");
+	if (!sim && o.formats_given)
+		return cli_usage_error("render", "--format needs a simulation folder as INPUT (a spec renders feather.png, "
+		                                 "or turntable/NNNN.png)");
 	if (sim && o.turntable > 0)
 		return cli_usage_error("render", "--turntable needs a feather spec as INPUT");
 	if (o.strip > 0 && (!sim || !(o.formats & CLI_FORMAT_PNG)))
 		return cli_usage_error("render", "--strip needs a simulation folder as INPUT and png among the formats");
 	if (o.frames_given && (!sim || o.strip > 0))
 		return cli_usage_error("render", "--frames needs a simulation folder as INPUT, and no --strip");
-	// Ranges rendered at once by several processes share DIR: create it first, so that
-	// each stages inside it and none finds it appearing under its feet.
-	if (o.frames_given) {
-		char frames[4352];
-		snprintf(frames, sizeof frames, "%s/frames", o.output_dir);
-		if ((mkdir(o.output_dir, 0777) != 0 && errno != EEXIST) || (mkdir(frames, 0777) != 0 && errno != EEXIST)) {
-			plume_error err;
-			plume_error_set(&err, PLUME_ERROR_IO, "%s: cannot create: %s", frames, strerror(errno));
-			return cli_fail(&err);
-		}
+	// The rendered frames/NNNN.obj would replace the simulation's own shell frames.
+	char input_frames[4352], output_frames[4352];
+	snprintf(input_frames, sizeof input_frames, "%s/frames", o.input);
+	snprintf(output_frames, sizeof output_frames, "%s/frames", o.output_dir);
+	if (sim && (same_file(o.input, o.output_dir) || same_file(input_frames, output_frames)))
+		return cli_usage_error("render",
+		                       "-o %s is the simulation folder %s itself: the rendered frames/NNNN.obj would replace "
+		                       "its shell frames; choose another output folder (such as %s/rt)",
+		                       o.output_dir, o.input, o.input);
+	// Another simulation's folder: the same (a render's own output has no mesh.obj).
+	char output_mesh[4352], output_frame[4352];
+	snprintf(output_mesh, sizeof output_mesh, "%s/mesh.obj", o.output_dir);
+	snprintf(output_frame, sizeof output_frame, "%s/frames/0000.obj", o.output_dir);
+	if (sim && access(output_mesh, F_OK) == 0 && access(output_frame, F_OK) == 0)
+		return cli_usage_error("render",
+		                       "-o %s holds a simulation (mesh.obj, frames/0000.obj ...): the rendered "
+		                       "frames/NNNN.obj would replace its shell frames; choose another output folder",
+		                       o.output_dir);
+	if (o.camera_path != NULL && stat(o.camera_path, &info) == 0 && S_ISDIR(info.st_mode)) {
+		plume_error_set(&err, PLUME_ERROR_IO, "%s: is a folder; --camera takes a camera file (docs/rendering.md)",
+		                o.camera_path);
+		return cli_fail(&err);
+	}
+	if (o.texture_path != NULL && stat(o.texture_path, &info) == 0 && S_ISDIR(info.st_mode)) {
+		plume_error_set(&err, PLUME_ERROR_IO, "%s: is a folder; --texture takes an image file", o.texture_path);
+		return cli_fail(&err);
 	}
 
-	plume_error err = {0};
 	plume_texture *texture = NULL;
 	if (o.texture_path != NULL && plume_texture_load(o.texture_path, &texture, &err) != PLUME_OK)
 		return cli_fail(&err);
 	plume_raytrace_def def;
 	plume_status status = make_def(&o, texture, &def, &err);
+	if (status == PLUME_OK)
+		status = check_camera(&o, &def.camera, &err);
+	if (status == PLUME_OK && !sim)
+		status = check_spec_kind(o.input, &err);
+	// Nothing is made outside the staging folder until the run has succeeded: --frames
+	// makes DIR/frames (shared with ranges rendered by other processes) only then.
 	cli_output output;
 	if (status == PLUME_OK && (status = cli_output_begin(&output, o.output_dir, &err)) == PLUME_OK) {
 		status = sim ? render_sim(&o, &def, &output, &err) : render_spec(&o, &def, &output, &err);

@@ -31,7 +31,8 @@ void cli_help_simulate(void)
 	     "  DIR/sim.glb           all frames as one animated glTF 2.0 file (morph\n"
 	     "                        targets, animation \"simulation\"; Blender, three.js;\n"
 	     "                        the body too, node \"body\")\n"
-	     "  DIR/sim.usda          the same as USD text: time-sampled points\n"
+	     "  DIR/sim.usda          the same as USD text: time-sampled points (the body as\n"
+	     "                        prim \"body\"; not the carried feathers of --glb-feather)\n"
 	     "  DIR/frames/NNNN.png   a shaded view of each frame, with --png\n"
 	     "  DIR/stats.csv         per step: time, Newton iterations, gradient norm,\n"
 	     "                        energy, largest barb-edge strain, wall seconds, the\n"
@@ -68,7 +69,9 @@ void cli_help_simulate(void)
 	     "                      stress in the barb frame, barb angle, material, membrane,\n"
 	     "                      compression and bending energy densities; per vertex\n"
 	     "                      velocity and handle (docs/formats.md)\n"
-	     "      --max-memory SIZE  refuse a run whose frames would pass SIZE bytes (default 4G)\n"
+	     "      --max-memory SIZE  refuse a run whose frames and sim.glb (with what writing it\n"
+	     "                      holds) would pass SIZE bytes (default 4G); a sim.glb past\n"
+	     "                      4 GiB or 65536 frames is refused too (docs/cli.md)\n"
 	     "  -h, --help          this help\n"
 	     "\n"
 	     "Scenes are described in docs/scene.md; examples/scenes/ has ready ones.");
@@ -710,6 +713,62 @@ static plume_status simulate(const plume_scene *scene, cli_output *output, run_s
 	return status == PLUME_OK ? run_status : status;
 }
 
+/// The most frames sim.glb holds: its sparse weights are indexed in 32 bits, frames^2 - 1 at
+/// most (src/io/gltf_mesh.c, which refuses more at the end; this refuses them before the run).
+#define SIM_GLB_MAX_FRAMES 65536
+
+/// Upper bounds for sim.glb of `frames` frames: the file's bytes, and the memory that writing
+/// it takes, measured on the examples (docs/cli.md, Limits).
+typedef struct glb_estimate {
+	size_t file;   ///< bytes of sim.glb
+	size_t memory; ///< bytes held: the frames kept for it, its buffer as it grows, the JSON
+} glb_estimate;
+
+/// The line vertices of a feather carried into sim.glb (--glb-feather): one per shaft sample,
+/// barb and barbule point, the afterfeather's too.
+static size_t carried_points(const plume_feather *feather)
+{
+	size_t points = 0;
+	for (const plume_feather *f = feather; f != NULL; f = f == feather ? plume_feather_afterfeather(feather) : NULL) {
+		plume_feather_info info = plume_feather_get_info(f);
+		points += (size_t)info.shaft_sample_count + (size_t)info.point_count;
+	}
+	return points;
+}
+
+static glb_estimate estimate_glb(const plume_scene *scene, bool glb_feather, size_t frames)
+{
+	// A shell of v vertices and f triangles: base positions and texture coordinates (20 B
+	// a vertex) and indices (12 B a triangle) once; per frame a morph target (12 B a
+	// vertex), a key time (4 B), a sparse weight (8 B) and at most 400 B of JSON.
+	size_t v = (size_t)scene->mesh->vertex_count, f = (size_t)scene->mesh->face_count;
+	size_t vb = scene->body != NULL ? (size_t)plume_body_vertex_count(scene->body) : 0;
+	size_t fb = scene->body != NULL ? (size_t)plume_body_triangle_count(scene->body) : 0;
+	size_t nodes = 1 + (scene->body != NULL ? 1 : 0);
+	size_t file = 65536 + 20 * (v + vb) + 12 * (f + fb) + frames * (12 * (v + vb) + 12);
+	// Kept while the run goes: every frame of the shell and the body, 12 B a vertex.
+	size_t memory = frames * 12 * (v + vb);
+	size_t points = 0;
+	if (glb_feather) {
+		// A carried feather: per line vertex position, texture coordinates, colour and at
+		// most two indices (44 B) once, and a morph target (12 B) per frame.
+		for (int i = 0; i < scene->feather_count; ++i)
+			if (scene->feathers[i].feather != NULL) {
+				points += carried_points(scene->feathers[i].feather);
+				++nodes;
+			}
+		file += 44 * points + frames * 12 * points;
+		// Writing them: the shell's frames in double (24 B a vertex), and one frame's
+		// feather carried and turned into lines twice over (at most 800 B a point).
+		memory += frames * 24 * v + 800 * points;
+	}
+	file += frames * 400 * nodes;
+	// The buffer doubles as it grows, copying: up to twice the file at once; the JSON
+	// objects take at most 4 KB a frame and node (2 KB measured).
+	memory += 2 * file + frames * 4096 * nodes;
+	return (glb_estimate){.file = file, .memory = memory};
+}
+
 int cli_simulate(int argc, char **argv)
 {
 	static const struct option options[] = {
@@ -828,18 +887,36 @@ int cli_simulate(int argc, char **argv)
 		scene->frame_every = frames_every;
 	run.scene = scene;
 	run.total_steps = (int)ceil(scene->duration / scene->sim.time_step - 1e-9);
-	// The frames' bytes before the run: an OBJ line is at most about 80 bytes
-	// (three %.17g coordinates), a PNG at most its raw pixels.
-	double frame_count = (double)run.total_steps / scene->frame_every + 2.0;
-	double body_elements =
-	    scene->body != NULL ? plume_body_vertex_count(scene->body) + plume_body_triangle_count(scene->body) : 0;
-	double frame_bytes = 80.0 * (scene->mesh->vertex_count + scene->mesh->face_count + body_elements) +
-	                     ((run.png ? 1 : 0) + (run.render ? 1 : 0)) * 4.0 * run.view.width * run.view.height;
-	if (frame_count * frame_bytes > (double)max_bytes) {
+	// Before the run: the frames' bytes (an OBJ line is at most about 80 bytes, three
+	// %.17g coordinates; a PNG at most its raw pixels) and what sim.glb holds in memory
+	// (glb_estimate). size_t products: nothing here wraps.
+	// Frame 0, every frame_every-th step, and the last step always (on_step).
+	size_t every = (size_t)scene->frame_every, steps = (size_t)run.total_steps;
+	size_t frame_count = 1 + steps / every + (steps % every != 0 ? 1 : 0);
+	size_t body_vertices = scene->body != NULL ? (size_t)plume_body_vertex_count(scene->body) : 0;
+	size_t body_faces = scene->body != NULL ? (size_t)plume_body_triangle_count(scene->body) : 0;
+	size_t frame_bytes =
+	    80 * ((size_t)scene->mesh->vertex_count + (size_t)scene->mesh->face_count + body_vertices + body_faces) +
+	    (size_t)((run.png ? 1 : 0) + (run.render ? 1 : 0)) * 4 * (size_t)run.view.width * (size_t)run.view.height;
+	glb_estimate glb = estimate_glb(scene, run.glb_feather, frame_count);
+	size_t total = frame_count * frame_bytes + glb.memory;
+	if (total > max_bytes) {
 		fprintf(stderr,
-		        "plume: %s: $.duration: %.0f frames of up to %.3g MB each would write %.3g GB; the limit is %.3g GB "
-		        "(raise it with --max-memory, or raise $.frame_every or $.time_step)\n",
-		        argv[optind], frame_count, frame_bytes / 1e6, frame_count * frame_bytes / 1e9, (double)max_bytes / 1e9);
+		        "plume: %s: $.duration: %zu frames of up to %.3g MB each would write %.3g GB, and sim.glb%s would hold "
+		        "%.3g GB in memory: %.3g GB; the limit is %.3g GB (raise it with --max-memory, or raise $.frame_every "
+		        "or $.time_step%s)\n",
+		        argv[optind], frame_count, (double)frame_bytes / 1e6, (double)(frame_count * frame_bytes) / 1e9,
+		        run.glb_feather ? " with the carried feathers (--glb-feather)" : "", (double)glb.memory / 1e9,
+		        (double)total / 1e9, (double)max_bytes / 1e9, run.glb_feather ? ", or leave out --glb-feather" : "");
+		plume_scene_destroy(scene);
+		return CLI_EXIT_LIMIT;
+	}
+	if (frame_count > SIM_GLB_MAX_FRAMES || glb.file > UINT32_MAX) {
+		fprintf(stderr,
+		        "plume: %s: $.duration: %zu frames%s make a sim.glb of about %.3g GB; a GLB file holds at most 4 GiB "
+		        "and %d frames (one morph target each) (raise $.frame_every or $.time_step, or shorten the run%s)\n",
+		        argv[optind], frame_count, run.glb_feather ? " with --glb-feather" : "", (double)glb.file / 1e9,
+		        SIM_GLB_MAX_FRAMES, run.glb_feather ? ", or leave out --glb-feather" : "");
 		plume_scene_destroy(scene);
 		return CLI_EXIT_LIMIT;
 	}

@@ -77,6 +77,38 @@ static int compare_files(const void *a, const void *b)
 	return strcmp(((const view_file *)a)->name, ((const view_file *)b)->name);
 }
 
+/// A .glb file starts with the GLB header (glTF 2.0, 4.4.2): the magic "glTF", version 2
+/// and the file's length, little-endian; anything else (a text file named .glb, a file cut
+/// short) is refused before the page is written, rather than failing in the browser.
+static plume_status check_glb_header(const char *path, long long size, plume_error *err)
+{
+	unsigned char header[12];
+	FILE *file = fopen(path, "rb");
+	if (file == NULL)
+		return plume_error_set(err, PLUME_ERROR_IO, "%s: %s", path, strerror(errno));
+	size_t n = fread(header, 1, sizeof header, file);
+	fclose(file);
+	uint32_t version = 0, length = 0;
+	for (int i = 3; i >= 0; --i) {
+		version = version << 8 | header[4 + i];
+		length = length << 8 | header[8 + i];
+	}
+	if (n < sizeof header || memcmp(header, "glTF", 4) != 0)
+		return plume_error_set(err, PLUME_ERROR_SPEC,
+		                       "%s: not a glTF binary (a .glb file starts with the bytes \"glTF\"); plume view shows "
+		                       ".glb files",
+		                       path);
+	if (version != 2)
+		return plume_error_set(err, PLUME_ERROR_SPEC, "%s: glTF binary version %u; plume view shows version 2", path,
+		                       version);
+	if ((long long)length != size)
+		return plume_error_set(err, PLUME_ERROR_SPEC,
+		                       "%s: its GLB header gives %u bytes, but the file has %lld (cut short, or not one "
+		                       "file)",
+		                       path, length, size);
+	return PLUME_OK;
+}
+
 // The .glb files of INPUT (a file or a folder's own entries), sorted by name.
 static plume_status find_inputs(const char *input, view_file *files, int *count, char *default_dir, size_t size,
                                 plume_error *err)
@@ -93,6 +125,9 @@ static plume_status find_inputs(const char *input, view_file *files, int *count,
 		snprintf(files[0].name, sizeof files[0].name, "%s", slash != NULL ? slash + 1 : input);
 		files[0].size = info.st_size;
 		*count = 1;
+		plume_status status = check_glb_header(input, info.st_size, err);
+		if (status != PLUME_OK)
+			return status;
 		if (slash != NULL)
 			snprintf(default_dir, size, "%.*s/view", (int)(slash - input), input);
 		else
@@ -119,6 +154,11 @@ static plume_status find_inputs(const char *input, view_file *files, int *count,
 		snprintf(f->path, sizeof f->path, "%s", path);
 		snprintf(f->name, sizeof f->name, "%s", entry->d_name);
 		f->size = info.st_size;
+		plume_status status = check_glb_header(path, info.st_size, err);
+		if (status != PLUME_OK) {
+			closedir(dir);
+			return status;
+		}
 	}
 	closedir(dir);
 	if (*count == 0)

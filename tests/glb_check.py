@@ -43,11 +43,24 @@ def load(path):
 
 def accessor(doc, binary, index):
     a = doc["accessors"][index]
-    view = doc["bufferViews"][a["bufferView"]]
     n = a["count"] * COMPONENTS[a["type"]]
-    start = view.get("byteOffset", 0) + a.get("byteOffset", 0)
-    values = struct.unpack_from("<%d%s" % (n, FORMATS[a["componentType"]]), binary, start)
     c = COMPONENTS[a["type"]]
+    if "bufferView" in a:
+        view = doc["bufferViews"][a["bufferView"]]
+        start = view.get("byteOffset", 0) + a.get("byteOffset", 0)
+        values = list(struct.unpack_from("<%d%s" % (n, FORMATS[a["componentType"]]), binary, start))
+    else:  # zeros (glTF 2.0 3.6.2.3), the sparse entries below replacing some
+        values = [0] * n
+    sparse = a.get("sparse")
+    if sparse is not None:
+        k = sparse["count"]
+        iv, vv = doc["bufferViews"][sparse["indices"]["bufferView"]], doc["bufferViews"][sparse["values"]["bufferView"]]
+        indices = struct.unpack_from("<%d%s" % (k, FORMATS[sparse["indices"]["componentType"]]), binary,
+                                     iv.get("byteOffset", 0) + sparse["indices"].get("byteOffset", 0))
+        stored = struct.unpack_from("<%d%s" % (k * c, FORMATS[a["componentType"]]), binary,
+                                    vv.get("byteOffset", 0) + sparse["values"].get("byteOffset", 0))
+        for i, at in enumerate(indices):
+            values[at * c:(at + 1) * c] = stored[i * c:(i + 1) * c]
     return [values[i:i + c] for i in range(0, n, c)] if c > 1 else list(values)
 
 
@@ -86,7 +99,8 @@ def frames(glb_path, frames_dir):
     against FRAMES_DIR/body-NNNN.obj; every animated node is keyed by the one sampler."""
     doc, binary = load(glb_path)
     listing = sorted(os.listdir(frames_dir))
-    files = [f for f in listing if f.endswith(".obj") and f[:-4].isdigit()]
+    # By number: simulate writes %04d, so 10000.obj comes after 9999.obj.
+    files = sorted((f for f in listing if f.endswith(".obj") and f[:-4].isdigit()), key=lambda f: int(f[:-4]))
     sampler = doc["animations"][0]["samplers"][0]
     times = accessor(doc, binary, sampler["input"])
     weights = accessor(doc, binary, sampler["output"])
@@ -103,7 +117,7 @@ def frames(glb_path, frames_dir):
             sys.exit(f"{glb_path}: node {node['name']} has {count} morph targets for {k} keys")
     worst, vertices = check_frames(doc, binary, glb_path, doc["meshes"][0], files, frames_dir)
     body = node_mesh(doc, "body")
-    bodies = [f for f in listing if f.startswith("body-") and f.endswith(".obj")]
+    bodies = ["body-" + f for f in files if "body-" + f in listing]
     if body is not None or bodies:
         if body is None:
             sys.exit(f"{glb_path}: {frames_dir} has body frames, the .glb no node \"body\"")

@@ -4,7 +4,11 @@
 // and 3.11 "Animations"): the mesh's base positions are the first frame, target
 // k holds frame k minus the first frame, and the animation's weights sampler
 // has one key per frame whose weights are 1 for that frame's target and 0 for
-// the others, LINEAR between keys. At a key time the displayed positions are
+// the others, LINEAR between keys. Those frames x frames weights are one sparse
+// accessor (3.6.2.3) with no bufferView: zeros but for the frames ones, stored
+// as their indices and values, 8 bytes a frame, so that the file grows with the
+// frames and not with their square (clients still expand the weights: 4 bytes
+// per frame squared in their memory). At a key time the displayed positions are
 // exactly base + target k, that is frame k (to float rounding: each of base
 // and displacement rounds once, a few 1e-8 m on a 0.2 m feather); between keys
 // they blend two neighbouring frames linearly. Both Blender's importer (shape
@@ -21,6 +25,10 @@
 #include "animation.h"
 #include "glb.h"
 #include "plume/gltf.h"
+
+/// The most frames an animation's sim.glb holds: its sparse weights' largest index,
+/// frames^2 - 1, is 32-bit (plume simulate refuses longer runs before they start).
+#define MAX_FRAMES 65536
 
 /// Area-weighted vertex normals of the triangles (unit; +z where a vertex has no area).
 static void vertex_normals(const plume_mesh *mesh, const plume_vec3 *x, double *normals)
@@ -269,6 +277,54 @@ static plume_vec3 *frame_positions(const plume_mesh_animation *a, const plume_ve
 	return positions;
 }
 
+/// A bufferView of `words` 4-byte values (no target, as sparse storage requires). glb.c makes
+/// views only with an accessor of floats, which only copies the bytes here: that accessor is
+/// made and dropped again, the view kept.
+static int raw_view(plume_glb *glb, const void *data, int words)
+{
+	if (glb->failed)
+		return 0;
+	int accessor = plume_glb_floats_f(glb, (const float *)data, words, 1, GLB_NO_TARGET, false);
+	json_t *object = json_array_get(glb->accessors, (size_t)accessor);
+	json_t *view = json_object_get(object, "bufferView");
+	int index = (int)json_integer_value(view);
+	if (glb->failed || view == NULL || json_array_remove(glb->accessors, (size_t)accessor) != 0) {
+		glb->failed = true;
+		return 0;
+	}
+	return index;
+}
+
+/// The weights output of the animation's sampler: key k weighs target k by 1 and the others
+/// by 0, frames x frames floats stored sparsely (3.6.2.3): no bufferView, so zeros, but for
+/// the frames indices k (frames + 1) whose values are 1. Indices are 32-bit, so frames is at
+/// most MAX_FRAMES. Returns the accessor.
+static int one_hot_weights(plume_glb *glb, int frames)
+{
+	PLUME_ASSERT(frames >= 1 && frames <= MAX_FRAMES);
+	uint32_t *indices = plume_alloc((size_t)frames * sizeof *indices);
+	float *ones = plume_alloc((size_t)frames * sizeof *ones);
+	int accessor = 0;
+	if (indices != NULL && ones != NULL) {
+		for (int k = 0; k < frames; ++k) {
+			indices[k] = (uint32_t)((uint64_t)k * (uint64_t)frames + (uint64_t)k); // < 2^32, asserted above
+			ones[k] = 1.0f;
+		}
+		int index_view = raw_view(glb, indices, frames);
+		int value_view = raw_view(glb, ones, frames);
+		json_t *object =
+		    json_pack("{s:i, s:I, s:s, s:{s:i, s:{s:i, s:i}, s:{s:i}}}", "componentType", GLB_FLOAT, "count",
+		              (json_int_t)frames * (json_int_t)frames, "type", "SCALAR", "sparse", "count", frames, "indices",
+		              "bufferView", index_view, "componentType", GLB_UNSIGNED_INT, "values", "bufferView", value_view);
+		accessor = plume_glb_append(glb, glb->accessors, object);
+	} else {
+		glb->failed = true;
+	}
+	plume_free(indices);
+	plume_free(ones);
+	return accessor;
+}
+
 /// The animation's mesh as node `name`: base positions the first frame, one morph target per frame.
 static int morph_node(plume_glb *glb, const plume_mesh_animation *a, const char *name, bool *ok)
 {
@@ -322,15 +378,18 @@ plume_status plume_mesh_animation_write_glb(const plume_mesh_animation *a, const
 			                       "%s: the body has %d frames, the shell %d (or at other times); they must match",
 			                       path, a->body->frame_count, frames);
 	}
+	if (frames > MAX_FRAMES)
+		return plume_error_set(err, PLUME_ERROR_LIMIT,
+		                       "%s: %d frames; a glTF morph animation of one target per frame holds at most %d (its "
+		                       "sparse weights are indexed in 32 bits)",
+		                       path, frames, MAX_FRAMES);
 	plume_glb glb;
 	plume_glb_init(&glb, "plume " PLUME_VERSION_STRING);
-	float *weights = plume_calloc((size_t)frames * (size_t)frames, sizeof(float));
-	bool ok = weights != NULL;
 	// Every node whose weights the animation keys: the shell, each carried feather (as many
 	// targets, one per frame), the body.
 	int *animated = plume_alloc((size_t)(a->feather_count + 2) * sizeof *animated);
 	int animated_count = 0;
-	ok = ok && animated != NULL;
+	bool ok = animated != NULL;
 	if (ok) {
 		animated[animated_count] = morph_node(&glb, a, "shell", &ok);
 		plume_glb_scene_root(&glb, animated[animated_count++]);
@@ -355,13 +414,11 @@ plume_status plume_mesh_animation_write_glb(const plume_mesh_animation *a, const
 		float *times = plume_alloc((size_t)frames * sizeof(float));
 		ok = ok && times != NULL;
 		if (ok) {
-			for (int k = 0; k < frames; ++k) {
+			for (int k = 0; k < frames; ++k)
 				times[k] = (float)a->times[k];
-				weights[(size_t)k * (size_t)frames + (size_t)k] = 1.0f;
-			}
 			// Sampler input must have min and max (spec 3.11).
 			int input = plume_glb_floats_f(&glb, times, frames, 1, GLB_NO_TARGET, true);
-			int output = plume_glb_floats_f(&glb, weights, frames * frames, 1, GLB_NO_TARGET, false);
+			int output = one_hot_weights(&glb, frames);
 			json_t *channels = json_array();
 			for (int k = 0; k < animated_count; ++k)
 				json_array_append_new(channels, json_pack("{s:i, s:{s:i, s:s}}", "sampler", 0, "target", "node",
@@ -376,7 +433,6 @@ plume_status plume_mesh_animation_write_glb(const plume_mesh_animation *a, const
 		plume_free(times);
 	}
 	plume_free(animated);
-	plume_free(weights);
 	plume_status status =
 	    ok ? plume_glb_write(&glb, path, err) : plume_error_set(err, PLUME_ERROR_MEMORY, "%s: out of memory", path);
 	plume_glb_free(&glb);

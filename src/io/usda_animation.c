@@ -5,7 +5,9 @@
 // are seconds x 24 with timeCodesPerSecond = 24, so a player shows the frames at
 // their simulated times. Points are frame k = first frame + displacement k in
 // float, the same values the glTF file holds, printed with "%.9g" (exact for a
-// float). Written in the "C" numeric locale (export.h).
+// float). A simulation with a body (plume_mesh_animation_set_body) has a second
+// Mesh prim, "body", sampled the same way, as sim.glb has node "body". Written in
+// the "C" numeric locale (export.h).
 #define _POSIX_C_SOURCE 200809L
 #include "export.h"
 
@@ -17,36 +19,18 @@
 /// Time codes per second: USD's default, what Blender and usdview expect.
 #define TIME_CODES_PER_SECOND 24.0
 
-plume_status plume_mesh_animation_write_usda(const plume_mesh_animation *a, const char *path, plume_error *err)
+/// One Mesh prim `name` of the animation a: faces, points and extent sampled per frame,
+/// texture coordinates and per-face colours and materials.
+static void write_mesh_prim(FILE *s, const plume_mesh_animation *a, const char *name)
 {
-	if (a->frame_count == 0)
-		return plume_error_set(err, PLUME_ERROR_SPEC, "%s: an animation needs at least one frame", path);
 	const plume_mesh *mesh = a->mesh;
 	int n = mesh->vertex_count;
-	plume_text_file text;
-	plume_status status = plume_text_open(&text, path, err);
-	if (status != PLUME_OK)
-		return status;
-	FILE *s = text.stream;
-	double t0 = a->times[0] * TIME_CODES_PER_SECOND, t1 = a->times[a->frame_count - 1] * TIME_CODES_PER_SECOND;
 	fprintf(s,
-	        "#usda 1.0\n"
-	        "(\n"
-	        "    defaultPrim = \"shell\"\n"
-	        "    doc = \"\"\"plume %s: a simulated shell, %d frames of %d vertices and %d triangles.\"\"\"\n"
-	        "    metersPerUnit = 1\n"
-	        "    upAxis = \"Y\"\n"
-	        "    startTimeCode = %.9g\n"
-	        "    endTimeCode = %.9g\n"
-	        "    timeCodesPerSecond = %g\n"
-	        "    framesPerSecond = %g\n"
-	        ")\n\n"
-	        "def Mesh \"shell\"\n"
+	        "def Mesh \"%s\"\n"
 	        "{\n"
 	        "    uniform bool doubleSided = 1\n"
 	        "    uniform token subdivisionScheme = \"none\"\n",
-	        PLUME_VERSION_STRING, a->frame_count, n, mesh->face_count, t0, t1, TIME_CODES_PER_SECOND,
-	        TIME_CODES_PER_SECOND);
+	        name);
 	fputs("    int[] faceVertexCounts = [", s);
 	for (int f = 0; f < mesh->face_count; ++f)
 		fputs(f > 0 ? ", 3" : "3", s);
@@ -98,5 +82,40 @@ plume_status plume_mesh_animation_write_usda(const plume_mesh_animation *a, cons
 		fprintf(s, "%s%d", f > 0 ? ", " : "", mesh->material != NULL ? mesh->material[f] : 0);
 	fputs("] (\n        interpolation = \"uniform\"\n    )\n", s);
 	fputs("}\n", s);
+}
+
+plume_status plume_mesh_animation_write_usda(const plume_mesh_animation *a, const char *path, plume_error *err)
+{
+	if (a->frame_count == 0)
+		return plume_error_set(err, PLUME_ERROR_SPEC, "%s: an animation needs at least one frame", path);
+	if (a->body != NULL && a->body->frame_count == 0)
+		return plume_error_set(err, PLUME_ERROR_SPEC, "%s: the body has no frame", path);
+	const plume_mesh *mesh = a->mesh;
+	plume_text_file text;
+	plume_status status = plume_text_open(&text, path, err);
+	if (status != PLUME_OK)
+		return status;
+	FILE *s = text.stream;
+	double t0 = a->times[0] * TIME_CODES_PER_SECOND, t1 = a->times[a->frame_count - 1] * TIME_CODES_PER_SECOND;
+	fprintf(s,
+	        "#usda 1.0\n"
+	        "(\n"
+	        "    defaultPrim = \"shell\"\n"
+	        "    doc = \"\"\"plume %s: a simulated shell, %d frames of %d vertices and %d triangles%s.\"\"\"\n"
+	        "    metersPerUnit = 1\n"
+	        "    upAxis = \"Y\"\n"
+	        "    startTimeCode = %.9g\n"
+	        "    endTimeCode = %.9g\n"
+	        "    timeCodesPerSecond = %g\n"
+	        "    framesPerSecond = %g\n"
+	        ")\n\n",
+	        PLUME_VERSION_STRING, a->frame_count, mesh->vertex_count, mesh->face_count,
+	        a->body != NULL ? ", and the body it hangs on (prim \"body\")" : "", t0, t1, TIME_CODES_PER_SECOND,
+	        TIME_CODES_PER_SECOND);
+	write_mesh_prim(s, a, "shell");
+	if (a->body != NULL) { // the same frames as the shell's, as sim.glb's node "body"
+		fputs("\n", s);
+		write_mesh_prim(s, a->body, "body");
+	}
 	return plume_text_close(&text, PLUME_OK, err);
 }

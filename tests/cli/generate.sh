@@ -23,7 +23,7 @@ for spec in "$presets"/*.json; do
 	check "$name: SVG root" grep -q '<svg' "$out/feather.svg"
 	check "$name: OBJ polylines" grep -q '^l ' "$out/feather.obj"
 	check "$name: USD curves" grep -q 'BasisCurves' "$out/feather.usda"
-	check "$name: only the six files" test "$(ls -A "$out" | wc -l)" -eq 6
+	check "$name: only the six files (and the run manifest)" test "$(ls -A "$out" | grep -Fvx .plume-run | wc -l)" -eq 6
 done
 
 # --- determinism -----------------------------------------------------------

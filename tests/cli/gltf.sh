@@ -72,6 +72,59 @@ status=$?
 check "sim.glb frames = OBJ frames to 1e-6 m ($(cat "$scratch/out.txt"))" test "$status" -eq 0
 check "sim.glb: 4 animation keys" test "$(field "$scratch/swing/sim.glb" animation_keys)" -eq 4
 
+# sim.glb's weights are stored sparsely: the file grows with the frames, not their square
+# (4 keys of 4 weights each here; glb_check.py above expands them and finds key k on target k).
+check "sim.glb: sparse weights" "$py" -c "
+import json, struct, sys
+d = open('$scratch/swing/sim.glb', 'rb').read()
+doc = json.loads(d[20:20 + struct.unpack_from('<I', d, 12)[0]])
+a = doc['accessors'][doc['animations'][0]['samplers'][0]['output']]
+sys.exit(0 if 'bufferView' not in a and a['count'] == 16 and a['sparse']['count'] == 4 else 1)"
+
+# A body: sim.usda holds it as prim "body" beside the shell, sampled at the same frames, as
+# sim.glb has node "body" (whose frames glb_check.py compares with frames/body-NNNN.obj).
+cat >"$scratch/body.json" <<JSON
+{"body": {"mesh": {"shape": "ellipsoid", "center": [0, 0, 0], "radii": [0.05, 0.05, 0.05], "segments": 8},
+          "keyframes": [{"time": 0}, {"time": 0.1, "rotation_axis": [0, 0, 1], "rotation_deg": 30}]},
+ "feathers": [{"feather": "$source_dir/examples/franco-walter/blue.json", "position": [0, 0, 0.05], "follicle": {}}],
+ "mesh": {"edge_length": 0.015}, "duration": 0.033}
+JSON
+"$plume" simulate "$scratch/body.json" -o "$scratch/body" >/dev/null 2>"$scratch/err.txt"
+status=$?
+check "simulate a body: exit 0 ($(cat "$scratch/err.txt"))" test "$status" -eq 0
+"$py" "$checker" frames "$scratch/body/sim.glb" "$scratch/body/frames" >"$scratch/out.txt" 2>&1
+status=$?
+check "body: sim.glb frames = OBJ frames ($(cat "$scratch/out.txt"))" test "$status" -eq 0
+"$py" - "$scratch/body" >"$scratch/out.txt" 2>&1 <<'PY'
+import glob, re, sys
+folder = sys.argv[1]
+text = open(folder + "/sim.usda").read()
+prims = re.findall(r'^def Mesh "(\w+)"', text, re.M)
+assert prims == ["shell", "body"], prims
+body = text[text.index('def Mesh "body"'):]
+samples = re.search(r"point3f\[\] points.timeSamples = \{\n(.*?)\n    \}", body, re.S).group(1).split("\n")
+frames = sorted(glob.glob(folder + "/frames/body-*.obj"))
+assert len(samples) == len(frames), (len(samples), len(frames))
+for sample, name in zip(samples, frames):
+    points = [tuple(map(float, p.split(","))) for p in re.findall(r"\(([^()]*)\)", sample.split(": ", 1)[1])]
+    vertices = [tuple(map(float, l.split()[1:4])) for l in open(name) if l.startswith("v ")]
+    assert len(points) == len(vertices), (name, len(points), len(vertices))
+    assert max(abs(a - b) for p, v in zip(points, vertices) for a, b in zip(p, v)) < 1e-6, name
+print("ok")
+PY
+status=$?
+check "body: sim.usda prim \"body\" = frames/body-NNNN.obj ($(cat "$scratch/out.txt"))" test "$status" -eq 0
+
+# --glb-feather's memory is in the estimate: the blue feather's 11 frames make a 23 MB
+# sim.glb that takes about twice that to write, far past 20M, while the OBJ frames are small.
+expect_no_output "--glb-feather past --max-memory" 5 "sim.glb with the carried feathers (--glb-feather) would hold" \
+	"$scratch/glbmem" "$plume" simulate "$scratch/swing.json" -o "$scratch/glbmem" --glb-feather --max-memory 20M
+"$plume" simulate "$scratch/swing.json" -o "$scratch/glbmem" --max-memory 20M >/dev/null 2>"$scratch/err.txt"
+succeeded "without --glb-feather the same limit passes"
+# More frames than a GLB's sparse weights can index (65536): refused before the run.
+expect_no_output "sim.glb frame limit" 5 "65536 frames" "$scratch/long" \
+	"$plume" simulate "$scratch/swing.json" -o "$scratch/long" --duration 720.9 --frames-every 1 --max-memory 1T
+
 # --fields: a .vtu per frame listed by fields.pvd; the handle's vertices are still.
 "$plume" simulate "$scratch/swing.json" -o "$scratch/fields" --fields >/dev/null 2>"$scratch/err.txt"
 status=$?

@@ -310,4 +310,67 @@ check "a linked DIR: the run is in the folder" test -s "$scratch/real/feather.js
 check "a linked DIR: the user's file kept" test "$(cat "$scratch/real/notes.txt")" = mine
 check "a linked DIR: no staging left" test -z "$(ls -A "$scratch" "$scratch/real" | grep plume-staging)"
 
+# --- the run manifest (DIR/.plume-run): a new run replaces exactly the earlier run's files,
+# whatever their names, and keeps everything else.
+grew=$scratch/grew
+$T "$plume" grow "$examples/streit-heidrich/contour.json" -o "$grew" --frames 6 --format json >/dev/null 2>&1
+echo mine >"$grew/frame-notes.txt"
+$T "$plume" grow "$examples/streit-heidrich/contour.json" -o "$grew" --frames 2 --format json >/dev/null 2>&1
+check "grow again: the new run's two frames and the user's file" \
+	test "$(ls "$grew" | tr '\n' ' ')" = "frame-0000.json frame-0001.json frame-notes.txt "
+gen2=$scratch/gen2
+$T "$plume" generate "$examples/zhang-kanai/figure8-contour.json" -o "$gen2" --format json >/dev/null 2>&1
+check "zhang-kanai writes summary.json" test -s "$gen2/summary.json"
+$T "$plume" generate "$examples/franco-walter/blue.json" -o "$gen2" --format json >/dev/null 2>&1
+check "franco-walter after it: the earlier run's summary.json gone" test "$(ls "$gen2")" = "feather.json"
+# A user's file named like a frame, in a folder the run writes, is the user's: kept.
+echo mine >"$run/frames/0007-notes.txt"
+$T "$plume" simulate "$bad/scene-short.json" -o "$run" >/dev/null 2>&1
+check "a user's file named like a frame kept" test "$(cat "$run/frames/0007-notes.txt")" = mine
+check "the manifest lists the run's files" grep -qx "frames/0001.obj" "$run/.plume-run"
+check "the manifest does not list the user's" bash -c "! grep -q notes '$run/.plume-run'"
+# An earlier run of another command is not this run's to replace: its files stay, and a run
+# that would overwrite one of them fails, naming it.
+mixed=$scratch/mixed
+$T "$plume" generate "$examples/franco-walter/blue.json" -o "$mixed" --format png,json >/dev/null 2>&1
+cp -r "$mixed" "$scratch/mixed-before"
+expect_failure "render over generate's feather.png" 4 "mixed/feather.png: written by plume generate, which this plume render would replace" \
+	$T "$plume" render "$examples/franco-walter/blue.json" -o "$mixed" --size 32x32 --spp 1
+check "that folder as it was" diff -r "$scratch/mixed-before" "$mixed"
+$T "$plume" render "$examples/franco-walter/blue.json" -o "$mixed" --size 32x32 --spp 1 --turntable 2 >/dev/null 2>&1
+check "a turntable beside generate's files" test "$(ls "$mixed" | tr '\n' ' ')" = "feather.json feather.png turntable "
+# A folder written before manifests (none in it): the earlier rule, names starting with a digit
+# in the run's folders are the earlier run's.
+rm "$run/.plume-run"
+$T "$plume" simulate "$bad/scene-short.json" -o "$run" >/dev/null 2>&1
+check "no manifest: frames named with a digit first replaced" test ! -e "$run/frames/0007-notes.txt"
+check "no manifest: other user files kept" test "$(cat "$run/frames/my-notes.txt")" = mine
+
+# As another user (root runs the suite in CI; skipped otherwise): a DIR whose parent plume may
+# not write is committed entry by entry, which keeps the user's files in the run's folders and
+# drops the earlier run's other files; a file of another user that the kernel will not let
+# plume hard-link (fs.protected_hardlinks) is named as such, and nothing changes.
+if [ "$(id -u)" -eq 0 ] && command -v setpriv >/dev/null; then
+	as_nobody() { setpriv --reuid=65534 --regid=65534 --clear-groups "$@"; }
+	locked=$scratch/locked
+	mkdir -p "$locked/out"
+	chmod 755 "$scratch" "$locked"
+	chmod 777 "$locked/out"
+	cp -r "$grew/." "$locked/out/"
+	chown -R 65534:65534 "$locked/out"
+	as_nobody $T "$plume" grow "$examples/streit-heidrich/contour.json" -o "$locked/out" --frames 1 --format json \
+		>/dev/null 2>"$scratch/err.txt"
+	succeeded "commit by moves (parent not writable)"
+	check "commit by moves: the new run and the user's file" \
+		test "$(ls -A "$locked/out" | tr '\n' ' ')" = ".plume-run frame-0000.json frame-notes.txt "
+	shared=$scratch/shared
+	mkdir -p "$shared/out"
+	chmod 777 "$shared" "$shared/out"
+	echo root >"$shared/out/user.txt"
+	expect_failure "another user's file" 4 "out/user.txt: owned by another user (uid 0)" \
+		as_nobody $T "$plume" generate "$examples/franco-walter/blue.json" -o "$shared/out" --format json
+	check "another user's file: the folder as it was" test "$(ls -A "$shared/out")" = "user.txt"
+	check "another user's file: no staging left" test -z "$(ls -A "$shared" | grep plume-staging)"
+fi
+
 finish

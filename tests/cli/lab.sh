@@ -12,7 +12,7 @@ succeeded "traction succeeds"
 for file in traction.csv traction.json traction.png traction.svg; do
 	check "traction: $file written" test -s "$out/$file"
 done
-check "traction: only the four files" test "$(ls -A "$out" | wc -l)" -eq 4
+check "traction: only the four files (and the run manifest)" test "$(ls -A "$out" | grep -Fvx .plume-run | wc -l)" -eq 4
 check "traction: 21 rows and a header" test "$(wc -l <"$out/traction.csv")" -eq 22
 check "traction: CSV header" grep -q '^strain,stress_pa,displacement_m,newton_iterations,converged$' "$out/traction.csv"
 check "traction: PNG signature" bash -c "head -c 8 '$out/traction.png' | od -An -tx1 | grep -q '89 50 4e 47 0d 0a 1a 0a'"
@@ -92,7 +92,7 @@ check "calibrate -o: curves.csv header" grep -q '^longitudinal_strain,longitudin
 for file in curves_longitudinal.png curves_longitudinal.svg curves_tilted.png curves_tilted.svg; do
 	check "calibrate -o: $file written" test -s "$scratch/cal/$file"
 done
-check "calibrate -o: only the six files and calibration.json" test "$(ls -A "$scratch/cal" | wc -l)" -eq 7
+check "calibrate -o: only the six files and calibration.json (and the run manifest)" test "$(ls -A "$scratch/cal" | grep -Fvx .plume-run | wc -l)" -eq 7
 check "calibrate -o: no progress when stderr is a file" test ! -s "$scratch/err.txt"
 # The curves are the ones matched: 11 samples from rest, the slope through the origin of
 # each (eq. C.7 by Simpson's rule on the 10 intervals) is the slope in slopes.csv.

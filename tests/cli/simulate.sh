@@ -61,7 +61,7 @@ check "same scene, same frames" cmp -s "$out/frames/0003.obj" "$scratch/again/fr
 echo keep >"$scratch/again/notes.txt"
 "$plume" simulate "$scratch/swing.json" -o "$scratch/again" >/dev/null 2>&1
 check "rerun keeps the user's files" test -s "$scratch/again/notes.txt"
-check "rerun leaves no staging" test -z "$(ls -A "$scratch/again" | grep plume)"
+check "rerun leaves no staging" test -z "$(ls -A "$scratch/again" | grep plume-staging)"
 
 # Bad scenes: clear error, exit 3, nothing written.
 bad() { # bad NAME FRAGMENT JSON-MEMBERS

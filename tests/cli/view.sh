@@ -13,12 +13,18 @@ echo '<!doctype html><script src="models.js"></script>' >"$viewer/index.html"
 echo '// viewer' >"$viewer/plume-viewer.js"
 echo 'MIT' >"$viewer/LICENSE.three.txt"
 
-# Three files whose lengths cover the three base64 paddings, and a non-.glb.
+# Three files whose lengths cover the three base64 paddings, and a non-.glb. Each starts with
+# a GLB header (the magic "glTF", version 2, its length, little-endian), which plume view checks.
 in=$scratch/results
 mkdir -p "$in"
-head -c 1000 /dev/urandom >"$in/b.glb"
-head -c 1001 /dev/urandom >"$in/a.glb"
-head -c 100002 /dev/urandom >"$in/c.glb"
+glb() { # glb LENGTH FILE: a GLB header, then random bytes
+	printf 'glTF\002\000\000\000' >"$2"
+	printf "$(printf '\\%03o\\%03o\\%03o\\%03o' $(($1 & 255)) $(($1 >> 8 & 255)) $(($1 >> 16 & 255)) $(($1 >> 24)))" >>"$2"
+	head -c $(($1 - 12)) /dev/urandom >>"$2"
+}
+glb 1000 "$in/b.glb"
+glb 1001 "$in/a.glb"
+glb 100002 "$in/c.glb"
 echo 'not a model' >"$in/notes.txt"
 
 # The base64 of the entry named $2 in models.js $1, decoded.
@@ -65,6 +71,18 @@ expect_no_output "not a .glb" 4 "not a .glb file" "$in/view-txt" \
 	"$plume" view "$in/notes.txt" --viewer "$viewer" -o "$in/view-txt"
 expect_no_output "missing input" 4 "$scratch/nothing.glb" "$scratch/view" \
 	"$plume" view "$scratch/nothing.glb" --viewer "$viewer"
+# A file named .glb that is not one: refused, alone or in a folder, nothing written.
+mkdir -p "$scratch/fake"
+echo 'just text' >"$scratch/fake/fake.glb"
+expect_no_output "a text file named .glb" 3 "fake.glb: not a glTF binary" "$scratch/fake/view" \
+	"$plume" view "$scratch/fake/fake.glb" --viewer "$viewer"
+cp "$in/a.glb" "$scratch/fake/a.glb"
+expect_no_output "a folder with a fake .glb" 3 "fake.glb: not a glTF binary" "$scratch/fake/view" \
+	"$plume" view "$scratch/fake" --viewer "$viewer"
+head -c 500 "$in/a.glb" >"$scratch/fake/cut.glb"
+rm "$scratch/fake/fake.glb"
+expect_no_output "a .glb cut short" 3 "cut.glb: its GLB header gives 1001 bytes, but the file has 500" \
+	"$scratch/fake/view" "$plume" view "$scratch/fake/cut.glb" --viewer "$viewer"
 expect_no_output "viewer not built" 4 "no built viewer there" "$scratch/v2" \
 	env PLUME_VIEWER_DIR="$scratch/empty" "$plume" view "$in" -o "$scratch/v2"
 expect_no_output "--serve not a port" 2 "--serve '99999' must be a port number" "$scratch/v3" \
