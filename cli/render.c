@@ -234,33 +234,6 @@ static plume_status make_def(const render_options *o, const plume_texture *textu
 	return PLUME_OK;
 }
 
-/// The checks the ray tracer makes of a camera (src/render/camera.c), made before anything
-/// is written, so that they name the camera file and its key rather than an image.
-static plume_status check_camera(const render_options *o, const plume_camera *camera, plume_error *err)
-{
-	if (o->camera_path == NULL)
-		return PLUME_OK; // the defaults and --size are valid
-	const char *file = o->camera_path;
-	if (!(camera->margin >= 0.0 && camera->margin < 0.45))
-		return plume_error_set(err, PLUME_ERROR_SPEC, "%s: $.camera.margin: is %g, allowed [0, 0.45)", file,
-		                       camera->margin);
-	if (camera->automatic)
-		return PLUME_OK; // the framing chooses eye, target and up, and fits ortho_height
-	plume_vec3 forward = plume_v3_sub(camera->target, camera->eye);
-	if (!(plume_v3_length(plume_v3_cross(forward, camera->up)) >
-	      1e-12 * plume_v3_length(forward) * plume_v3_length(camera->up)))
-		return plume_error_set(err, PLUME_ERROR_SPEC,
-		                       "%s: $.camera.up: (%g, %g, %g) is parallel to the view direction (from eye to "
-		                       "target); give an up across it",
-		                       file, camera->up.x, camera->up.y, camera->up.z);
-	if (camera->orthographic && !(camera->ortho_height > 0.0 && isfinite(camera->ortho_height)))
-		return plume_error_set(err, PLUME_ERROR_SPEC,
-		                       "%s: $.camera.ortho_height: missing; an orthographic camera placed by eye and target "
-		                       "needs its visible height in m (> 0); automatic framing fits it",
-		                       file);
-	return PLUME_OK;
-}
-
 /// Ray-traces one image into image and writes it to path as PNG. A camera that the
 /// scene shows to be wrong (its eye inside the scene, or seeing none of it) is named
 /// by its file and key; other errors name the image.
@@ -951,8 +924,6 @@ int cli_render(int argc, char **argv)
 		return cli_fail(&err);
 	plume_raytrace_def def;
 	plume_status status = make_def(&o, texture, &def, &err);
-	if (status == PLUME_OK)
-		status = check_camera(&o, &def.camera, &err);
 	if (status == PLUME_OK && !sim)
 		status = check_spec_kind(o.input, &err);
 	// Nothing is made outside the staging folder until the run has succeeded: --frames

@@ -556,6 +556,12 @@ static void test_camera_json(void **state)
 	    {"{\"spp\": 0}", "$.spp"},
 	    {"{\"background\": [1, 2, 0]}", "$.background"},
 	    {"{\"camera\": {\"eye\": [0, 0, 1], \"target\": [0, 0, 1]}}", "$.camera.target"},
+	    // What the ray tracer needs of a camera, refused by the reader (naming the file and the key).
+	    {"{\"camera\": {\"margin\": 0.45}}", "$.camera.margin: is 0.45, allowed [0, 0.45)"},
+	    {"{\"camera\": {\"eye\": [0, 0, 1], \"target\": [0, 0, 0], \"up\": [0, 0, 2]}}",
+	     "$.camera.up: (0, 0, 2) is parallel to the view direction"},
+	    {"{\"camera\": {\"eye\": [0, 0, 1], \"target\": [0, 0, 0], \"orthographic\": true}}",
+	     "$.camera.ortho_height: missing"},
 	};
 	for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
 		test_write_file(path, bad[i].text);

@@ -131,13 +131,29 @@ static void read_camera(plume_spec_reader *reader, const json_t *object, plume_c
 		camera->width = (int)size[0];
 		camera->height = (int)size[1];
 	}
-	if (plume_spec_number(reader, object, path, "margin", &camera->margin))
-		check_range(reader, path, "margin", camera->margin, 0.0, 0.45, false);
+	// The framing leaves margin on each side of the image: at 0.45 nothing is left between.
+	if (plume_spec_number(reader, object, path, "margin", &camera->margin) &&
+	    !(camera->margin >= 0.0 && camera->margin < 0.45))
+		plume_spec_fail(reader, "$.camera.margin", "is %g, allowed [0, 0.45)", camera->margin);
 	double turntable = camera->turntable / DEG;
 	if (plume_spec_number(reader, object, path, "turntable_deg", &turntable)) {
 		check_range(reader, path, "turntable_deg", turntable, -360.0, 360.0, false);
 		camera->turntable = turntable * DEG;
 	}
+	if (reader->status != PLUME_OK || camera->automatic)
+		return; // automatic framing chooses eye, target and up, and fits ortho_height
+	// What the ray tracer needs of a camera placed by eye and target (src/render/camera.c),
+	// refused here so that the message names the file and the key.
+	plume_vec3 forward = plume_v3_sub(camera->target, camera->eye);
+	if (!(plume_v3_length(plume_v3_cross(forward, camera->up)) >
+	      1e-12 * plume_v3_length(forward) * plume_v3_length(camera->up)))
+		plume_spec_fail(reader, "$.camera.up",
+		                "(%g, %g, %g) is parallel to the view direction (from eye to target); give an up across it",
+		                camera->up.x, camera->up.y, camera->up.z);
+	else if (camera->orthographic && !(camera->ortho_height > 0.0 && isfinite(camera->ortho_height)))
+		plume_spec_fail(reader, "$.camera.ortho_height",
+		                "missing; an orthographic camera placed by eye and target needs its visible height in m "
+		                "(> 0); automatic framing fits it");
 }
 
 static void read_lights(plume_spec_reader *reader, const json_t *array, plume_raytrace_def *def)
