@@ -46,6 +46,22 @@ static bool parse_stage(const char *text, double *stage)
 	return true;
 }
 
+/// The picture shows the feathers whose follicle faces +z (plume_coat_render2d): says so when none does.
+static void warn_hidden(const plume_coat *coat)
+{
+	int count = plume_coat_feather_count(coat);
+	for (int i = 0; i < count; ++i) {
+		plume_vec3 root, normal;
+		plume_coat_follicle(coat, i, &root, &normal);
+		if (normal.z > -0.05)
+			return;
+	}
+	fprintf(stderr,
+	        "plume: coat: warning: no follicle faces +z (the surface is seen from behind), so the picture shows "
+	        "none of the %d feathers\n",
+	        count);
+}
+
 static plume_status write_coat(cli_output *output, const plume_coat *coat, unsigned formats,
                                const plume_render2d_def *image, plume_error *err)
 {
@@ -151,6 +167,8 @@ int cli_coat(int argc, char **argv)
 	spec_options.progress_user = &progress;
 	plume_status status = plume_coat_spec_generate(argv[optind], &spec_options, &coat, &err);
 	cli_progress_end(&progress);
+	if (status == PLUME_OK && (formats & (CLI_FORMAT_PNG | CLI_FORMAT_SVG | CLI_FORMAT_PDF)) != 0)
+		warn_hidden(coat);
 	if (status == PLUME_OK && (status = cli_output_begin(&output, output_dir, &err)) == PLUME_OK) {
 		status = write_coat(&output, coat, formats, &image, &err);
 		if (status == PLUME_OK)

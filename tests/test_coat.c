@@ -463,6 +463,54 @@ static void test_progress(void **state)
 	plume_coat_destroy(plain);
 }
 
+/// A surface seen from behind: no follicle faces +z, and the picture is the background alone.
+static void test_picture_of_a_surface_seen_from_behind(void **state)
+{
+	(void)state;
+	char obj[512];
+	snprintf(obj, sizeof obj, "%s/flipped.obj", scratch);
+	test_write_file(obj, "v 0 0 0\nv 0.05 0 0\nv 0 0.05 0\nf 1 3 2\n");
+	const char *path =
+	    write_coat("flipped.json", "\"surface\": {\"type\": \"mesh\", \"obj\": \"flipped.obj\"},"
+	                               "\"follicles\": {\"layout\": \"poisson\", \"spacing\": 0.01},"
+	                               "\"key_feathers\": [{\"at\": [0, 0, 0], \"feather\": \"@contour.json\"}]");
+	plume_coat *coat = build(path, 0, false);
+	int count = plume_coat_feather_count(coat);
+	assert_true(count > 1);
+	for (int i = 0; i < count; ++i) {
+		plume_vec3 root, normal;
+		plume_coat_follicle(coat, i, &root, &normal);
+		assert_close(normal.z, -1.0, 1e-12);
+	}
+	plume_render2d_def def = plume_render2d_default_def();
+	def.width = def.height = 64;
+	const plume_image_format formats[3] = {PLUME_IMAGE_PNG, PLUME_IMAGE_SVG, PLUME_IMAGE_PDF};
+	const char *const names[3] = {"behind.png", "behind.svg", "behind.pdf"};
+	for (int k = 0; k < 3; ++k) {
+		char out[512];
+		snprintf(out, sizeof out, "%s/%s", scratch, names[k]);
+		plume_error err = {0};
+		if (plume_coat_render2d(coat, &def, formats[k], out, &err) != PLUME_OK)
+			fail_msg("%s: %s", names[k], err.message);
+		assert_true(test_file_exists(out));
+	}
+	// The PNG is the white background, every pixel.
+	char png[512];
+	snprintf(png, sizeof png, "%s/behind.png", scratch);
+	plume_texture *picture = NULL;
+	plume_error err = {0};
+	assert_int_equal(plume_texture_load(png, &picture, &err), PLUME_OK);
+	for (int k = 0; k < 5; ++k) {
+		plume_color c = plume_texture_sample_vane(picture, PLUME_SIDE_LEFT, 0.1 + 0.2 * k, 0.1 + 0.2 * k);
+		assert_close(c.r + c.g + c.b + c.a, 4.0, 1e-9);
+	}
+	plume_texture_destroy(picture);
+	// Without a view to frame it, no feather is still an error.
+	const plume_feather *none = NULL;
+	assert_int_equal(plume_render2d_feathers(&none, 0, &def, PLUME_IMAGE_PNG, png, &err), PLUME_ERROR_SPEC);
+	plume_coat_destroy(coat);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -476,6 +524,7 @@ int main(void)
 	    cmocka_unit_test(test_exports_and_strip_rendering),
 	    cmocka_unit_test(test_bad_coats),
 	    cmocka_unit_test(test_progress),
+	    cmocka_unit_test(test_picture_of_a_surface_seen_from_behind),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);
 }

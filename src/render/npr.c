@@ -482,7 +482,11 @@ static cairo_status_t paint(cairo_surface_t *surface, const plume_feather *const
                             const plume_render2d_def *def, bool *out_of_memory)
 {
 	cairo_t *cr = cairo_create(surface);
-	renderer r = {.cr = cr, .def = def, .view = fit_view(def, union_info(feathers, count))};
+	// No feather (count 0): the def's view frames the empty picture.
+	plume_feather_info info = {0};
+	if (count > 0)
+		info = union_info(feathers, count);
+	renderer r = {.cr = cr, .def = def, .view = fit_view(def, info)};
 	// SOURCE so that a translucent background replaces the surface's
 	// transparent black instead of blending with it.
 	cairo_set_operator(cr, CAIRO_OPERATOR_SOURCE);
@@ -584,9 +588,13 @@ plume_status plume_render2d_feathers(const plume_feather *const *feathers, int c
 {
 	PLUME_ASSERT_DEF(def);
 	PLUME_ASSERT(count >= 0 && (count == 0 || feathers != NULL));
-	PLUME_ASSERT(feathers != NULL && def != NULL && path != NULL);
-	if (count < 1)
-		return plume_error_set(err, PLUME_ERROR_SPEC, "render2d: no feather to draw");
+	PLUME_ASSERT(def != NULL && path != NULL);
+	// No feather at all is a picture of the background, when the def says what it frames.
+	bool framed = def->view_max.x > def->view_min.x && def->view_max.y > def->view_min.y;
+	if (count < 1 && !framed)
+		return plume_error_set(err, PLUME_ERROR_SPEC,
+		                       "render2d: no feather to draw (and no view_min, view_max to frame "
+		                       "an empty picture)");
 	plume_status status = validate_def(def, err);
 	if (status != PLUME_OK)
 		return status;
@@ -595,7 +603,9 @@ plume_status plume_render2d_feathers(const plume_feather *const *feathers, int c
 	for (int i = 0; i < count; ++i)
 		if (plume_feather_get_info(feathers[i]).shaft_sample_count <= 0)
 			return plume_error_set(err, PLUME_ERROR_SPEC, "render2d: the feather is empty (it has no shaft)");
-	plume_feather_info info = union_info(feathers, count);
+	plume_feather_info info = {0};
+	if (count > 0)
+		info = union_info(feathers, count);
 	if (!(isfinite(info.bounds_min.x) && isfinite(info.bounds_min.y) && isfinite(info.bounds_max.x) &&
 	      isfinite(info.bounds_max.y)))
 		return plume_error_set(err, PLUME_ERROR_NUMERIC, "render2d: the feather's bounds are not finite");
