@@ -27,7 +27,8 @@ void cli_help_coat(void)
 	     "      --style STYLE      lines (default) or strips: barbs as alpha-faded triangle\n"
 	     "                         strips (Streit & Heidrich 4.3.1)\n"
 	     "      --stage G          grow every feather to stage G in [0, 1] (default 1)\n"
-	     "      --max-memory SIZE  refuse a coat estimated to need more (default 4G; docs/cli.md)\n"
+	     "      --max-memory SIZE  refuse a coat, or its outputs, estimated to need more\n"
+	     "                         (default 4G; docs/cli.md)\n"
 	     "  -h, --help             this help\n"
 	     "\n"
 	     "Coat specs are described in docs/coats.md; examples/coats/ has ready ones.");
@@ -44,6 +45,150 @@ static bool parse_stage(const char *text, double *stage)
 	}
 	*stage = value;
 	return true;
+}
+
+// ---------------------------------------------------------------------------
+// What the outputs add (docs/cli.md, Limits): checked once the coat is built, before anything is
+// written. Per picture format, Cairo's vector surfaces hold every drawing operation until the page
+// ends (a fill for each curve, its path, and the document's text); the GLB holds its JSON document
+// (an object per view, accessor, primitive and node) and two feathers' ribbons at a time. Each
+// format's memory is freed before the next is written: the largest counts. The constants are peak RSS
+// measured on coats of 64 to 2929 feathers at 4 and 12 points a barb, with half again as margin.
+
+/// SVG and PDF (lines): bytes per fill (one per curve) and per curve point.
+#define COAT_VECTOR_FILL_BYTES 1536.0
+#define COAT_SVG_POINT_BYTES 96.0
+#define COAT_PDF_POINT_BYTES 32.0
+/// SVG and PDF with --style strips: a mesh pattern of two patches per barb segment, per barb point.
+#define COAT_SVG_STRIP_POINT_BYTES 2048.0
+#define COAT_PDF_STRIP_POINT_BYTES 5120.0
+/// GLB: the JSON document per feather (its node, and a mesh of up to four primitives, each with five
+/// accessors and views), and per curve point of the two feathers held (two ribbon vertices of 14 floats
+/// and six indices).
+#define COAT_GLB_FEATHER_BYTES 4096.0
+#define COAT_GLB_PRIMITIVE_BYTES 14336.0
+#define COAT_GLB_POINT_BYTES 136.0
+/// What a format holds besides: a text format its stream's buffer and scratch, a picture Cairo's surface,
+/// the GLB its two blocks of 256 KiB.
+#define COAT_TEXT_BYTES (64.0 * 1024)
+#define COAT_PICTURE_BYTES (256.0 * 1024)
+#define COAT_GLB_BYTES (1024.0 * 1024)
+
+/// The coat's curves: counts over every feather and afterfeather.
+typedef struct coat_counts {
+	double points;      ///< shaft samples, barb and barbule points
+	double barb_points; ///< barb points alone
+	double curves;      ///< shafts, barbs and barbules: one fill each
+	double barbs;
+	double primitives;  ///< non-empty glTF parts (shaft, vanes, barbules) over the feathers
+	double most_points; ///< the most points of one feather, afterfeather in
+	int feathers;
+} coat_counts;
+
+static coat_counts count_curves(const plume_coat *coat)
+{
+	coat_counts c = {0};
+	c.feathers = plume_coat_feather_count(coat);
+	for (int i = 0; i < c.feathers; ++i) {
+		double points = 0.0;
+		bool parts[4] = {false, false, false, false};
+		for (const plume_feather *f = plume_coat_feather(coat, i); f != NULL; f = plume_feather_afterfeather(f)) {
+			plume_feather_info info = plume_feather_get_info(f);
+			points += info.shaft_sample_count + info.point_count;
+			c.curves += 1.0 + info.barb_count + info.barbule_count;
+			c.barbs += info.barb_count;
+			for (int b = 0; b < info.barb_count; ++b) {
+				plume_barb barb = plume_feather_barb(f, b);
+				c.barb_points += barb.curve.count;
+				parts[barb.side == PLUME_SIDE_LEFT ? 1 : 2] = true;
+			}
+			parts[0] = parts[0] || info.shaft_sample_count > 0;
+			parts[3] = parts[3] || info.barbule_count > 0;
+		}
+		for (int k = 0; k < 4; ++k)
+			c.primitives += parts[k] ? 1.0 : 0.0;
+		c.points += points;
+		c.most_points = points > c.most_points ? points : c.most_points;
+	}
+	return c;
+}
+
+/// Bytes writing formats adds to the coat, at most: the largest format's.
+static double output_bytes(const plume_coat *coat, unsigned formats, const plume_render2d_def *image)
+{
+	coat_counts c = count_curves(coat);
+	bool strips = image->style == PLUME_STYLE_STRIPS;
+	double fills = strips ? c.curves - c.barbs : c.curves; // strips draw barbs as mesh patterns, not fills
+	double bytes[5] = {0};
+	if ((formats & (CLI_FORMAT_OBJ | CLI_FORMAT_USDA)) != 0)
+		bytes[0] = COAT_TEXT_BYTES;
+	if ((formats & CLI_FORMAT_PNG) != 0)
+		bytes[1] = COAT_PICTURE_BYTES + 4.0 * image->width * image->height;
+	if ((formats & CLI_FORMAT_SVG) != 0)
+		bytes[2] = COAT_PICTURE_BYTES + COAT_VECTOR_FILL_BYTES * fills + COAT_SVG_POINT_BYTES * c.points +
+		           (strips ? COAT_SVG_STRIP_POINT_BYTES * c.barb_points : 0.0);
+	if ((formats & CLI_FORMAT_PDF) != 0)
+		bytes[3] = COAT_PICTURE_BYTES + COAT_VECTOR_FILL_BYTES * fills + COAT_PDF_POINT_BYTES * c.points +
+		           (strips ? COAT_PDF_STRIP_POINT_BYTES * c.barb_points : 0.0);
+	if ((formats & CLI_FORMAT_GLB) != 0) { // and the surface's mesh, in doubles and floats
+		const plume_mesh *surface = plume_coat_surface(coat);
+		bytes[4] = COAT_GLB_BYTES + COAT_GLB_FEATHER_BYTES * c.feathers + COAT_GLB_PRIMITIVE_BYTES * c.primitives +
+		           2.0 * COAT_GLB_POINT_BYTES * c.most_points + 160.0 * surface->vertex_count +
+		           48.0 * surface->face_count;
+	}
+	double most = 0.0;
+	for (int k = 0; k < 5; ++k)
+		most = bytes[k] > most ? bytes[k] : most;
+	return most;
+}
+
+/// The formats asked for, by name ("png, svg").
+static void format_names(unsigned formats, char *text, size_t size)
+{
+	static const struct {
+		unsigned bit;
+		const char *name;
+	} names[] = {{CLI_FORMAT_PNG, "png"}, {CLI_FORMAT_SVG, "svg"},   {CLI_FORMAT_PDF, "pdf"},
+	             {CLI_FORMAT_OBJ, "obj"}, {CLI_FORMAT_USDA, "usda"}, {CLI_FORMAT_GLB, "glb"}};
+	text[0] = '\0';
+	for (size_t i = 0; i < sizeof names / sizeof names[0]; ++i)
+		if ((formats & names[i].bit) != 0)
+			snprintf(text + strlen(text), size - strlen(text), "%s%s", text[0] != '\0' ? ", " : "", names[i].name);
+}
+
+/// PLUME_ERROR_LIMIT when the coat (what the library holds now) and its largest output pass the limit.
+static plume_status check_outputs(const char *spec, const plume_coat *coat, unsigned formats,
+                                  const plume_render2d_def *image, uint64_t max_memory, plume_error *err)
+{
+	double limit = (double)(max_memory > 0 ? max_memory : PLUME_DEFAULT_MAX_MEMORY);
+	double held = (double)plume_bytes_in_use(), outputs = output_bytes(coat, formats, image);
+	if (held + outputs <= limit)
+		return PLUME_OK;
+	char names[64];
+	format_names(formats, names, sizeof names);
+	return plume_error_set(err, PLUME_ERROR_LIMIT,
+	                       "%s: writing %s (--format, --size %dx%d%s) takes up to %.3g GB besides the coat's %.3g GB: "
+	                       "%.3g GB in all; the limit is %.3g GB (raise it with --max-memory, or write fewer or "
+	                       "smaller formats)",
+	                       spec, names, image->width, image->height,
+	                       image->style == PLUME_STYLE_STRIPS ? ", --style strips" : "", outputs / 1e9, held / 1e9,
+	                       (held + outputs) / 1e9, limit / 1e9);
+}
+
+/// The picture shows the feathers whose follicle faces +z (plume_coat_render2d): says so when none does.
+static void warn_hidden(const plume_coat *coat)
+{
+	int count = plume_coat_feather_count(coat);
+	for (int i = 0; i < count; ++i) {
+		plume_vec3 root, normal;
+		plume_coat_follicle(coat, i, &root, &normal);
+		if (normal.z > -0.05)
+			return;
+	}
+	fprintf(stderr,
+	        "plume: coat: warning: no follicle faces +z (the surface is seen from behind), so the picture shows "
+	        "none of the %d feathers\n",
+	        count);
 }
 
 static plume_status write_coat(cli_output *output, const plume_coat *coat, unsigned formats,
@@ -151,6 +296,10 @@ int cli_coat(int argc, char **argv)
 	spec_options.progress_user = &progress;
 	plume_status status = plume_coat_spec_generate(argv[optind], &spec_options, &coat, &err);
 	cli_progress_end(&progress);
+	if (status == PLUME_OK)
+		status = check_outputs(argv[optind], coat, formats, &image, spec_options.max_memory, &err);
+	if (status == PLUME_OK && (formats & (CLI_FORMAT_PNG | CLI_FORMAT_SVG | CLI_FORMAT_PDF)) != 0)
+		warn_hidden(coat);
 	if (status == PLUME_OK && (status = cli_output_begin(&output, output_dir, &err)) == PLUME_OK) {
 		status = write_coat(&output, coat, formats, &image, &err);
 		if (status == PLUME_OK)

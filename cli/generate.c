@@ -26,16 +26,87 @@ static plume_status write_summary(cli_output *output, const plume_feather *feath
 	return PLUME_OK;
 }
 
-/// cli_parse_formats skips one comma after each name, so "png," passed where "png,,obj" did not:
-/// an empty item is refused wherever it is.
-static bool formats_without_empty_items(const char *command, const char *list)
+// ---------------------------------------------------------------------------
+// What the outputs add (docs/cli.md, Limits): checked once the feather is built, before anything is
+// written. Cairo's SVG and PDF surfaces hold every drawing operation until the page ends (a fill for
+// each curve, or with --texture for each run of one colour along a barb, and the document's text);
+// the others stream, but for their pixels (PNG), a block at a time (GLB) or the texture's PNG
+// encoding (GLB with --texture). Each format's memory is freed before the next is written: the
+// largest counts. The constants are peak RSS measured on Franco–Walter, Streit–Heidrich and
+// Zhang–Kanai feathers of 2 to 1000 points a barb, with half again as margin.
+
+/// SVG and PDF: bytes per fill and per curve point.
+#define GENERATE_VECTOR_FILL_BYTES 1536.0
+#define GENERATE_SVG_POINT_BYTES 96.0
+#define GENERATE_PDF_POINT_BYTES 32.0
+/// What a format holds besides: a text format its stream's buffer and scratch, a picture Cairo's
+/// surface, the GLB its two blocks of 256 KiB and its JSON document.
+#define GENERATE_TEXT_BYTES (64.0 * 1024)
+#define GENERATE_PICTURE_BYTES (256.0 * 1024)
+#define GENERATE_GLB_BYTES (1024.0 * 1024)
+
+/// Bytes writing formats adds to the feather, at most: the largest format's.
+static double output_bytes(const plume_feather *feather, unsigned formats, const cli_image_options *images)
 {
-	size_t length = strlen(list);
-	if (length > 0 && (list[0] == ',' || list[length - 1] == ',' || strstr(list, ",,") != NULL)) {
-		cli_usage_error(command, "--format '%s' has an empty item; allowed: png, svg, pdf, obj, usda, json, glb", list);
-		return false;
+	double points = 0.0, barb_points = 0.0, curves = 0.0, longest = 0.0;
+	for (const plume_feather *f = feather; f != NULL; f = plume_feather_afterfeather(f)) {
+		plume_feather_info info = plume_feather_get_info(f);
+		points += info.shaft_sample_count + info.point_count;
+		curves += 1.0 + info.barb_count + info.barbule_count;
+		longest = info.shaft_sample_count > longest ? info.shaft_sample_count : longest;
+		for (int b = 0; b < info.barb_count; ++b) {
+			int count = plume_feather_barb(f, b).curve.count;
+			barb_points += count;
+			longest = count > longest ? count : longest;
+		}
 	}
-	return true;
+	// With a texture a barb is filled once per run of one colour: at most once per segment.
+	double fills = images->texture != NULL ? curves + barb_points : curves;
+	// The picture: --size, else 1200 pixels tall and at most 4096 wide (cli_write_feather).
+	double pixels = images->width > 0 ? (double)images->width * images->height : 4096.0 * 1200.0;
+	double texture = images->texture != NULL
+	                     ? 4.0 * plume_texture_width(images->texture) * (double)plume_texture_height(images->texture)
+	                     : 0.0;
+	double bytes[5] = {0};
+	if ((formats & (CLI_FORMAT_OBJ | CLI_FORMAT_USDA | CLI_FORMAT_JSON)) != 0)
+		bytes[0] = GENERATE_TEXT_BYTES;
+	if ((formats & CLI_FORMAT_PNG) != 0)
+		bytes[1] = GENERATE_PICTURE_BYTES + 4.0 * pixels;
+	if ((formats & CLI_FORMAT_SVG) != 0)
+		bytes[2] = GENERATE_PICTURE_BYTES + GENERATE_VECTOR_FILL_BYTES * fills + GENERATE_SVG_POINT_BYTES * points;
+	if ((formats & CLI_FORMAT_PDF) != 0)
+		bytes[3] = GENERATE_PICTURE_BYTES + GENERATE_VECTOR_FILL_BYTES * fills + GENERATE_PDF_POINT_BYTES * points;
+	if ((formats & CLI_FORMAT_GLB) != 0) // and the texture's pixels and PNG encoding; a curve's colours
+		bytes[4] = GENERATE_GLB_BYTES + 3.0 * texture + 64.0 * longest;
+	double most = 0.0;
+	for (int k = 0; k < 5; ++k)
+		most = bytes[k] > most ? bytes[k] : most;
+	return most;
+}
+
+/// PLUME_ERROR_LIMIT when the feather (what the library holds now) and its largest output pass the limit.
+static plume_status check_outputs(const char *spec, const plume_feather *feather, unsigned formats,
+                                  const cli_image_options *images, uint64_t max_memory, plume_error *err)
+{
+	double limit = (double)(max_memory > 0 ? max_memory : PLUME_DEFAULT_MAX_MEMORY);
+	double held = (double)plume_bytes_in_use(), outputs = output_bytes(feather, formats, images);
+	if (held + outputs <= limit)
+		return PLUME_OK;
+	static const struct {
+		unsigned bit;
+		const char *name;
+	} names[] = {{CLI_FORMAT_PNG, "png"},   {CLI_FORMAT_SVG, "svg"},   {CLI_FORMAT_PDF, "pdf"}, {CLI_FORMAT_OBJ, "obj"},
+	             {CLI_FORMAT_USDA, "usda"}, {CLI_FORMAT_JSON, "json"}, {CLI_FORMAT_GLB, "glb"}};
+	char list[64] = "";
+	for (size_t i = 0; i < sizeof names / sizeof names[0]; ++i)
+		if ((formats & names[i].bit) != 0)
+			snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", list[0] != '\0' ? ", " : "",
+			         names[i].name);
+	return plume_error_set(err, PLUME_ERROR_LIMIT,
+	                       "%s: writing %s (--format%s) takes up to %.3g GB besides the feather's %.3g GB: %.3g GB in "
+	                       "all; the limit is %.3g GB (raise it with --max-memory, or write fewer or smaller formats)",
+	                       spec, list, images->texture != NULL ? ", --texture" : "", outputs / 1e9, held / 1e9,
+	                       (held + outputs) / 1e9, limit / 1e9);
 }
 
 void cli_help_generate(void)
@@ -55,8 +126,8 @@ void cli_help_generate(void)
 	     "      --size WxH         image size in pixels (default: 1200 tall, width to fit)\n"
 	     "  -t, --texture IMAGE    colour the barbs from IMAGE (Franco & Walter 4.4) instead\n"
 	     "                         of the line style; feather.glb embeds IMAGE\n"
-	     "      --max-memory BYTES refuse a feather estimated past BYTES, before the work (K, M,\n"
-	     "                         G suffixes; default 4G; docs/cli.md)\n"
+	     "      --max-memory BYTES refuse a feather, or its outputs, estimated past BYTES,\n"
+	     "                         before the work (K, M, G suffixes; default 4G; docs/cli.md)\n"
 	     "  -h, --help             this help\n"
 	     "\n"
 	     "Specs are described in docs/spec-franco-walter.md and docs/spec-zhang-kanai.md;\n"
@@ -66,14 +137,10 @@ void cli_help_generate(void)
 int cli_generate(int argc, char **argv)
 {
 	static const struct option options[] = {
-	    {"output", required_argument, NULL, 'o'},
-	    {"seed", required_argument, NULL, 's'},
-	    {"format", required_argument, NULL, 'f'},
-	    {"size", required_argument, NULL, 'S'},
-	    {"texture", required_argument, NULL, 't'},
-	    {"max-memory", required_argument, NULL, 'M'},
-	    {"help", no_argument, NULL, 'h'},
-	    {NULL, 0, NULL, 0},
+	    {"output", required_argument, NULL, 'o'},  {"seed", required_argument, NULL, 's'},
+	    {"format", required_argument, NULL, 'f'},  {"size", required_argument, NULL, 'S'},
+	    {"texture", required_argument, NULL, 't'}, {"max-memory", required_argument, NULL, 'M'},
+	    {"help", no_argument, NULL, 'h'},          {NULL, 0, NULL, 0},
 	};
 	const char *output_dir = NULL, *texture_path = NULL;
 	unsigned formats = CLI_FORMAT_ALL;
@@ -91,7 +158,7 @@ int cli_generate(int argc, char **argv)
 			spec_options.seed_given = true;
 			break;
 		case 'f':
-			if (!formats_without_empty_items("generate", optarg) || !cli_parse_formats("generate", optarg, &formats))
+			if (!cli_parse_formats("generate", optarg, &formats))
 				return CLI_EXIT_USAGE;
 			break;
 		case 'S':
@@ -120,6 +187,8 @@ int cli_generate(int argc, char **argv)
 	plume_feather *feather = NULL;
 	cli_output output;
 	plume_status status = plume_spec_generate(argv[optind], &spec_options, &feather, &err);
+	if (status == PLUME_OK)
+		status = check_outputs(argv[optind], feather, formats, &images, spec_options.max_memory, &err);
 	if (status == PLUME_OK && (status = cli_output_begin(&output, output_dir, &err)) == PLUME_OK) {
 		status = cli_write_feather(&output, feather, "feather", formats, &images, &err);
 		if (status == PLUME_OK)

@@ -37,18 +37,6 @@ void cli_help_grow(void)
 	     "Example: plume grow examples/streit-heidrich/contour.json -o growth --frames 5");
 }
 
-/// cli_parse_formats skips one comma after each name, so "png," passed where "png,,obj" did not:
-/// an empty item is refused wherever it is.
-static bool formats_without_empty_items(const char *command, const char *list)
-{
-	size_t length = strlen(list);
-	if (length > 0 && (list[0] == ',' || list[length - 1] == ',' || strstr(list, ",,") != NULL)) {
-		cli_usage_error(command, "--format '%s' has an empty item; allowed: png, svg, pdf, obj, usda, json, glb", list);
-		return false;
-	}
-	return true;
-}
-
 static bool parse_frames(const char *text, int *frames)
 {
 	char *end;
@@ -210,7 +198,7 @@ int cli_grow(int argc, char **argv)
 			spec_options.seed_given = true;
 			break;
 		case 'f':
-			if (!formats_without_empty_items("grow", optarg) || !cli_parse_formats("grow", optarg, &formats))
+			if (!cli_parse_formats("grow", optarg, &formats))
 				return CLI_EXIT_USAGE;
 			break;
 		case 'S':

@@ -75,6 +75,12 @@ static const struct {
 bool cli_parse_formats(const char *command, const char *list, unsigned *formats)
 {
 	*formats = 0;
+	// An empty item ("png,", ",png", "png,,obj") is a typo, not a format: refused wherever it is.
+	size_t size = strlen(list);
+	if (size > 0 && (list[0] == ',' || list[size - 1] == ',' || strstr(list, ",,") != NULL)) {
+		cli_usage_error(command, "--format '%s' has an empty item; allowed: png, svg, pdf, obj, usda, json, glb", list);
+		return false;
+	}
 	const char *cursor = list;
 	while (*cursor != '\0') {
 		size_t length = strcspn(cursor, ",");

@@ -2,9 +2,13 @@
 // orientation, key feathers, interpolation, drawing order, determinism, the
 // strip renderer, exports and bad input.
 #include <math.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #include "plume/coat.h"
 #include "plume/streit_heidrich.h"
@@ -472,6 +476,126 @@ static void test_progress(void **state)
 	plume_coat_destroy(plain);
 }
 
+// ---------------------------------------------------------------------------
+// Memory: the estimate coat_build checks bounds what the build allocates
+
+static _Atomic int64_t peak_bytes;
+
+/// plume_alloc's hook: the high-water mark of plume_bytes_in_use, the block being allocated included.
+static void *peak_alloc(size_t size)
+{
+	int64_t now = plume_bytes_in_use() + (int64_t)size, seen = atomic_load(&peak_bytes);
+	while (now > seen && !atomic_compare_exchange_weak(&peak_bytes, &seen, now)) {
+	}
+	return malloc(size);
+}
+
+/// The most bytes building the coat at path had allocated at once, beyond what was in use before.
+static int64_t build_peak(const char *path)
+{
+	int64_t before = plume_bytes_in_use();
+	atomic_store(&peak_bytes, before);
+	plume_set_allocator(peak_alloc, NULL);
+	plume_coat *coat = build(path, 0, false);
+	plume_set_allocator(NULL, NULL);
+	plume_coat_destroy(coat);
+	return atomic_load(&peak_bytes) - before;
+}
+
+static plume_status build_within(const char *path, uint64_t max_memory, plume_error *err)
+{
+	plume_spec_options options = {.max_memory = max_memory};
+	plume_coat *coat = NULL;
+	plume_status status = plume_coat_spec_generate(path, &options, &coat, err);
+	plume_coat_destroy(coat);
+	return status;
+}
+
+static void test_estimate_bounds_the_build(void **state)
+{
+	(void)state;
+	// The examples, and key feathers of three types (one with an afterfeather) blended by inverse
+	// distance: a blend's rachis, curvatures and spacing between the keys'.
+	char mixed[512];
+	snprintf(mixed, sizeof mixed, "%s",
+	         write_coat("mixed.json", "\"surface\": {\"type\": \"plane\", \"size\": [0.05, 0.04]},"
+	                                  "\"follicles\": {\"layout\": \"poisson\", \"spacing\": 0.005},"
+	                                  "\"key_feathers\": [{\"at\": [0, 0], \"feather\": \"@contour.json\"},"
+	                                  "{\"at\": [0.05, 0], \"feather\": \"@plume.json\"},"
+	                                  "{\"at\": [0.025, 0.04], \"feather\": \"" PLUME_SOURCE_DIR
+	                                  "/examples/streit-heidrich/semiplume.json\"}],"
+	                                  "\"interpolation\": \"inverse-distance\""));
+	const char *const paths[] = {figure15, PLUME_SOURCE_DIR "/examples/coats/figure16-poisson.json",
+	                             PLUME_SOURCE_DIR "/examples/coats/sphere.json",
+	                             PLUME_SOURCE_DIR "/examples/coats/back-cap.json", mixed};
+	int threads = 1;
+#ifdef _OPENMP
+	threads = omp_get_max_threads();
+#endif
+	for (size_t i = 0; i < sizeof paths / sizeof paths[0]; ++i) {
+		int64_t peak = build_peak(paths[i]);
+		assert_true(peak > 0);
+		// Refused just below what the build really took: its estimate is at least that ...
+		plume_error err = {0};
+		assert_int_equal(build_within(paths[i], (uint64_t)peak - 1, &err), PLUME_ERROR_LIMIT);
+		if (strstr(err.message, "$.follicles.spacing") == NULL || strstr(err.message, "KB") == NULL)
+			fail_msg("%s: %s", paths[i], err.message);
+		// ... and not far above it: built with three times that and each thread's scratch.
+		uint64_t roomy = 3 * (uint64_t)peak + (uint64_t)threads * (2u << 20);
+		if (build_within(paths[i], roomy, &err) != PLUME_OK)
+			fail_msg("%s within %llu bytes (peak %lld): %s", paths[i], (unsigned long long)roomy, (long long)peak,
+			         err.message);
+	}
+}
+
+/// A surface seen from behind: no follicle faces +z, and the picture is the background alone.
+static void test_picture_of_a_surface_seen_from_behind(void **state)
+{
+	(void)state;
+	char obj[512];
+	snprintf(obj, sizeof obj, "%s/flipped.obj", scratch);
+	test_write_file(obj, "v 0 0 0\nv 0.05 0 0\nv 0 0.05 0\nf 1 3 2\n");
+	const char *path =
+	    write_coat("flipped.json", "\"surface\": {\"type\": \"mesh\", \"obj\": \"flipped.obj\"},"
+	                               "\"follicles\": {\"layout\": \"poisson\", \"spacing\": 0.01},"
+	                               "\"key_feathers\": [{\"at\": [0, 0, 0], \"feather\": \"@contour.json\"}]");
+	plume_coat *coat = build(path, 0, false);
+	int count = plume_coat_feather_count(coat);
+	assert_true(count > 1);
+	for (int i = 0; i < count; ++i) {
+		plume_vec3 root, normal;
+		plume_coat_follicle(coat, i, &root, &normal);
+		assert_close(normal.z, -1.0, 1e-12);
+	}
+	plume_render2d_def def = plume_render2d_default_def();
+	def.width = def.height = 64;
+	const plume_image_format formats[3] = {PLUME_IMAGE_PNG, PLUME_IMAGE_SVG, PLUME_IMAGE_PDF};
+	const char *const names[3] = {"behind.png", "behind.svg", "behind.pdf"};
+	for (int k = 0; k < 3; ++k) {
+		char out[512];
+		snprintf(out, sizeof out, "%s/%s", scratch, names[k]);
+		plume_error err = {0};
+		if (plume_coat_render2d(coat, &def, formats[k], out, &err) != PLUME_OK)
+			fail_msg("%s: %s", names[k], err.message);
+		assert_true(test_file_exists(out));
+	}
+	// The PNG is the white background, every pixel.
+	char png[512];
+	snprintf(png, sizeof png, "%s/behind.png", scratch);
+	plume_texture *picture = NULL;
+	plume_error err = {0};
+	assert_int_equal(plume_texture_load(png, &picture, &err), PLUME_OK);
+	for (int k = 0; k < 5; ++k) {
+		plume_color c = plume_texture_sample_vane(picture, PLUME_SIDE_LEFT, 0.1 + 0.2 * k, 0.1 + 0.2 * k);
+		assert_close(c.r + c.g + c.b + c.a, 4.0, 1e-9);
+	}
+	plume_texture_destroy(picture);
+	// Without a view to frame it, no feather is still an error.
+	const plume_feather *none = NULL;
+	assert_int_equal(plume_render2d_feathers(&none, 0, &def, PLUME_IMAGE_PNG, png, &err), PLUME_ERROR_SPEC);
+	plume_coat_destroy(coat);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -485,6 +609,8 @@ int main(void)
 	    cmocka_unit_test(test_exports_and_strip_rendering),
 	    cmocka_unit_test(test_bad_coats),
 	    cmocka_unit_test(test_progress),
+	    cmocka_unit_test(test_estimate_bounds_the_build),
+	    cmocka_unit_test(test_picture_of_a_surface_seen_from_behind),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);
 }

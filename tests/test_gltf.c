@@ -5,9 +5,12 @@
 // base + morph target to 1e-6 m at their key times; a coat's instances.
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include <sys/stat.h>
 
 #include <jansson.h>
 
@@ -635,6 +638,111 @@ static void test_coat_instances(void **state)
 	plume_coat_destroy(coat);
 }
 
+// ---------------------------------------------------------------------------
+// Memory: the writers stream the binary chunk to the file and hold one part's arrays (coats: two
+// feathers') at a time. Peaks count plume's allocations and jansson's (the JSON document).
+
+static _Atomic int64_t peak_bytes, json_bytes;
+
+static void note_peak(int64_t now)
+{
+	int64_t seen = atomic_load(&peak_bytes);
+	while (now > seen && !atomic_compare_exchange_weak(&peak_bytes, &seen, now)) {
+	}
+}
+
+static void *peak_alloc(size_t size)
+{
+	note_peak(plume_bytes_in_use() + (int64_t)size + atomic_load(&json_bytes));
+	return malloc(size);
+}
+
+static void *peak_json_malloc(size_t size)
+{
+	unsigned char *block = malloc(size + 16);
+	if (block == NULL)
+		return NULL;
+	memcpy(block, &size, sizeof size);
+	note_peak(plume_bytes_in_use() + atomic_fetch_add(&json_bytes, (int64_t)size) + (int64_t)size);
+	return block + 16;
+}
+
+static void peak_json_free(void *memory)
+{
+	if (memory == NULL)
+		return;
+	unsigned char *block = (unsigned char *)memory - 16;
+	size_t size;
+	memcpy(&size, block, sizeof size);
+	atomic_fetch_sub(&json_bytes, (int64_t)size);
+	free(block);
+}
+
+static void peak_begin(void)
+{
+	atomic_store(&json_bytes, 0);
+	atomic_store(&peak_bytes, plume_bytes_in_use());
+	plume_set_allocator(peak_alloc, NULL);
+	json_set_alloc_funcs(peak_json_malloc, peak_json_free);
+}
+
+/// The most bytes allocated at once since peak_begin, beyond before.
+static int64_t peak_end(int64_t before)
+{
+	plume_set_allocator(NULL, NULL);
+	json_set_alloc_funcs(malloc, free);
+	return atomic_load(&peak_bytes) - before;
+}
+
+static void test_writers_stream(void **state)
+{
+	(void)state;
+	// 2000 barbs of 100 points: 400,000 ribbon vertices, 9.6 MB in the file.
+	const char *spec = "{\"model\": \"franco-walter\", \"barb_samples\": 100, \"segments\": [{\"barb_count\": 500}, "
+	                   "{\"barb_count\": 500}]}";
+	plume_spec_options options = {0};
+	plume_feather *feather = NULL;
+	plume_error err = {0};
+	if (plume_spec_parse(spec, "dense", &options, &feather, &err) != PLUME_OK)
+		fail_msg("%s", err.message);
+	char folder[512], path[600];
+	snprintf(folder, sizeof folder, "%s/stream", scratch);
+	assert_int_equal(mkdir(folder, 0777), 0);
+	snprintf(path, sizeof path, "%s/dense.glb", folder);
+	int64_t before = plume_bytes_in_use();
+	peak_begin();
+	plume_status status = plume_write_glb(feather, NULL, path, &err);
+	int64_t peak = peak_end(before);
+	if (status != PLUME_OK)
+		fail_msg("%s", err.message);
+	size_t size = 0;
+	free(test_read_file(path, &size));
+	assert_true(size > 9000000);
+	// Two blocks of 256 KiB, the longest curve's scratch and the JSON: nothing grows with the feather.
+	if (peak > (2 << 20))
+		fail_msg("plume_write_glb of a %zu-byte file took %lld bytes", size, (long long)peak);
+	assert_int_equal(test_count_entries(folder), 1); // the spooled chunk is gone
+	plume_feather_destroy(feather);
+
+	// A coat: one feather's parts (and one earlier feather's, to compare) at a time and the document.
+	plume_coat *coat = NULL;
+	if (plume_coat_spec_generate(PLUME_SOURCE_DIR "/examples/coats/figure15-hexagonal.json", &options, &coat, &err) !=
+	    PLUME_OK)
+		fail_msg("%s", err.message);
+	snprintf(path, sizeof path, "%s/coat.glb", scratch);
+	before = plume_bytes_in_use();
+	peak_begin();
+	status = plume_coat_write_glb(coat, NULL, path, &err);
+	peak = peak_end(before);
+	if (status != PLUME_OK)
+		fail_msg("%s", err.message);
+	free(test_read_file(path, &size));
+	int count = plume_coat_feather_count(coat);
+	if (peak > (int64_t)count * (64 << 10) + (1 << 20))
+		fail_msg("plume_coat_write_glb of %d feathers (%zu bytes) took %lld bytes", count, size, (long long)peak);
+	plume_coat_destroy(coat);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -642,6 +750,7 @@ int main(void)
 	    cmocka_unit_test(test_shell_and_animation_read_back),
 	    cmocka_unit_test(test_carried_feather),
 	    cmocka_unit_test(test_coat_instances),
+	    cmocka_unit_test(test_writers_stream),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);
 }

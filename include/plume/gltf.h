@@ -51,7 +51,9 @@ plume_gltf_def plume_gltf_default_def(void);
 
 /// A feather: a root node "feather" with one child node and mesh per part
 /// (shaft, left_vane, right_vane, barbules) and the afterfeather as a child
-/// node "afterfeather" with its own parts. def may be NULL (defaults).
+/// node "afterfeather" with its own parts. def may be NULL (defaults). The
+/// ribbons are streamed to a temporary file beside path as they are made and
+/// copied into it: the writer holds no copy of the geometry.
 plume_status plume_write_glb(const plume_feather *feather, const plume_gltf_def *def, const char *path,
                              plume_error *err);
 
@@ -65,9 +67,11 @@ plume_status plume_mesh_write_glb(const plume_mesh *mesh, const plume_vec3 *posi
 /// A coat: the body surface as mesh "surface", and one node per feather
 /// (feather_00000 ..., drawing order), translated to its follicle, whose mesh
 /// holds the feather's parts relative to the follicle. Feathers with the same
-/// geometry relative to their follicle share one mesh (node instances, which
-/// every glTF importer reads; EXT_mesh_gpu_instancing is not used because
-/// Blender 3.4's importer ignores it). def may be NULL.
+/// geometry relative to their follicle (as stored: float32) share one mesh
+/// (node instances, which every glTF importer reads; EXT_mesh_gpu_instancing is
+/// not used because Blender 3.4's importer ignores it). def may be NULL. One
+/// feather's arrays are held at a time (and an earlier one's to compare), the
+/// binary chunk streamed as for plume_write_glb.
 plume_status plume_coat_write_glb(const plume_coat *coat, const plume_gltf_def *def, const char *path,
                                   plume_error *err);
 

@@ -7,7 +7,9 @@
 // which every platform plume builds on is (checked at compile time below).
 #include "glb.h"
 
+#include <errno.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -52,10 +54,25 @@ void plume_glb_init(plume_glb *glb, const char *generator)
 	glb->animations = NULL; // only documents with animations have the key
 }
 
+plume_status plume_glb_init_spooled(plume_glb *glb, const char *generator, const char *path, plume_error *err)
+{
+	plume_glb_init(glb, generator);
+	plume_status status = plume_atomic_open(&glb->spool, path, err);
+	if (status != PLUME_OK) {
+		json_decref(glb->root);
+		memset(glb, 0, sizeof *glb);
+		return status;
+	}
+	glb->spooled = true;
+	return PLUME_OK;
+}
+
 void plume_glb_free(plume_glb *glb)
 {
 	json_decref(glb->root);
 	plume_free(glb->bytes);
+	if (glb->spooled)
+		plume_atomic_abort(&glb->spool);
 	memset(glb, 0, sizeof *glb);
 }
 
@@ -68,31 +85,65 @@ int plume_glb_append(plume_glb *glb, json_t *array, json_t *obj)
 	return (int)json_array_size(array) - 1;
 }
 
-/// Copies size bytes into the binary chunk as a new view; returns its index.
-static int add_view(plume_glb *glb, const void *data, size_t size, int target)
+/// The GLB's length field is 32 bits: a binary chunk is refused (too_large) before it passes this.
+#define GLB_MAX_BINARY ((size_t)UINT32_MAX - ((size_t)1 << 24))
+
+/// Appends size bytes to the binary chunk: to the spool, or to the buffer in memory.
+static void append_bytes(plume_glb *glb, const void *data, size_t size)
 {
-	size_t start = (glb->size + 3) & ~(size_t)3;
-	if (start + size > glb->capacity) {
+	if (glb->failed || glb->write_error != 0 || glb->too_large || size == 0)
+		return;
+	if (size > GLB_MAX_BINARY - glb->size) {
+		glb->too_large = true;
+		return;
+	}
+	if (glb->spooled) {
+		if (fwrite(data, 1, size, glb->spool.stream) != size)
+			glb->write_error = errno != 0 ? errno : EIO;
+		else
+			glb->size += size;
+		return;
+	}
+	if (glb->size + size > glb->capacity) {
 		size_t capacity = glb->capacity > 0 ? glb->capacity : 1 << 16;
-		while (capacity < start + size)
+		while (capacity < glb->size + size)
 			capacity *= 2;
 		uint8_t *bytes = plume_realloc(glb->bytes, capacity);
 		if (bytes == NULL) {
 			glb->failed = true;
-			return 0;
+			return;
 		}
 		glb->bytes = bytes;
 		glb->capacity = capacity;
 	}
-	memset(glb->bytes + glb->size, 0, start - glb->size);
-	if (size > 0)
-		memcpy(glb->bytes + start, data, size);
-	glb->size = start + size;
-	json_t *view =
-	    json_pack("{s:i, s:I, s:I}", "buffer", 0, "byteOffset", (json_int_t)start, "byteLength", (json_int_t)size);
+	memcpy(glb->bytes + glb->size, data, size);
+	glb->size += size;
+}
+
+void plume_glb_view_begin(plume_glb *glb)
+{
+	static const uint8_t zeros[4] = {0, 0, 0, 0};
+	append_bytes(glb, zeros, ((glb->size + 3) & ~(size_t)3) - glb->size); // every view starts on 4 bytes
+	glb->view_start = glb->size;
+}
+
+void plume_glb_view_append(plume_glb *glb, const void *data, size_t size) { append_bytes(glb, data, size); }
+
+int plume_glb_view_end(plume_glb *glb, int target)
+{
+	json_t *view = json_pack("{s:i, s:I, s:I}", "buffer", 0, "byteOffset", (json_int_t)glb->view_start, "byteLength",
+	                         (json_int_t)(glb->size - glb->view_start));
 	if (view != NULL && target != GLB_NO_TARGET)
 		json_object_set_new(view, "target", json_integer(target));
 	return plume_glb_append(glb, glb->buffer_views, view);
+}
+
+/// Copies size bytes into the binary chunk as a new view; returns its index.
+static int add_view(plume_glb *glb, const void *data, size_t size, int target)
+{
+	plume_glb_view_begin(glb);
+	append_bytes(glb, data, size);
+	return plume_glb_view_end(glb, target);
 }
 
 static const char *type_name(int components)
@@ -105,27 +156,39 @@ static const char *type_name(int components)
 	}
 }
 
-int plume_glb_floats_f(plume_glb *glb, const float *values, int count, int components, int target, bool bounds)
+int plume_glb_float_accessor(plume_glb *glb, int view, int64_t count, int components, const float *min,
+                             const float *max)
 {
-	int view = add_view(glb, values, (size_t)count * (size_t)components * sizeof(float), target);
-	json_t *accessor = json_pack("{s:i, s:i, s:i, s:s}", "bufferView", view, "componentType", GLB_FLOAT, "count", count,
-	                             "type", type_name(components));
-	if (accessor != NULL && bounds && count > 0) {
+	json_t *accessor = json_pack("{s:i, s:i, s:I, s:s}", "bufferView", view, "componentType", GLB_FLOAT, "count",
+	                             (json_int_t)count, "type", type_name(components));
+	if (accessor != NULL && min != NULL && max != NULL) {
 		json_t *lo = json_array(), *hi = json_array();
 		for (int c = 0; c < components; ++c) {
-			float a = values[c], b = values[c];
-			for (int i = 1; i < count; ++i) {
-				float v = values[(size_t)i * (size_t)components + (size_t)c];
-				a = v < a ? v : a;
-				b = v > b ? v : b;
-			}
-			json_array_append_new(lo, json_real(a));
-			json_array_append_new(hi, json_real(b));
+			json_array_append_new(lo, json_real(min[c]));
+			json_array_append_new(hi, json_real(max[c]));
 		}
 		json_object_set_new(accessor, "min", lo);
 		json_object_set_new(accessor, "max", hi);
 	}
 	return plume_glb_append(glb, glb->accessors, accessor);
+}
+
+int plume_glb_floats_f(plume_glb *glb, const float *values, int count, int components, int target, bool bounds)
+{
+	int view = add_view(glb, values, (size_t)count * (size_t)components * sizeof(float), target);
+	float lo[4], hi[4];
+	bounds = bounds && count > 0;
+	for (int c = 0; bounds && c < components; ++c) {
+		float a = values[c], b = values[c];
+		for (int i = 1; i < count; ++i) {
+			float v = values[(size_t)i * (size_t)components + (size_t)c];
+			a = v < a ? v : a;
+			b = v > b ? v : b;
+		}
+		lo[c] = a;
+		hi[c] = b;
+	}
+	return plume_glb_float_accessor(glb, view, count, components, bounds ? lo : NULL, bounds ? hi : NULL);
 }
 
 int plume_glb_floats(plume_glb *glb, const double *values, int count, int components, int target, bool bounds)
@@ -143,12 +206,17 @@ int plume_glb_floats(plume_glb *glb, const double *values, int count, int compon
 	return index;
 }
 
-int plume_glb_indices(plume_glb *glb, const uint32_t *values, int64_t count)
+int plume_glb_index_accessor(plume_glb *glb, int view, int64_t count)
 {
-	int view = add_view(glb, values, (size_t)count * sizeof(uint32_t), GLB_ELEMENT_ARRAY_BUFFER);
 	json_t *accessor = json_pack("{s:i, s:i, s:I, s:s}", "bufferView", view, "componentType", GLB_UNSIGNED_INT, "count",
 	                             (json_int_t)count, "type", "SCALAR");
 	return plume_glb_append(glb, glb->accessors, accessor);
+}
+
+int plume_glb_indices(plume_glb *glb, const uint32_t *values, int64_t count)
+{
+	int view = add_view(glb, values, (size_t)count * sizeof(uint32_t), GLB_ELEMENT_ARRAY_BUFFER);
+	return plume_glb_index_accessor(glb, view, count);
 }
 
 void plume_glb_scene_root(plume_glb *glb, int node)
@@ -197,16 +265,53 @@ double plume_glb_linear(double srgb)
 	return srgb <= 0.04045 ? srgb / 12.92 : pow((srgb + 0.055) / 1.055, 2.4);
 }
 
+/// Frees json_dumps's text with jansson's own free (json_set_alloc_funcs may have changed it).
+static void free_text(char *text)
+{
+	json_free_t free_fn = NULL;
+	json_get_alloc_funcs(NULL, &free_fn);
+	if (free_fn != NULL)
+		free_fn(text);
+	else
+		free(text);
+}
+
 static void put_u32(uint8_t *at, uint32_t value)
 {
 	for (int i = 0; i < 4; ++i)
 		at[i] = (uint8_t)(value >> (8 * i));
 }
 
+/// Copies the spooled binary chunk (glb->size bytes) to out. False when a read or a write fails.
+static bool copy_spool(plume_glb *glb, FILE *out)
+{
+	if (fflush(glb->spool.stream) != 0 || ferror(glb->spool.stream))
+		return false;
+	enum { BLOCK = 1 << 18 };
+	unsigned char *block = plume_alloc(BLOCK);
+	FILE *in = block != NULL ? fopen(glb->spool.tmp_path, "rb") : NULL;
+	size_t left = glb->size;
+	bool ok = in != NULL;
+	while (ok && left > 0) {
+		size_t n = left < BLOCK ? left : BLOCK;
+		ok = fread(block, 1, n, in) == n && fwrite(block, 1, n, out) == n;
+		left -= n;
+	}
+	if (in != NULL)
+		fclose(in);
+	plume_free(block);
+	return ok;
+}
+
 plume_status plume_glb_write(plume_glb *glb, const char *path, plume_error *err)
 {
 	if (glb->failed)
 		return plume_error_set(err, PLUME_ERROR_MEMORY, "%s: out of memory", path);
+	if (glb->too_large)
+		return plume_error_set(err, PLUME_ERROR_IO, "%s: the binary chunk passes the GLB limit of 4 GiB", path);
+	if (glb->write_error != 0)
+		return plume_error_set(err, PLUME_ERROR_IO, "%s: cannot write its binary chunk beside it: %s", path,
+		                       strerror(glb->write_error));
 	// The one buffer: its byteLength is the chunk's unpadded length (spec 4.4.3.3 allows padding after it).
 	json_t *buffers = json_pack("[{s:I}]", "byteLength", (json_int_t)glb->size);
 	if (buffers == NULL || json_object_set_new(glb->root, "buffers", buffers) != 0)
@@ -225,7 +330,7 @@ plume_status plume_glb_write(plume_glb *glb, const char *path, plume_error *err)
 	size_t bin_padded = (glb->size + 3) & ~(size_t)3;
 	size_t total = 12 + 8 + json_padded + (glb->size > 0 ? 8 + bin_padded : 0);
 	if (total > UINT32_MAX) {
-		free(text);
+		free_text(text);
 		return plume_error_set(err, PLUME_ERROR_IO, "%s: %zu bytes is over the GLB limit of 4 GiB", path, total);
 	}
 	uint8_t header[20];
@@ -238,7 +343,7 @@ plume_status plume_glb_write(plume_glb *glb, const char *path, plume_error *err)
 	plume_atomic_file file;
 	plume_status status = plume_atomic_open(&file, path, err);
 	if (status != PLUME_OK) {
-		free(text);
+		free_text(text);
 		return status;
 	}
 	static const char spaces[4] = {' ', ' ', ' ', ' '};
@@ -246,12 +351,14 @@ plume_status plume_glb_write(plume_glb *glb, const char *path, plume_error *err)
 	bool ok = fwrite(header, 1, sizeof header, file.stream) == sizeof header &&
 	          fwrite(text, 1, json_length, file.stream) == json_length &&
 	          fwrite(spaces, 1, json_padded - json_length, file.stream) == json_padded - json_length;
-	free(text);
+	free_text(text);
 	if (ok && glb->size > 0) {
 		uint8_t chunk[8];
 		put_u32(chunk, (uint32_t)bin_padded);
 		memcpy(chunk + 4, "BIN\0", 4);
-		ok = fwrite(chunk, 1, 8, file.stream) == 8 && fwrite(glb->bytes, 1, glb->size, file.stream) == glb->size &&
+		ok = fwrite(chunk, 1, 8, file.stream) == 8 &&
+		     (glb->spooled ? copy_spool(glb, file.stream)
+		                   : fwrite(glb->bytes, 1, glb->size, file.stream) == glb->size) &&
 		     fwrite(zeros, 1, bin_padded - glb->size, file.stream) == bin_padded - glb->size;
 	}
 	if (!ok) {

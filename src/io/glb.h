@@ -1,6 +1,9 @@
 // Private: a glTF 2.0 binary (.glb) builder. The JSON chunk is built with
-// jansson (the project's JSON library) and the binary chunk is one buffer that
-// grows as views are added; plume_glb_write lays out the container (glTF 2.0
+// jansson (the project's JSON library). The binary chunk is either one buffer
+// in memory that grows as views are added (plume_glb_init), or spooled to a
+// temporary file beside the destination as views are added, so that a writer
+// holds none of it (plume_glb_init_spooled: the feather and coat writers, whose
+// chunk can be gigabytes). plume_glb_write lays out the container (glTF 2.0
 // spec, section 4.4 "GLB File Format Specification") and writes it atomically.
 //
 // Only what plume's writers need: one buffer, tightly packed views, accessors
@@ -14,6 +17,7 @@
 
 #include <jansson.h>
 
+#include "core/atomic_file.h"
 #include "plume/core.h"
 
 /// glTF accessor component types (spec 5.1.3).
@@ -33,15 +37,39 @@ enum {
 typedef struct plume_glb {
 	json_t *root; ///< the glTF document
 	json_t *buffer_views, *accessors, *meshes, *nodes, *materials, *animations;
-	uint8_t *bytes; ///< the binary chunk
+	uint8_t *bytes; ///< the binary chunk (in memory)
 	size_t size, capacity;
-	bool failed; ///< out of memory somewhere: plume_glb_write reports it
+	bool spooled;            ///< the binary chunk goes to spool instead of bytes
+	plume_atomic_file spool; ///< plume_glb_init_spooled: the binary chunk so far, removed by plume_glb_free
+	size_t view_start;       ///< where the view being streamed (plume_glb_view_begin) starts
+	bool failed;             ///< out of memory somewhere: plume_glb_write reports it
+	int write_error;         ///< errno of the first failed write to the spool (0: none); plume_glb_write reports it
+	bool too_large;          ///< the binary chunk passed the GLB's 4 GiB: plume_glb_write reports it
 } plume_glb;
 
 /// Starts an empty document (asset, one scene with no nodes yet). On failure the
 /// builder is marked failed and plume_glb_write reports PLUME_ERROR_MEMORY.
 void plume_glb_init(plume_glb *glb, const char *generator);
+
+/// plume_glb_init with the binary chunk spooled to a temporary file beside path (the file
+/// plume_glb_write will write), so that it is never held in memory. PLUME_ERROR_IO when
+/// the temporary file cannot be created (nothing to free then).
+plume_status plume_glb_init_spooled(plume_glb *glb, const char *generator, const char *path, plume_error *err);
 void plume_glb_free(plume_glb *glb);
+
+/// A view written in pieces: plume_glb_view_begin, any number of plume_glb_view_append,
+/// then plume_glb_view_end, which adds the view (all the bytes appended) and returns its index.
+void plume_glb_view_begin(plume_glb *glb);
+void plume_glb_view_append(plume_glb *glb, const void *data, size_t size);
+int plume_glb_view_end(plume_glb *glb, int target);
+
+/// A float accessor of count elements of components floats on view; min and max
+/// (components each) when not NULL (required for POSITION). Returns its index.
+int plume_glb_float_accessor(plume_glb *glb, int view, int64_t count, int components, const float *min,
+                             const float *max);
+
+/// An unsigned 32-bit SCALAR accessor of count elements on view. Returns its index.
+int plume_glb_index_accessor(plume_glb *glb, int view, int64_t count);
 
 /// Appends count * components floats (given as doubles, rounded to float) as
 /// a new accessor of type "SCALAR", "VEC2", "VEC3" or "VEC4". With bounds, the

@@ -4,6 +4,9 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #include "../core/asserts.h"
 #include "../core/alloc.h"
@@ -163,10 +166,16 @@ typedef struct follicles {
 	plume_vec3 *positions;
 	plume_vec3 *normals;
 	int count, capacity;
+	double most; ///< more follicles than this would not fit in the memory limit: the layout stops
 } follicles;
+
+/// FOLLICLES_PAST_LIMIT: the layout passed f->most and stops; -1: out of memory.
+enum { FOLLICLES_PAST_LIMIT = -3 };
 
 static int add_follicle(follicles *f, plume_vec3 position, plume_vec3 normal)
 {
+	if (f->count + 1 > f->most)
+		return FOLLICLES_PAST_LIMIT;
 	int capacity = f->capacity;
 	if (PLUME_GROW(f->positions, capacity, f->count + 1) != 0)
 		return -1;
@@ -180,10 +189,18 @@ static int add_follicle(follicles *f, plume_vec3 position, plume_vec3 normal)
 	return 0;
 }
 
-// Resource bounds. A feather of the coarsest level of detail still holds a
-// shaft and a few barbs: 4 KiB is a floor, far below the example coats' 30-200 KiB.
-#define COAT_MIN_FEATHER_BYTES 4096
+// Resource bounds (docs/cli.md, Limits). Before the layout, its own arrays (the follicle count
+// estimated from the surface's area: an upper bound for hexagonal layouts, the densest packing for
+// Poisson ones); after it, the coat, from the follicles laid out and a bound on any one feather
+// (coat_feather_bound), before any feather is built.
 #define COAT_MAX_FOLLICLES 1e8 // also keeps every count far inside an int
+/// Bytes a follicle takes besides its feather: the coat's arrays (feather pointer, root, normal, frame, key
+/// flag: 129 B) and, while it is built, the layout's (positions and normals grown by doubling: 96 B, the
+/// Poisson grid's cells and links) and the build's (key index, drawing order, status).
+#define COAT_FOLLICLE_BYTES 512.0
+/// Scratch of one thread while it builds a feather: the blended definition (60 KiB), the blend's key lists
+/// (27 KiB for each key feather, 16 at most), the builder's tables, and the barbs' roots (at most 4000).
+#define COAT_THREAD_BYTES (2.0 * 1024 * 1024)
 
 /// Upper estimate of the follicle count, from the layout's own geometry.
 static double estimated_follicles(const coat_def *def, double area)
@@ -204,12 +221,12 @@ static double estimated_follicles(const coat_def *def, double area)
 static int hexagonal_plane(const coat_def *def, follicles *f)
 {
 	double s = def->spacing, row_step = s * sqrt(3.0) / 2.0;
-	int rows = (int)floor(def->plane_size[1] / row_step + 1e-9) + 1;
+	int rows = (int)floor(def->plane_size[1] / row_step + 1e-9) + 1, status = 0;
 	for (int r = 0; r < rows; ++r) {
 		double y = r * row_step;
 		for (double x = (r % 2) * 0.5 * s; x <= def->plane_size[0] + 1e-9 * s; x += s)
-			if (add_follicle(f, plume_v3(x, y, 0.0), plume_v3(0.0, 0.0, 1.0)) != 0)
-				return -1;
+			if ((status = add_follicle(f, plume_v3(x, y, 0.0), plume_v3(0.0, 0.0, 1.0))) != 0)
+				return status;
 	}
 	return 0;
 }
@@ -235,8 +252,9 @@ static int hexagonal_sphere(const coat_def *def, follicles *f)
 #define PUT(p)                                                                                                         \
 	do {                                                                                                               \
 		plume_vec3 u = plume_v3_normalize(p);                                                                          \
-		if (add_follicle(f, plume_v3_mad(def->sphere_centre, def->sphere_radius, u), u) != 0)                          \
-			return -1;                                                                                                 \
+		int added = add_follicle(f, plume_v3_mad(def->sphere_centre, def->sphere_radius, u), u);                       \
+		if (added != 0)                                                                                                \
+			return added;                                                                                              \
 	} while (0)
 	for (int i = 0; i < 12; ++i)
 		PUT(corner[i]);
@@ -396,10 +414,8 @@ static int poisson(const coat_def *def, const surface_sampler *sampler, follicle
 			continue;
 		}
 		failures = 0;
-		if (add_follicle(f, p, n) != 0 || PLUME_GROW(g.next, next_capacity, f->count) != 0) {
-			status = -1;
+		if ((status = add_follicle(f, p, n)) != 0 || (status = PLUME_GROW(g.next, next_capacity, f->count)) != 0)
 			break;
-		}
 		unsigned h = cell_hash(cx, cy, cz, g.mask);
 		g.next[f->count - 1] = g.head[h];
 		g.head[h] = f->count - 1;
@@ -407,6 +423,119 @@ static int poisson(const coat_def *def, const surface_sampler *sampler, follicle
 	plume_free(g.head);
 	plume_free(g.next);
 	return status;
+}
+
+// ---------------------------------------------------------------------------
+// The coat's bytes
+
+/// Widens bound so that plume_sh_estimate_bytes of it is at least that of p: the longer rachis, the
+/// larger curvatures (their sizes: a bend either way lengthens the rachis's control polygon), both
+/// spacings the smallest of the four, and one key barb of the most control vertices.
+static void widen_params(plume_sh_params *bound, const plume_sh_params *p)
+{
+	bound->rachis_length = fmax(bound->rachis_length, p->rachis_length);
+	bound->rachis_side_curvature = fmax(fabs(bound->rachis_side_curvature), fabs(p->rachis_side_curvature));
+	bound->rachis_front_curvature = fmax(fabs(bound->rachis_front_curvature), fabs(p->rachis_front_curvature));
+	double spacing = fmin(fmin(bound->spacing_base, bound->spacing_tip), fmin(p->spacing_base, p->spacing_tip));
+	bound->spacing_base = bound->spacing_tip = spacing;
+	int cvs = bound->key_barb_count > 0 ? bound->key_barbs[0].cv_count : 0;
+	for (int j = 0; j < p->key_barb_count && j < PLUME_SH_MAX_KEY_BARBS; ++j)
+		cvs = p->key_barbs[j].cv_count > cvs ? p->key_barbs[j].cv_count : cvs;
+	bound->key_barb_count = cvs > 0 ? 1 : 0;
+	if (cvs > 0)
+		bound->key_barbs[0].cv_count = cvs;
+}
+
+double coat_feather_bound(const coat_def *def)
+{
+	// Every feather is plume_sh_def_blend of the key feathers (a key feather: its own weight 1), and
+	// a blend's parameters are weighted means: its rachis length, the sizes of its curvatures and its
+	// smaller spacing lie within the key feathers' (afterfeathers: those of the key feathers that have
+	// one), and its key barbs have no more control vertices than the key feathers' (Bdf1 and Bdf2
+	// included, the 4 plume_sh_estimate_bytes counts at least). So the estimate of the widest
+	// definition bounds every feather's, which bounds the feather built (streit_heidrich.h).
+	plume_sh_def *bound = plume_alloc(sizeof *bound);
+	if (bound == NULL)
+		return INFINITY;
+	*bound = def->key_defs[0];
+	bound->has_afterfeather = false;
+	bound->main.key_barb_count = 0;
+	for (int k = 0; k < def->key_count; ++k) {
+		const plume_sh_def *key = &def->key_defs[k];
+		widen_params(&bound->main, &key->main);
+		if (key->has_afterfeather) {
+			if (!bound->has_afterfeather) {
+				bound->afterfeather = key->afterfeather;
+				bound->afterfeather.key_barb_count = 0;
+			}
+			bound->has_afterfeather = true;
+			widen_params(&bound->afterfeather, &key->afterfeather);
+		}
+	}
+	double estimate = plume_sh_estimate_bytes(bound, &def->lod);
+	plume_free(bound);
+	// What the estimate leaves out, per feather object (main, afterfeather): barb and shaft records
+	// grow by doubling from 16 (a barb record, 40 B, is at most 1/9 of its barb's share of the
+	// estimate: at least 4 points of 80 B), the shaft's samples are 112 B, and the feather's own
+	// struct and its arrays' allocation headers take under 1 KiB.
+	double shaft = def->lod.calamus_samples + 4.0 + def->lod.rachis_elevations;
+	double objects = 1.0;
+	for (int k = 0; k < def->key_count; ++k)
+		if (def->key_defs[k].has_afterfeather)
+			objects = 2.0;
+	return estimate * 10.0 / 9.0 +
+	       objects * (sizeof(plume_shaft_sample) * (shaft + 16.0) + sizeof(plume_barb_record) * 16.0 + 1024.0);
+}
+
+/// Threads that build feathers at once.
+static int coat_threads(void)
+{
+#ifdef _OPENMP
+	return omp_get_max_threads();
+#else
+	return 1;
+#endif
+}
+
+/// The bytes of a coat besides its follicles: the threads' scratch, the surface (rest, reference, uv,
+/// faces and per-face data) and the layout's vertex normals and areas.
+static double coat_fixed_bytes(const plume_mesh *surface)
+{
+	double surface_bytes = surface != NULL ? 96.0 * surface->vertex_count + 48.0 * surface->face_count : 0.0;
+	return coat_threads() * COAT_THREAD_BYTES + surface_bytes;
+}
+
+double coat_estimate_bytes(const coat_def *def, int follicle_count, const plume_mesh *surface)
+{
+	return follicle_count * (coat_feather_bound(def) + COAT_FOLLICLE_BYTES) + coat_fixed_bytes(surface);
+}
+
+/// PLUME_ERROR_LIMIT for a coat of follicle_count follicles past the limit, or (stopped) for a layout that
+/// stopped at follicle_count, the most that fit.
+static plume_status coat_limit_error(const coat_def *def, double follicle_count, bool stopped, double feather,
+                                     double fixed, plume_error *err)
+{
+	double limit = (double)def->max_memory;
+	if (stopped && follicle_count < 1.0)
+		return plume_error_set(err, PLUME_ERROR_LIMIT,
+		                       "$.follicles.spacing: the coat's scratch (%.3g GB for its threads and surface) leaves "
+		                       "no room for a feather of up to %.3g KB (the key feathers' bound, at $.lod) in the "
+		                       "limit of %.3g GB (raise it with --max-memory)",
+		                       fixed / 1e9, feather / 1e3, limit / 1e9);
+	if (stopped)
+		return plume_error_set(err, PLUME_ERROR_LIMIT,
+		                       "$.follicles.spacing: %g m on this surface makes more than %.0f follicles (the layout "
+		                       "stopped there), and with feathers of at most %.3g KB each (the key feathers' longest "
+		                       "rachis, largest curvatures, smallest barb spacing and most control vertices, at $.lod) "
+		                       "no more fit in the limit of %.3g GB (raise it with --max-memory, or widen the spacing)",
+		                       def->spacing, follicle_count, feather / 1e3, limit / 1e9);
+	return plume_error_set(err, PLUME_ERROR_LIMIT,
+	                       "$.follicles.spacing: %g m on this surface makes %.0f follicles; with feathers of at most "
+	                       "%.3g KB each (the key feathers' longest rachis, largest curvatures, smallest barb spacing "
+	                       "and most control vertices, at $.lod) the coat takes up to %.3g GB; the limit is %.3g GB "
+	                       "(raise it with --max-memory, or widen the spacing)",
+	                       def->spacing, follicle_count, feather / 1e3,
+	                       (follicle_count * (feather + COAT_FOLLICLE_BYTES) + fixed) / 1e9, limit / 1e9);
 }
 
 plume_status coat_follicles(const coat_def *def, const plume_mesh *surface, plume_vec3 **positions,
@@ -441,20 +570,29 @@ plume_status coat_follicles(const coat_def *def, const plume_mesh *surface, plum
 		                       sampler.area);
 	}
 	if (status == 0) {
-		// Refuse before the layout grows: every follicle costs at least its
-		// position, its normal and a feather of COAT_MIN_FEATHER_BYTES.
+		// Refuse before the layout grows: its arrays take COAT_FOLLICLE_BYTES a follicle (the feathers
+		// are counted once the follicles are known, coat_build).
 		double estimate = estimated_follicles(def, sampler.area);
-		double bytes = estimate * (double)COAT_MIN_FEATHER_BYTES;
+		double bytes = estimate * COAT_FOLLICLE_BYTES;
 		if (!(estimate <= COAT_MAX_FOLLICLES && bytes <= (double)def->max_memory)) {
 			plume_free((void *)sampler.vertex_normals);
 			plume_free(sampler.cumulative_area);
 			return plume_error_set(err, PLUME_ERROR_LIMIT,
-			                       "$.follicles.spacing: %g m on %.3g m^2 of surface makes about %.3g follicles, at "
-			                       "least %.3g GB of feathers; the limit is %.3g GB (raise it with --max-memory, or "
-			                       "widen the spacing)",
-			                       def->spacing, sampler.area, estimate, bytes / 1e9, (double)def->max_memory / 1e9);
+			                       "$.follicles.spacing: %g m on %.3g m^2 of surface makes about %.3g follicles (at "
+			                       "most %.0e), whose layout alone takes %.3g GB; the limit is %.3g GB (raise it with "
+			                       "--max-memory, or widen the spacing)",
+			                       def->spacing, sampler.area, estimate, COAT_MAX_FOLLICLES, bytes / 1e9,
+			                       (double)def->max_memory / 1e9);
 		}
 	}
+	// The coat is checked once its follicles are known, before any feather is built: every feather is
+	// bounded (coat_feather_bound). A Poisson layout, the slow one, stops as soon as it has more
+	// follicles than would fit; the others are counted whole (their arrays are bounded above).
+	double feather = def->key_count > 0 ? coat_feather_bound(def) : 0.0;
+	double fixed = coat_fixed_bytes(surface), most = INFINITY;
+	if (def->key_count > 0)
+		most = fmax(0.0, floor(((double)def->max_memory - fixed) / (feather + COAT_FOLLICLE_BYTES)));
+	f.most = def->layout == COAT_LAYOUT_POISSON ? most : INFINITY;
 	if (status == 0) {
 		if (def->layout == COAT_LAYOUT_POISSON)
 			status = poisson(def, &sampler, &f);
@@ -465,9 +603,15 @@ plume_status coat_follicles(const coat_def *def, const plume_mesh *surface, plum
 	}
 	plume_free((void *)sampler.vertex_normals);
 	plume_free(sampler.cumulative_area);
+	bool stopped = status == FOLLICLES_PAST_LIMIT; // more than f.most follicles, the rest not laid out
+	if (status == 0 && f.count > most)
+		status = FOLLICLES_PAST_LIMIT;
 	if (status != 0) {
 		plume_free(f.positions);
 		plume_free(f.normals);
+		if (status == FOLLICLES_PAST_LIMIT) {
+			return coat_limit_error(def, stopped ? f.most : f.count, stopped, feather, fixed, err);
+		}
 		if (status == -2)
 			return plume_error_set(err, PLUME_ERROR_SPEC,
 			                       "the follicle spacing %g m puts tens of millions of follicles on this surface; "

@@ -68,4 +68,13 @@ plume_status coat_build(coat_def *def, plume_coat **out, plume_error *err);
 plume_status coat_follicles(const coat_def *def, const plume_mesh *surface, plume_vec3 **positions,
                             plume_vec3 **normals, int *count, plume_error *err);
 
+/// Bytes any one feather of the coat takes at most, allocations included: plume_sh_estimate_bytes of
+/// a definition at least as wide as every blend of the key feathers, and the records' growth.
+double coat_feather_bound(const coat_def *def);
+
+/// Bytes the coat takes at most with follicle_count follicles on surface: their feathers (coat_feather_bound),
+/// the coat's and the build's arrays, the threads' scratch and the surface. coat_build refuses a coat
+/// past def->max_memory before it builds a feather.
+double coat_estimate_bytes(const coat_def *def, int follicle_count, const plume_mesh *surface);
+
 #endif

@@ -367,77 +367,117 @@ static view fit_view(const plume_render2d_def *def, plume_feather_info info)
 // ---------------------------------------------------------------------------
 // Output
 
-/// Where Cairo's output goes: a file, or (when stream is NULL) a growing
-/// buffer in plume memory.
+/// Cairo names the SVG's top group after the surface's process-wide serial
+/// number ("surface1" for a process's first surface, "surface57" later), so the
+/// same drawing would not give the same bytes twice in one process. The names
+/// are renumbered by first appearance as the text streams to the file (a name
+/// split between two of Cairo's writes is held back until it ends), which keeps
+/// references between them intact and holds none of the document in memory.
+enum { SVG_MAX_NAMES = 64, SVG_MAX_DIGITS = 20 };
+
+typedef struct svg_renamer {
+	int matched;                 ///< characters of "surface" matched so far (7: now reading its digits)
+	char digits[SVG_MAX_DIGITS]; ///< the digits read after "surface"
+	int digit_count;
+	long seen[SVG_MAX_NAMES]; ///< the numbers met, in order of first appearance
+	int seen_count;
+} svg_renamer;
+
+/// Where Cairo's output goes: a file, through the renamer for SVG.
 typedef struct stream_closure {
 	FILE *stream;
 	int error; ///< errno of the first failed write, 0 when none failed
-	char *memory;
-	int memory_size, memory_capacity;
-	bool memory_full;
+	bool svg;  ///< renumber surface names (svg_renamer)
+	svg_renamer names;
 } stream_closure;
+
+static const char svg_token[] = "surface";
+enum { SVG_TOKEN_LENGTH = sizeof svg_token - 1 };
+
+static bool put_bytes(stream_closure *target, const void *data, size_t length)
+{
+	if (length > 0 && fwrite(data, 1, length, target->stream) != length) {
+		if (target->error == 0)
+			target->error = errno != 0 ? errno : EIO;
+		return false;
+	}
+	return true;
+}
+
+/// Writes the name held (matched, digits): renumbered when it has digits, else as it came.
+static bool flush_name(stream_closure *target)
+{
+	svg_renamer *r = &target->names;
+	bool ok = put_bytes(target, svg_token, (size_t)r->matched);
+	if (r->digit_count > 0) {
+		long number = 0;
+		for (int i = 0; i < r->digit_count; ++i)
+			number = number < 100000000L ? number * 10 + (r->digits[i] - '0') : number;
+		int rank = -1;
+		for (int k = 0; k < r->seen_count && rank < 0; ++k)
+			if (r->seen[k] == number)
+				rank = k;
+		if (rank < 0 && r->seen_count < SVG_MAX_NAMES) {
+			r->seen[r->seen_count] = number;
+			rank = r->seen_count++;
+		}
+		if (rank >= 0) { // beyond SVG_MAX_NAMES distinct names the rest stay as Cairo wrote them
+			char text[16];
+			int n = snprintf(text, sizeof text, "%d", rank + 1);
+			ok = ok && put_bytes(target, text, (size_t)n);
+		} else {
+			ok = ok && put_bytes(target, r->digits, (size_t)r->digit_count);
+		}
+	}
+	r->matched = 0;
+	r->digit_count = 0;
+	return ok;
+}
+
+/// The SVG text through the renamer: plain runs go out as they are, names renumbered.
+static bool write_svg_renamed(stream_closure *target, const unsigned char *data, size_t length)
+{
+	svg_renamer *r = &target->names;
+	size_t run = 0; // data[run, i) passes through unchanged
+	for (size_t i = 0; i < length; ++i) {
+		char c = (char)data[i];
+		if (r->matched == 0) {
+			if (c != svg_token[0])
+				continue;
+			if (!put_bytes(target, data + run, i - run))
+				return false;
+			r->matched = 1;
+			run = i + 1;
+		} else if (r->matched < SVG_TOKEN_LENGTH) {
+			if (c == svg_token[r->matched]) {
+				r->matched++;
+				run = i + 1;
+			} else {
+				// Not a name: the letters held go out, and c starts over ("surface" repeats no letter
+				// of its own, so no match can begin inside the letters held).
+				if (!flush_name(target))
+					return false;
+				run = i;
+				--i;
+			}
+		} else if (isdigit((unsigned char)c) && r->digit_count < SVG_MAX_DIGITS) {
+			r->digits[r->digit_count++] = c;
+			run = i + 1;
+		} else {
+			if (!flush_name(target))
+				return false;
+			run = i;
+			--i;
+		}
+	}
+	return put_bytes(target, data + run, length - run);
+}
 
 static cairo_status_t write_to_stream(void *closure, const unsigned char *data, unsigned int length)
 {
 	stream_closure *target = closure;
-	if (target->stream == NULL) {
-		if (length > (unsigned int)(INT32_MAX / 2 - target->memory_size) ||
-		    PLUME_GROW(target->memory, target->memory_capacity, target->memory_size + (int)length) != 0) {
-			target->memory_full = true;
-			return CAIRO_STATUS_NO_MEMORY;
-		}
-		memcpy(target->memory + target->memory_size, data, length);
-		target->memory_size += (int)length;
-		return CAIRO_STATUS_SUCCESS;
-	}
-	if (fwrite(data, 1, length, target->stream) != length) {
-		if (target->error == 0)
-			target->error = errno != 0 ? errno : EIO;
-		return CAIRO_STATUS_WRITE_ERROR;
-	}
-	return CAIRO_STATUS_SUCCESS;
-}
-
-/// Cairo names the SVG's top group after the surface's process-wide serial
-/// number ("surface1" for a process's first surface, "surface57" later), so the
-/// same drawing would not give the same bytes twice in one process. The names
-/// are renumbered by first appearance, which keeps references between them
-/// intact. Returns false when a write fails.
-static bool write_svg_renumbered(FILE *out, const char *text, size_t size)
-{
-	static const char token[] = "surface";
-	const size_t token_length = sizeof token - 1;
-	enum { MAX_NAMES = 64 };
-	long seen[MAX_NAMES];
-	int seen_count = 0;
-	size_t written = 0; // text[0, written) is out already
-	size_t i = 0;
-	while (i + token_length < size) {
-		if (memcmp(text + i, token, token_length) != 0 || !isdigit((unsigned char)text[i + token_length])) {
-			++i;
-			continue;
-		}
-		size_t end = i + token_length;
-		long number = 0;
-		for (; end < size && isdigit((unsigned char)text[end]); ++end)
-			number = number < 100000000L ? number * 10 + (text[end] - '0') : number;
-		int rank = -1;
-		for (int k = 0; k < seen_count && rank < 0; ++k)
-			if (seen[k] == number)
-				rank = k;
-		if (rank < 0 && seen_count < MAX_NAMES) {
-			seen[seen_count] = number;
-			rank = seen_count++;
-		}
-		if (rank >= 0) { // beyond MAX_NAMES distinct names the rest stay as Cairo wrote them
-			size_t prefix = i + token_length - written;
-			if (fwrite(text + written, 1, prefix, out) != prefix || fprintf(out, "%d", rank + 1) < 0)
-				return false;
-			written = end;
-		}
-		i = end;
-	}
-	return fwrite(text + written, 1, size - written, out) == size - written;
+	bool ok = target->svg ? write_svg_renamed(target, data, length) : put_bytes(target, data, length);
+	return ok ? CAIRO_STATUS_SUCCESS : CAIRO_STATUS_WRITE_ERROR;
 }
 
 static const char *format_name(plume_image_format format)
@@ -482,7 +522,11 @@ static cairo_status_t paint(cairo_surface_t *surface, const plume_feather *const
                             const plume_render2d_def *def, bool *out_of_memory)
 {
 	cairo_t *cr = cairo_create(surface);
-	renderer r = {.cr = cr, .def = def, .view = fit_view(def, union_info(feathers, count))};
+	// No feather (count 0): the def's view frames the empty picture.
+	plume_feather_info info = {0};
+	if (count > 0)
+		info = union_info(feathers, count);
+	renderer r = {.cr = cr, .def = def, .view = fit_view(def, info)};
 	// SOURCE so that a translucent background replaces the surface's
 	// transparent black instead of blending with it.
 	cairo_set_operator(cr, CAIRO_OPERATOR_SOURCE);
@@ -534,11 +578,9 @@ static plume_status render_vector(const plume_feather *const *feathers, int coun
 	plume_status result = plume_atomic_open(&file, path, err);
 	if (result != PLUME_OK)
 		return result;
-	stream_closure closure = {.stream = file.stream};
+	stream_closure closure = {.stream = file.stream, .svg = format == PLUME_IMAGE_SVG};
 	cairo_surface_t *surface;
 	if (format == PLUME_IMAGE_SVG) {
-		// Into memory first, to renumber the surface names (write_svg_renumbered).
-		closure.stream = NULL;
 		surface = cairo_svg_surface_create_for_stream(write_to_stream, &closure, def->width, def->height);
 	} else {
 		surface = cairo_pdf_surface_create_for_stream(write_to_stream, &closure, def->width, def->height);
@@ -556,14 +598,9 @@ static plume_status render_vector(const plume_feather *const *feathers, int coun
 	if (status == CAIRO_STATUS_SUCCESS)
 		status = cairo_surface_status(surface);
 	cairo_surface_destroy(surface);
-	if (status == CAIRO_STATUS_SUCCESS && closure.memory_full)
-		status = CAIRO_STATUS_NO_MEMORY;
-	if (status == CAIRO_STATUS_SUCCESS && format == PLUME_IMAGE_SVG &&
-	    !write_svg_renumbered(file.stream, closure.memory, (size_t)closure.memory_size)) {
-		closure.error = errno != 0 ? errno : EIO;
+	// A name at the very end of the document.
+	if (status == CAIRO_STATUS_SUCCESS && closure.svg && closure.names.matched > 0 && !flush_name(&closure))
 		status = CAIRO_STATUS_WRITE_ERROR;
-	}
-	plume_free(closure.memory);
 	if (status != CAIRO_STATUS_SUCCESS || closure.error != 0) {
 		plume_atomic_abort(&file);
 		return cairo_failure(path, format, status != CAIRO_STATUS_SUCCESS ? status : CAIRO_STATUS_WRITE_ERROR, &closure,
@@ -584,9 +621,13 @@ plume_status plume_render2d_feathers(const plume_feather *const *feathers, int c
 {
 	PLUME_ASSERT_DEF(def);
 	PLUME_ASSERT(count >= 0 && (count == 0 || feathers != NULL));
-	PLUME_ASSERT(feathers != NULL && def != NULL && path != NULL);
-	if (count < 1)
-		return plume_error_set(err, PLUME_ERROR_SPEC, "render2d: no feather to draw");
+	PLUME_ASSERT(def != NULL && path != NULL);
+	// No feather at all is a picture of the background, when the def says what it frames.
+	bool framed = def->view_max.x > def->view_min.x && def->view_max.y > def->view_min.y;
+	if (count < 1 && !framed)
+		return plume_error_set(err, PLUME_ERROR_SPEC,
+		                       "render2d: no feather to draw (and no view_min, view_max to frame "
+		                       "an empty picture)");
 	plume_status status = validate_def(def, err);
 	if (status != PLUME_OK)
 		return status;
@@ -595,7 +636,9 @@ plume_status plume_render2d_feathers(const plume_feather *const *feathers, int c
 	for (int i = 0; i < count; ++i)
 		if (plume_feather_get_info(feathers[i]).shaft_sample_count <= 0)
 			return plume_error_set(err, PLUME_ERROR_SPEC, "render2d: the feather is empty (it has no shaft)");
-	plume_feather_info info = union_info(feathers, count);
+	plume_feather_info info = {0};
+	if (count > 0)
+		info = union_info(feathers, count);
 	if (!(isfinite(info.bounds_min.x) && isfinite(info.bounds_min.y) && isfinite(info.bounds_max.x) &&
 	      isfinite(info.bounds_max.y)))
 		return plume_error_set(err, PLUME_ERROR_NUMERIC, "render2d: the feather's bounds are not finite");
