@@ -106,8 +106,8 @@ static plume_feather *small_feather(int depth)
 	return feather;
 }
 
-typedef enum format { FORMAT_OBJ, FORMAT_USDA, FORMAT_JSON } format;
-static const char *const format_extensions[] = {"obj", "usda", "json"};
+typedef enum format { FORMAT_OBJ, FORMAT_USDA, FORMAT_JSON, FORMAT_GLB } format;
+static const char *const format_extensions[] = {"obj", "usda", "json", "glb"};
 
 static plume_status write_format(format which, const plume_feather *feather, const char *path, plume_error *err)
 {
@@ -115,6 +115,7 @@ static plume_status write_format(format which, const plume_feather *feather, con
 	case FORMAT_OBJ: return plume_write_obj(feather, path, err);
 	case FORMAT_USDA: return plume_write_usda(feather, path, err);
 	case FORMAT_JSON: return plume_write_json(feather, path, err);
+	case FORMAT_GLB: return plume_write_glb(feather, NULL, path, err);
 	}
 	return PLUME_ERROR_UNSUPPORTED;
 }
@@ -295,13 +296,15 @@ static void test_json_refuses_non_finite_numbers(void **state)
 /// OBJ and USD print numbers with "%.9g", which writes "nan" and "inf" that no reader takes:
 /// both writers refuse such a feather (USD also a number past float, which it holds as inf),
 /// name the piece, and leave the file that was there.
-static void test_obj_usda_refuse_non_finite_numbers(void **state)
+static void test_obj_usda_glb_refuse_non_finite_numbers(void **state)
 {
 	(void)state;
 	int64_t before = plume_bytes_in_use();
 	char dir[256], path[512];
 	test_make_temp_dir(dir, sizeof dir);
-	for (int which = FORMAT_OBJ; which <= FORMAT_USDA; ++which) {
+	static const format formats[] = {FORMAT_OBJ, FORMAT_USDA, FORMAT_GLB};
+	for (size_t f = 0; f < sizeof formats / sizeof formats[0]; ++f) {
+		format which = formats[f];
 		snprintf(path, sizeof path, "%s/feather.%s", dir, format_extensions[which]);
 		plume_feather *good = small_feather(1);
 		write_ok((format)which, good, path);
@@ -324,12 +327,12 @@ static void test_obj_usda_refuse_non_finite_numbers(void **state)
 				feather->uv[feather->barbules[1].curve.first].y = NAN;
 				named = ": barbule 1 (point 0) has a NaN or infinite number";
 				break;
-			default: // finite, but inf as USD's float (OBJ prints the double)
+			default: // finite, but inf as USD's and glTF's float (OBJ prints the double)
 				feather->points[feather->barbs[0].curve.first].z = 1e39;
 				named = ": barb 0 (point 0) has a NaN or infinite number (or one past single precision";
 				break;
 			}
-			if (which == FORMAT_USDA || piece < 3) {
+			if (which != FORMAT_OBJ || piece < 3) {
 				plume_error err;
 				assert_int_equal(write_format((format)which, feather, path, &err), PLUME_ERROR_NUMERIC);
 				if (strstr(err.message, named) == NULL || strstr(err.message, path) == NULL)
@@ -1005,7 +1008,7 @@ int main(void)
 	    cmocka_unit_test(test_json_binary_round_trip),
 	    cmocka_unit_test(test_json_number_text),
 	    cmocka_unit_test(test_json_refuses_non_finite_numbers),
-	    cmocka_unit_test(test_obj_usda_refuse_non_finite_numbers),
+	    cmocka_unit_test(test_obj_usda_glb_refuse_non_finite_numbers),
 	    cmocka_unit_test(test_json_binary_errors),
 	    cmocka_unit_test(test_same_seed_same_bytes_other_seed_other_bytes),
 	    cmocka_unit_test(test_obj_parses_back_to_the_feather),

@@ -3,6 +3,8 @@
 #define _POSIX_C_SOURCE 200809L
 #include "export.h"
 
+#include <math.h>
+
 #include "../core/alloc.h"
 #include "../model/feather_internal.h"
 
@@ -83,4 +85,56 @@ void plume_curve_set_count(const plume_feather *feather, plume_curve_set set, in
 			*points += curve.count;
 		}
 	}
+}
+
+static bool number_fits(double value, bool single) { return single ? isfinite((float)value) : isfinite(value); }
+
+static bool vec_fits(plume_vec3 v, bool single)
+{
+	return number_fits(v.x, single) && number_fits(v.y, single) && number_fits(v.z, single);
+}
+
+static bool find_non_finite(const plume_feather *feather, bool single, const char *prefix, char *what, size_t size)
+{
+	int count = plume_feather_get_info(feather).shaft_sample_count;
+	const plume_shaft_sample *shaft = plume_feather_shaft(feather);
+	for (int i = 0; i < count; ++i)
+		if (!vec_fits(shaft[i].position, single) || !vec_fits(shaft[i].tangent, single) ||
+		    !vec_fits(shaft[i].normal, single) || !vec_fits(shaft[i].binormal, single) ||
+		    !number_fits(shaft[i].width, single) || !number_fits(shaft[i].t, single)) {
+			snprintf(what, size, "%sshaft sample %d", prefix, i);
+			return true;
+		}
+	static const plume_curve_set sets[] = {PLUME_CURVES_BARBS, PLUME_CURVES_BARBULES};
+	static const char *const names[] = {"barb", "barbule"};
+	for (int k = 0; k < 2; ++k) {
+		int range = plume_curve_set_range(feather, sets[k]);
+		plume_polyline curve;
+		for (int i = 0; i < range; ++i) {
+			if (!plume_curve_set_get(feather, sets[k], i, &curve))
+				continue;
+			for (int j = 0; j < curve.count; ++j)
+				if (!vec_fits(curve.points[j], single) || !vec_fits(curve.normals[j], single) ||
+				    !number_fits(curve.widths[j], single) || !number_fits(curve.uv[j].x, single) ||
+				    !number_fits(curve.uv[j].y, single)) {
+					snprintf(what, size, "%s%s %d (point %d)", prefix, names[k], i, j);
+					return true;
+				}
+		}
+	}
+	const plume_feather *after = plume_feather_afterfeather(feather);
+	if (after == NULL)
+		return false;
+	if (!isfinite(plume_feather_afterfeather_t(feather))) {
+		snprintf(what, size, "%safterfeather's attach_t", prefix);
+		return true;
+	}
+	char longer[256];
+	snprintf(longer, sizeof longer, "%safterfeather's ", prefix);
+	return find_non_finite(after, single, longer, what, size);
+}
+
+bool plume_feather_find_non_finite(const plume_feather *feather, bool single_precision, char *what, size_t size)
+{
+	return find_non_finite(feather, single_precision, "", what, size);
 }

@@ -66,4 +66,12 @@ bool plume_curve_set_get(const plume_feather *feather, plume_curve_set set, int 
 /// Curves and points that plume_curve_set_get yields for the set.
 void plume_curve_set_count(const plume_feather *feather, plume_curve_set set, int *curves, int64_t *points);
 
+/// The first piece of the feather (or of its afterfeathers) holding a number no exporter can
+/// write, described in what ("barb 12 (point 3)", "afterfeather's shaft sample 0"); false when
+/// there is none. A number is NaN or infinite, or, for files of single precision (USD's float
+/// attributes, glTF's accessors), past FLT_MAX, where the float rounds to infinity. "%.9g"
+/// would print "nan" and "inf", which no OBJ or USD reader takes for a number, and glTF's
+/// bounds would be infinite. Checked before a file is opened: nothing is written.
+bool plume_feather_find_non_finite(const plume_feather *feather, bool single_precision, char *what, size_t size);
+
 #endif

@@ -8,12 +8,14 @@
 // shades the ribbon as the curve it stands for. Triangles wind counter-
 // clockwise seen from n. Colours are converted from sRGB to linear, as glTF's
 // COLOR_0 is linear.
+#define _POSIX_C_SOURCE 200809L // export.h: locale_t
 #include <math.h>
 #include <string.h>
 
 #include "../core/asserts.h"
 #include "../core/alloc.h"
 #include "../model/feather_internal.h"
+#include "export.h"
 #include "glb.h"
 #include "render/texture_png.h"
 #include "plume/embed.h"
@@ -620,6 +622,13 @@ plume_status plume_write_glb(const plume_feather *feather, const plume_gltf_def 
 	plume_gltf_def defaults = plume_gltf_default_def();
 	if (def == NULL)
 		def = &defaults;
+	// Checked before the file is opened: nothing is written, and path keeps what it held.
+	char what[320];
+	if (plume_feather_find_non_finite(feather, true, what, sizeof what))
+		return plume_error_set(err, PLUME_ERROR_NUMERIC,
+		                       "%s: %s has a NaN or infinite number (or one past single precision, 3.4e38), which "
+		                       "glTF's float accessors cannot hold",
+		                       path, what);
 	plume_glb glb;
 	int materials[2];
 	plume_status begun = begin_curves_glb(&glb, def, path, materials, err);

@@ -85,48 +85,11 @@ static void write_feather(FILE *stream, const plume_feather *feather, const char
 	}
 }
 
-static bool vec_is_finite(plume_vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
-
-/// The first piece of the feather (or its afterfeathers, named by prefix) with a NaN or infinite
-/// number that the file would hold, described in what; false when there is none. "%.9g" would print
-/// "nan" and "inf", which no OBJ reader takes for a number (Blender reads them as 0 or fails).
-static bool find_non_finite(const plume_feather *feather, const char *prefix, char *what, size_t size)
-{
-	int count = plume_feather_get_info(feather).shaft_sample_count;
-	const plume_shaft_sample *shaft = plume_feather_shaft(feather);
-	for (int i = 0; i < count; ++i)
-		if (!vec_is_finite(shaft[i].position) || !isfinite(shaft[i].t)) {
-			snprintf(what, size, "%sshaft sample %d", prefix, i);
-			return true;
-		}
-	static const plume_curve_set sets[] = {PLUME_CURVES_BARBS, PLUME_CURVES_BARBULES};
-	static const char *const names[] = {"barb", "barbule"};
-	for (int k = 0; k < 2; ++k) {
-		int range = plume_curve_set_range(feather, sets[k]);
-		plume_polyline curve;
-		for (int i = 0; i < range; ++i) {
-			if (!plume_curve_set_get(feather, sets[k], i, &curve))
-				continue;
-			for (int j = 0; j < curve.count; ++j)
-				if (!vec_is_finite(curve.points[j]) || !isfinite(curve.uv[j].x) || !isfinite(curve.uv[j].y)) {
-					snprintf(what, size, "%s%s %d (point %d)", prefix, names[k], i, j);
-					return true;
-				}
-		}
-	}
-	const plume_feather *after = plume_feather_afterfeather(feather);
-	if (after == NULL)
-		return false;
-	char longer[256];
-	snprintf(longer, sizeof longer, "%safterfeather's ", prefix);
-	return find_non_finite(after, longer, what, size);
-}
-
 plume_status plume_write_obj(const plume_feather *feather, const char *path, plume_error *err)
 {
 	// Checked before the file is opened: nothing is written, and path keeps what it held.
 	char what[320];
-	if (find_non_finite(feather, "", what, sizeof what))
+	if (plume_feather_find_non_finite(feather, false, what, sizeof what))
 		return plume_error_set(err, PLUME_ERROR_NUMERIC, "%s: %s has a NaN or infinite number, which OBJ cannot hold",
 		                       path, what);
 	plume_text_file text;

@@ -294,57 +294,11 @@ static void write_feather(FILE *stream, const plume_feather *feather, const char
 	fputs("}\n", stream);
 }
 
-/// Whether value is finite as the float the file holds (a double past FLT_MAX rounds to inf).
-static bool float_is_finite(double value) { return isfinite((float)value); }
-
-static bool vec_is_float(plume_vec3 v) { return float_is_finite(v.x) && float_is_finite(v.y) && float_is_finite(v.z); }
-
-/// The first piece of the feather (or its afterfeathers, named by prefix) with a number that is
-/// NaN or infinite as a float, described in what; false when there is none. "%.9g" would print
-/// "nan" and "inf", which usdcat refuses, and the extent would be infinite.
-static bool find_non_finite(const plume_feather *feather, const char *prefix, char *what, size_t size)
-{
-	int count = plume_feather_get_info(feather).shaft_sample_count;
-	const plume_shaft_sample *shaft = plume_feather_shaft(feather);
-	for (int i = 0; i < count; ++i)
-		if (!vec_is_float(shaft[i].position) || !float_is_finite(shaft[i].width) || !float_is_finite(shaft[i].t)) {
-			snprintf(what, size, "%sshaft sample %d", prefix, i);
-			return true;
-		}
-	static const plume_curve_set sets[] = {PLUME_CURVES_BARBS, PLUME_CURVES_BARBULES};
-	static const char *const names[] = {"barb", "barbule"};
-	for (int k = 0; k < 2; ++k) {
-		int range = plume_curve_set_range(feather, sets[k]);
-		plume_polyline curve;
-		for (int i = 0; i < range; ++i) {
-			if (!plume_curve_set_get(feather, sets[k], i, &curve))
-				continue;
-			for (int j = 0; j < curve.count; ++j)
-				if (!vec_is_float(curve.points[j]) || !vec_is_float(curve.normals[j]) ||
-				    !float_is_finite(curve.widths[j]) || !float_is_finite(curve.uv[j].x) ||
-				    !float_is_finite(curve.uv[j].y)) {
-					snprintf(what, size, "%s%s %d (point %d)", prefix, names[k], i, j);
-					return true;
-				}
-		}
-	}
-	const plume_feather *after = plume_feather_afterfeather(feather);
-	if (after == NULL)
-		return false;
-	if (!isfinite(plume_feather_afterfeather_t(feather))) {
-		snprintf(what, size, "%safterfeather's attach_t", prefix);
-		return true;
-	}
-	char longer[256];
-	snprintf(longer, sizeof longer, "%safterfeather's ", prefix);
-	return find_non_finite(after, longer, what, size);
-}
-
 plume_status plume_write_usda(const plume_feather *feather, const char *path, plume_error *err)
 {
 	// Checked before the file is opened: nothing is written, and path keeps what it held.
 	char what[320];
-	if (find_non_finite(feather, "", what, sizeof what))
+	if (plume_feather_find_non_finite(feather, true, what, sizeof what))
 		return plume_error_set(err, PLUME_ERROR_NUMERIC,
 		                       "%s: %s has a NaN or infinite number (or one past single precision, 3.4e38), which "
 		                       "USD's float attributes cannot hold",
