@@ -40,6 +40,8 @@ int cli_usage_error(const char *command, const char *format, ...)
 
 /// Parses "png,svg,obj"; false (and a usage message) on an unknown name.
 bool cli_parse_formats(const char *command, const char *list, unsigned *formats);
+/// The formats' names, comma-separated ("png, svg"), into text.
+void cli_format_list(unsigned formats, char *text, size_t size);
 
 /// Parses "WxH" with both in [16, 16384].
 bool cli_parse_size(const char *command, const char *text, int *width, int *height);

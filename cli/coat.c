@@ -142,20 +142,6 @@ static double output_bytes(const plume_coat *coat, unsigned formats, const plume
 	return most;
 }
 
-/// The formats asked for, by name ("png, svg").
-static void format_names(unsigned formats, char *text, size_t size)
-{
-	static const struct {
-		unsigned bit;
-		const char *name;
-	} names[] = {{CLI_FORMAT_PNG, "png"}, {CLI_FORMAT_SVG, "svg"},   {CLI_FORMAT_PDF, "pdf"},
-	             {CLI_FORMAT_OBJ, "obj"}, {CLI_FORMAT_USDA, "usda"}, {CLI_FORMAT_GLB, "glb"}};
-	text[0] = '\0';
-	for (size_t i = 0; i < sizeof names / sizeof names[0]; ++i)
-		if ((formats & names[i].bit) != 0)
-			snprintf(text + strlen(text), size - strlen(text), "%s%s", text[0] != '\0' ? ", " : "", names[i].name);
-}
-
 /// PLUME_ERROR_LIMIT when the coat (what the library holds now) and its largest output pass the limit.
 static plume_status check_outputs(const char *spec, const plume_coat *coat, unsigned formats,
                                   const plume_render2d_def *image, uint64_t max_memory, plume_error *err)
@@ -165,7 +151,7 @@ static plume_status check_outputs(const char *spec, const plume_coat *coat, unsi
 	if (held + outputs <= limit)
 		return PLUME_OK;
 	char names[64];
-	format_names(formats, names, sizeof names);
+	cli_format_list(formats, names, sizeof names);
 	return plume_error_set(err, PLUME_ERROR_LIMIT,
 	                       "%s: writing %s (--format, --size %dx%d%s) takes up to %.3g GB besides the coat's %.3g GB: "
 	                       "%.3g GB in all; the limit is %.3g GB (raise it with --max-memory, or write fewer or "

@@ -92,16 +92,8 @@ static plume_status check_outputs(const char *spec, const plume_feather *feather
 	double held = (double)plume_bytes_in_use(), outputs = output_bytes(feather, formats, images);
 	if (held + outputs <= limit)
 		return PLUME_OK;
-	static const struct {
-		unsigned bit;
-		const char *name;
-	} names[] = {{CLI_FORMAT_PNG, "png"},   {CLI_FORMAT_SVG, "svg"},   {CLI_FORMAT_PDF, "pdf"}, {CLI_FORMAT_OBJ, "obj"},
-	             {CLI_FORMAT_USDA, "usda"}, {CLI_FORMAT_JSON, "json"}, {CLI_FORMAT_GLB, "glb"}};
-	char list[64] = "";
-	for (size_t i = 0; i < sizeof names / sizeof names[0]; ++i)
-		if ((formats & names[i].bit) != 0)
-			snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", list[0] != '\0' ? ", " : "",
-			         names[i].name);
+	char list[64];
+	cli_format_list(formats, list, sizeof list);
 	return plume_error_set(err, PLUME_ERROR_LIMIT,
 	                       "%s: writing %s (--format%s) takes up to %.3g GB besides the feather's %.3g GB: %.3g GB in "
 	                       "all; the limit is %.3g GB (raise it with --max-memory, or write fewer or smaller formats)",

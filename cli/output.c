@@ -72,6 +72,16 @@ static const struct {
     {"usda", CLI_FORMAT_USDA}, {"json", CLI_FORMAT_JSON}, {"glb", CLI_FORMAT_GLB},
 };
 
+void cli_format_list(unsigned formats, char *text, size_t size)
+{
+	if (size > 0)
+		text[0] = '\0';
+	for (size_t i = 0; i < sizeof format_names / sizeof format_names[0]; ++i)
+		if ((formats & format_names[i].bit) != 0)
+			snprintf(text + strlen(text), size - strlen(text), "%s%s", text[0] != '\0' ? ", " : "",
+			         format_names[i].name);
+}
+
 bool cli_parse_formats(const char *command, const char *list, unsigned *formats)
 {
 	*formats = 0;

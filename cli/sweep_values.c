@@ -77,19 +77,15 @@ json_t *sweep_run_value(const sweep *s, int param, int index)
 	return json_deep_copy(json_array_get(p->values, k));
 }
 
-/// CSV text of a scalar: numbers to 17 digits (they round-trip), strings quoted when needed.
+/// CSV text of a scalar: numbers in the fewest digits that round-trip (plume_lab_format_number),
+/// strings quoted when needed.
 void sweep_csv_value(char *out, size_t size, const json_t *value)
 {
 	if (json_is_integer(value))
 		snprintf(out, size, "%lld", (long long)json_integer_value(value));
 	else if (json_is_real(value)) {
-		// The shortest of 15, 16, 17 digits that reads back as the same double.
-		double x = json_real_value(value);
-		for (int digits = 15; digits <= 17; ++digits) {
-			snprintf(out, size, "%.*g", digits, x);
-			if (strtod(out, NULL) == x)
-				break;
-		}
+		char text[PLUME_LAB_NUMBER_TEXT];
+		snprintf(out, size, "%s", plume_lab_format_number(text, sizeof text, json_real_value(value)));
 	} else if (json_is_true(value))
 		snprintf(out, size, "true");
 	else if (json_is_false(value))

@@ -1,7 +1,6 @@
 // Plots of the lab's curves with PLplot (a real plotting library, as the issue asks):
 // PNG through the "mem" raster driver (Debian's PLplot has no pngcairo driver) and
 // Cairo's PNG writer, SVG through the "svg" driver. And CSV tables.
-#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -12,6 +11,7 @@
 #include "core/alloc.h"
 #include "core/asserts.h"
 #include "core/atomic_file.h"
+#include "core/number_text.h"
 #include "plume/lab.h"
 #include "render/cairo_png.h"
 
@@ -137,9 +137,9 @@ static plume_status draw(const plume_plot *plot, plume_error *err)
 		bool left = plot->legend == PLUME_LEGEND_TOP_LEFT || plot->legend == PLUME_LEGEND_BOTTOM_LEFT;
 		PLINT position = (top ? PL_POSITION_TOP : PL_POSITION_BOTTOM) | (left ? PL_POSITION_LEFT : PL_POSITION_RIGHT) |
 		                 PL_POSITION_INSIDE;
-		pllegend(&legend_width, &legend_height, PL_LEGEND_BOUNDING_BOX, position, 0.02, 0.02, 0.08, 0, 1, 1, 0, 0, n, opts, 1.0,
-		         0.8, 2.0, 0.0, text_colors, texts, NULL, NULL, NULL, NULL, line_colors, line_styles, line_widths,
-		         symbol_colors, symbol_scales, symbol_numbers, symbols);
+		pllegend(&legend_width, &legend_height, PL_LEGEND_BOUNDING_BOX, position, 0.02, 0.02, 0.08, 0, 1, 1, 0, 0, n,
+		         opts, 1.0, 0.8, 2.0, 0.0, text_colors, texts, NULL, NULL, NULL, NULL, line_colors, line_styles,
+		         line_widths, symbol_colors, symbol_scales, symbol_numbers, symbols);
 	}
 	return PLUME_OK;
 }
@@ -225,16 +225,7 @@ plume_status plume_lab_plot(const plume_plot *plot, const char *png_path, const 
 const char *plume_lab_format_number(char *text, size_t size, double value)
 {
 	PLUME_ASSERT(text != NULL && size >= PLUME_LAB_NUMBER_TEXT);
-	// A normal double whose shortest round-trip form has 15 digits or fewer is given back by
-	// "%.15g" (DBL_DIG is 15, and %g drops the trailing zeros), so trying 15, 16 and 17
-	// digits finds the shortest form: "0.1", not "0.10000000000000001". Subnormals hold
-	// fewer digits (5e-324 is "5e-324", not "4.94065645841247e-324"): they try from 1.
-	for (int digits = fabs(value) < DBL_MIN && value != 0.0 ? 1 : 15; digits <= 17; ++digits) {
-		snprintf(text, size, "%.*g", digits, value);
-		if (!isfinite(value) || strtod(text, NULL) == value)
-			break;
-	}
-	return text;
+	return plume_number_shortest(text, size, value);
 }
 
 plume_status plume_lab_write_csv(const char *path, const char *header, const double *const *columns, int column_count,

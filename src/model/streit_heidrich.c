@@ -22,6 +22,7 @@
 #include <string.h>
 
 #include "../core/asserts.h"
+#include "../core/number_text.h"
 #include "../core/alloc.h"
 #include "../core/vec_inline.h"
 #include "feather_internal.h"
@@ -125,25 +126,13 @@ plume_sh_lod plume_sh_default_lod(void)
 // ---------------------------------------------------------------------------
 // Validation
 
-/// value with the digits it takes to show it outside [lo, hi]: "%g" printed 180.0001 as "180",
-/// a value the message then called not allowed (six digits, then more until the text is no bound).
-static const char *outside(char *out, size_t size, double value, double lo, double hi)
-{
-	for (int digits = 6;; ++digits) {
-		snprintf(out, size, "%.*g", digits, value);
-		double printed = strtod(out, NULL);
-		if (digits >= 17 || printed == value || (printed != lo && printed != hi))
-			return out;
-	}
-}
-
 /// "is value, allowed [lo, hi]", with "(" for a range open at lo (value must be above it).
 static plume_status fail_range(plume_error *err, const char *prefix, const char *key, double value, double lo,
                                double hi, bool open_lo)
 {
 	char text[32];
 	return plume_error_set(err, PLUME_ERROR_SPEC, "%s.%s is %s, allowed %c%g, %g]", prefix, key,
-	                       outside(text, sizeof text, value, lo, hi), open_lo ? '(' : '[', lo, hi);
+	                       plume_number_outside(text, sizeof text, value, lo, hi), open_lo ? '(' : '[', lo, hi);
 }
 
 static plume_status check_length(plume_error *err, const char *prefix, const char *key, double value, bool zero_ok)
@@ -165,7 +154,7 @@ static plume_status check_profile(const plume_sh_length_profile *profile, const 
 		char text[32];
 		if (profile->count > 1 && !(p >= 0.0 && p <= 1.0))
 			return plume_error_set(err, PLUME_ERROR_SPEC, "%s.%s[%d] is at rachis position %s, allowed [0, 1]", prefix,
-			                       key, i, outside(text, sizeof text, p, 0.0, 1.0));
+			                       key, i, plume_number_outside(text, sizeof text, p, 0.0, 1.0));
 		if (profile->count > 1 && i > 0 && !(p > profile->position[i - 1]))
 			return plume_error_set(err, PLUME_ERROR_SPEC, "%s.%s[%d]: rachis positions must increase (%g follows %g)",
 			                       prefix, key, i, p, profile->position[i - 1]);
@@ -187,7 +176,7 @@ static plume_status check_key_barb(const plume_sh_key_barb *key, const char *pre
 	char text[32];
 	if (!(key->position >= 0.0 && key->position <= 1.0))
 		return plume_error_set(err, PLUME_ERROR_SPEC, "%s.key_barbs[%d].position is %s, allowed [0, 1]", prefix, index,
-		                       outside(text, sizeof text, key->position, 0.0, 1.0));
+		                       plume_number_outside(text, sizeof text, key->position, 0.0, 1.0));
 	if (key->position < previous)
 		return plume_error_set(err, PLUME_ERROR_SPEC,
 		                       "%s.key_barbs[%d].position is %g, below the key barb before it (%g); key barbs go "
@@ -202,7 +191,7 @@ static plume_status check_key_barb(const plume_sh_key_barb *key, const char *pre
 			                       index, i);
 	if (!(key->plumulaceous >= 0.0 && key->plumulaceous <= 1.0))
 		return plume_error_set(err, PLUME_ERROR_SPEC, "%s.key_barbs[%d].plumulaceous is %s, allowed [0, 1]", prefix,
-		                       index, outside(text, sizeof text, key->plumulaceous, 0.0, 1.0));
+		                       index, plume_number_outside(text, sizeof text, key->plumulaceous, 0.0, 1.0));
 	return PLUME_OK;
 }
 
@@ -230,7 +219,7 @@ plume_status sh_params_validate(const plume_sh_params *p, const char *prefix, pl
 			if (!(angle > 0.0 && angle <= PI))
 				return plume_error_set(err, PLUME_ERROR_SPEC, "%s.%s is %s, allowed (0, 180]", prefix,
 				                       angle_keys[side][end],
-				                       outside(text, sizeof text, angle * 180.0 / PI, 0.0, 180.0));
+				                       plume_number_outside(text, sizeof text, angle * 180.0 / PI, 0.0, 180.0));
 		}
 	static const char *const length_keys[2] = {"barb_length", "barb_length_right"};
 	for (int side = 0; side < 2; ++side)

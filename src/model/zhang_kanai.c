@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "../core/asserts.h"
+#include "../core/number_text.h"
 #include "../core/alloc.h"
 #include "feather_internal.h"
 #include "zhang_kanai_internal.h"
@@ -69,24 +70,12 @@ plume_zk_def plume_zk_default_def(void)
 // ---------------------------------------------------------------------------
 // Validation: messages name the spec's JSON path.
 
-/// value with the digits it takes to show it outside [lo, hi]: "%g" printed a growth_stage of
-/// 1.0000001 as "1", a value the message then called not allowed.
-static const char *outside(char *out, size_t size, double value, double lo, double hi)
-{
-	for (int digits = 6;; ++digits) {
-		snprintf(out, size, "%.*g", digits, value);
-		double printed = strtod(out, NULL);
-		if (digits >= 17 || printed == value || (printed != lo && printed != hi))
-			return out;
-	}
-}
-
 static plume_status check_range(double value, double lo, double hi, const char *path, plume_error *err)
 {
 	char text[32];
 	if (!(value >= lo && value <= hi))
 		return plume_error_set(err, PLUME_ERROR_SPEC, "%s is %s, allowed [%g, %g]", path,
-		                       outside(text, sizeof text, value, lo, hi), lo, hi);
+		                       plume_number_outside(text, sizeof text, value, lo, hi), lo, hi);
 	return PLUME_OK;
 }
 
@@ -201,13 +190,13 @@ plume_status plume_zk_def_validate(const plume_zk_def *def, plume_error *err)
 	char text[32];
 	if (!(def->rachis_taper > 0.0 && def->rachis_taper <= 1.0))
 		return plume_error_set(err, PLUME_ERROR_SPEC, "$.rachis_taper is %s, allowed (0, 1]",
-		                       outside(text, sizeof text, def->rachis_taper, 0.0, 1.0));
+		                       plume_number_outside(text, sizeof text, def->rachis_taper, 0.0, 1.0));
 	if (!(def->theta_distal > 0.0 && def->theta_distal < 180.0 * deg))
 		return plume_error_set(err, PLUME_ERROR_SPEC, "$.theta_distal_deg is %s, allowed (0, 180)",
-		                       outside(text, sizeof text, def->theta_distal / deg, 0.0, 180.0));
+		                       plume_number_outside(text, sizeof text, def->theta_distal / deg, 0.0, 180.0));
 	if (!(def->theta_proximal > 0.0 && def->theta_proximal < 180.0 * deg))
 		return plume_error_set(err, PLUME_ERROR_SPEC, "$.theta_proximal_deg is %s, allowed (0, 180)",
-		                       outside(text, sizeof text, def->theta_proximal / deg, 0.0, 180.0));
+		                       plume_number_outside(text, sizeof text, def->theta_proximal / deg, 0.0, 180.0));
 	if ((status = check_range(def->azimuth / deg, 0.0, 180.0, "$.azimuth_deg", err)) != PLUME_OK)
 		return status;
 	if (def->split_count < 0 || def->split_count > PLUME_ZK_MAX_SPLITS)
@@ -236,7 +225,7 @@ plume_status plume_zk_def_validate(const plume_zk_def *def, plume_error *err)
 			return status;
 		if (!(fabs(split->angle) < 180.0 * deg))
 			return plume_error_set(err, PLUME_ERROR_SPEC, "$.splits[%d].angle_deg is %s, allowed (-180, 180)", k,
-			                       outside(text, sizeof text, split->angle / deg, -180.0, 180.0));
+			                       plume_number_outside(text, sizeof text, split->angle / deg, -180.0, 180.0));
 	}
 	return PLUME_OK;
 }
