@@ -551,6 +551,8 @@ static void test_camera_json(void **state)
 	    {"{\"camera\": {\"fov\": 40}}", "$.camera.fov: unknown key"},
 	    {"{\"camera\": {\"fov_deg\": 190}}", "$.camera.fov_deg"},
 	    {"{\"camera\": {\"size\": [10, 10]}}", "$.camera.size"},
+	    // Too large for an int: refused without converting it (UBSan found the cast).
+	    {"{\"camera\": {\"size\": [8e11, 16]}}", "$.camera.size: is [8e+11, 16], allowed whole pixels"},
 	    {"{\"lights\": [{\"direction\": [0, 0]}]}", "$.lights[0].direction"},
 	    {"{\"shading\": \"phong\"}", "$.shading"},
 	    {"{\"spp\": 0}", "$.spp"},

@@ -128,8 +128,10 @@ static void read_camera(plume_spec_reader *reader, const json_t *object, plume_c
 		      size[1] == floor(size[1])))
 			plume_spec_fail(reader, "$.camera.size", "is [%g, %g], allowed whole pixels in [16, 16384]", size[0],
 			                size[1]);
-		camera->width = (int)size[0];
-		camera->height = (int)size[1];
+		else { // only a size in range converts to int without overflow
+			camera->width = (int)size[0];
+			camera->height = (int)size[1];
+		}
 	}
 	// The framing leaves margin on each side of the image: at 0.45 nothing is left between.
 	if (plume_spec_number(reader, object, path, "margin", &camera->margin) &&
