@@ -45,6 +45,9 @@ void cli_format_list(unsigned formats, char *text, size_t size);
 
 /// Parses "WxH" with both in [16, 16384].
 bool cli_parse_size(const char *command, const char *text, int *width, int *height);
+/// Without --size: the width of a picture height pixels tall that frames a w x h view (margin: a
+/// fraction of the height on each side), in [256, 4096]; height when h is not > 0.
+int cli_image_width(double w, double h, int height, double margin);
 
 /// After the options: exactly one positional argument (named input in the message,
 /// "SPEC.json") and an output folder. False after printing the usage error.

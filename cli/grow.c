@@ -128,9 +128,7 @@ static plume_status write_frames(cli_output *output, const char *spec, plume_spe
 		if (image.width == 0) { // 1200 tall, as wide as the framing needs
 			double w = image.view_max.x - image.view_min.x, h = image.view_max.y - image.view_min.y;
 			image.height = 1200;
-			int width =
-			    h > 0.0 ? (int)(1200.0 * (1.0 - 2.0 * image.margin) * w / h + 2.0 * image.margin * 1200.0 + 0.5) : 1200;
-			image.width = width < 256 ? 256 : (width > 4096 ? 4096 : width);
+			image.width = cli_image_width(w, h, image.height, image.margin);
 		}
 	}
 	cli_writer *writer = NULL;

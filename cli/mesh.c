@@ -116,8 +116,12 @@ static plume_status draw_mesh(const plume_mesh *mesh, int width, int height, con
 	double margin = 20.0;
 	if (height <= 0)
 		height = 1200;
-	if (width <= 0)
-		width = (int)ceil(2.0 * margin + (height - 2.0 * margin) * span_x / span_y);
+	if (width <= 0) {
+		// As wide as the mesh needs, up to what --size allows; clamped as a double: a flat mesh's
+		// span_x / span_y (a 0.1 m row of guides 1e-8 m apart) is past an int.
+		double wide = ceil(2.0 * margin + (height - 2.0 * margin) * span_x / span_y);
+		width = !(wide <= 16384.0) ? 16384 : (int)wide;
+	}
 	if (width < 16)
 		width = 16;
 	view v = {fmin((width - 2.0 * margin) / span_x, (height - 2.0 * margin) / span_y), x0, y1, margin};

@@ -128,6 +128,15 @@ bool cli_parse_size(const char *command, const char *text, int *width, int *heig
 	return true;
 }
 
+int cli_image_width(double w, double h, int height, double margin)
+{
+	if (!(h > 0.0))
+		return height;
+	// Clamped as a double: a flat feather's w / h (a 200 m span over a 1e-6 m rachis) is past an int.
+	double width = height * (1.0 - 2.0 * margin) * w / h + 2.0 * margin * height + 0.5;
+	return !(width >= 256.0) ? 256 : (width > 4096.0 ? 4096 : (int)width);
+}
+
 bool cli_parse_seed(const char *command, const char *text, uint64_t *seed)
 {
 	char *end;
@@ -1224,9 +1233,7 @@ static plume_render2d_def image_def(const plume_feather *feather, const cli_imag
 	plume_feather_info info = plume_feather_get_info(feather);
 	double w = info.bounds_max.x - info.bounds_min.x, h = info.bounds_max.y - info.bounds_min.y;
 	def.height = 1200;
-	double inner = def.height * (1.0 - 2.0 * def.margin);
-	int width = h > 0.0 ? (int)(inner * w / h + 2.0 * def.margin * def.height + 0.5) : def.height;
-	def.width = width < 256 ? 256 : (width > 4096 ? 4096 : width);
+	def.width = cli_image_width(w, h, def.height, def.margin);
 	return def;
 }
 

@@ -814,9 +814,13 @@ int cli_simulate(int argc, char **argv)
 		case 'V': {
 			double azimuth, elevation;
 			char tail;
-			if (sscanf(optarg, "%lf,%lf%c", &azimuth, &elevation, &tail) != 2 || fabs(elevation) > 90)
+			// sscanf takes "nan" and "inf": a camera of NaN directions draws nothing.
+			if (sscanf(optarg, "%lf,%lf%c", &azimuth, &elevation, &tail) != 2 || !isfinite(azimuth) ||
+			    !(fabs(elevation) <= 90))
 				return cli_usage_error(
-				    "simulate", "--view takes AZIMUTH,ELEVATION in degrees (|elevation| <= 90), got '%s'", optarg);
+				    "simulate",
+				    "--view takes AZIMUTH,ELEVATION in degrees (a finite azimuth, |elevation| <= 90), got '%s'",
+				    optarg);
 			run.view.azimuth = azimuth * acos(-1.0) / 180;
 			run.view.elevation = elevation * acos(-1.0) / 180;
 			break;

@@ -93,6 +93,10 @@ extern const calibration_key sweep_calibration_keys[SWEEP_CALIBRATION_KEY_COUNT]
 
 typedef enum dist_kind { DIST_NONE, DIST_UNIFORM, DIST_NORMAL, DIST_LOGNORMAL } dist_kind;
 
+/// An integer parameter's values lie in [-2^53, 2^53], where a double holds every integer: they
+/// become JSON integers exactly (json_int_t), and a rounding or a cast of a larger one is not defined.
+#define SWEEP_MAX_INTEGER 9007199254740992.0
+
 typedef struct sweep_param {
 	char path[256]; ///< "$.material.barb_fraction"
 	char name[256]; ///< "material.barb_fraction", the CSV column

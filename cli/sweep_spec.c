@@ -128,7 +128,14 @@ static bool read_column(sweep *s, sweep_param *p, const json_t *item, const char
 			fclose(stream);
 			return sweep_error(s, "%s: %s line %d: column %s is '%s', not a number", where, path, row, column, field);
 		}
-		bool whole = p->integer || (json_is_integer(target) && x == floor(x));
+		if (p->integer && !(fabs(x) <= SWEEP_MAX_INTEGER)) {
+			free(line);
+			fclose(stream);
+			return sweep_error(s,
+			                   "%s: %s line %d: column %s is '%s'; an integer parameter takes values in [-2^53, 2^53]",
+			                   where, path, row, column, field);
+		}
+		bool whole = p->integer || (json_is_integer(target) && x == floor(x) && fabs(x) <= SWEEP_MAX_INTEGER);
 		json_array_append_new(p->values, whole ? json_integer((json_int_t)llround(x)) : json_real(x));
 	}
 	free(line);
@@ -174,6 +181,20 @@ static bool check_keys(const sweep *s, const json_t *object, const char *where, 
 		if (best != 0)
 			return sweep_error(s, "%s.%s is not a sweep key; did you mean \"%s\"?", where, key, nearest);
 	}
+	return true;
+}
+
+/// An integer parameter's distribution truncated to [-2^53, 2^53] (SWEEP_MAX_INTEGER): a "min" or "max"
+/// outside is refused, an unbounded side bounded there (and the probability inside is checked as for any
+/// truncation, sweep_check.c).
+static bool integer_range(const sweep *s, sweep_param *p, const char *where)
+{
+	if (isfinite(p->lo) && p->lo < -SWEEP_MAX_INTEGER)
+		return sweep_error(s, "%s.min is %g; an integer parameter takes values in [-2^53, 2^53]", where, p->lo);
+	if (isfinite(p->hi) && p->hi > SWEEP_MAX_INTEGER)
+		return sweep_error(s, "%s.max is %g; an integer parameter takes values in [-2^53, 2^53]", where, p->hi);
+	p->lo = fmax(p->lo, -SWEEP_MAX_INTEGER);
+	p->hi = fmin(p->hi, SWEEP_MAX_INTEGER);
 	return true;
 }
 
@@ -264,13 +285,17 @@ static bool parse_param(sweep *s, const json_t *item, int index)
 			return false;
 		if (count != floor(count) || count < 1 || count > 100000)
 			return sweep_error(s, "%s.count is %g, allowed a whole number in [1, 100000]", grid_where, count);
+		if (p->integer && !(fabs(from) <= SWEEP_MAX_INTEGER && fabs(to) <= SWEEP_MAX_INTEGER))
+			return sweep_error(s, "%s.%s is %g; an integer parameter takes values in [-2^53, 2^53]", grid_where,
+			                   fabs(from) <= SWEEP_MAX_INTEGER ? "to" : "from",
+			                   fabs(from) <= SWEEP_MAX_INTEGER ? to : from);
 		p->values = json_array();
 		for (int k = 0; k < (int)count; ++k) {
 			double v = count == 1 ? from : from + (to - from) * k / (count - 1);
 			if (k == (int)count - 1)
 				v = to; // the end exactly, whatever the rounding of the steps
 			// Whole numbers stay integers where the base spec has one (a count, a seed).
-			bool whole = p->integer || (json_is_integer(target) && v == floor(v));
+			bool whole = p->integer || (json_is_integer(target) && v == floor(v) && fabs(v) <= SWEEP_MAX_INTEGER);
 			json_array_append_new(p->values, whole ? json_integer((json_int_t)llround(v)) : json_real(v));
 		}
 	} else {
@@ -318,6 +343,8 @@ static bool parse_param(sweep *s, const json_t *item, int index)
 			return sweep_error(s, "%s: the standard deviation must be > 0", where);
 		if (!(p->lo < p->hi))
 			return sweep_error(s, "%s: \"min\" must be below \"max\"", where);
+		if (p->integer && !integer_range(s, p, where))
+			return false;
 		s->random_count++;
 	}
 	return true;

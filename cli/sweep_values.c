@@ -50,7 +50,7 @@ static double random_value(const sweep *s, int param, int sample)
 		default: x = exp(p->a + p->b * normal_sample(&rng)); break;
 		}
 		if (p->integer)
-			x = (double)llround(x);
+			x = round(x); // llround's, defined for any x: an unbounded normal draws past a long
 		if (x >= p->lo && x <= p->hi)
 			return x;
 	}

@@ -415,6 +415,15 @@ static void test_bad_coats(void **state)
 	                  "\"key_feathers\": [{\"at\": [0, 0], \"feather\": \"@plume.json\"},"
 	                  "{\"at\": [0.001, 0], \"feather\": \"@plume.json\"}]",
 	                  PLUME_ERROR_SPEC, "already holds key feather 0");
+	// A Poisson layout's grid indexes cells by coordinate / spacing as longs: 1e12 m / 1e-7 m (1e19) was
+	// cast past a long. A spacing under 1e-15 of how far the surface reaches is refused before the layout.
+	expect_coat_error(
+	    "\"surface\": {\"type\": \"sphere\", \"centre\": [1e12, 0, 0], \"radius\": 2e-6},"
+	    "\"follicles\": {\"layout\": \"poisson\", \"spacing\": 1e-7},"
+	    "\"key_feathers\": [{\"at\": [1e12, 0, 0], \"feather\": \"@plume.json\"}]",
+	    PLUME_ERROR_SPEC,
+	    "$.follicles.spacing: 1e-07 m (1e-07 m the smallest, with the gradient) is too fine for a Poisson "
+	    "layout on a surface reaching 1e+12 m from the origin; allowed a smallest spacing >= 0.001 m");
 	// An OBJ with a face of two corners.
 	char obj[512];
 	snprintf(obj, sizeof obj, "%s/short.obj", scratch);

@@ -202,6 +202,28 @@ static int add_follicle(follicles *f, plume_vec3 position, plume_vec3 normal)
 /// (27 KiB for each key feather, 16 at most), the builder's tables, and the barbs' roots (at most 4000).
 #define COAT_THREAD_BYTES (2.0 * 1024 * 1024)
 
+/// The Poisson layout's hash grid indexes a point's cell by its coordinates over the smallest spacing, as
+/// longs: at most 1e15 cells from the origin keeps the index far inside a long (9.2e18; a cast past it is
+/// undefined) and a coordinate's rounding under a quarter of a cell, so that neighbouring cells stay apart.
+#define COAT_MAX_CELL_INDEX 1e15
+
+/// The largest coordinate magnitude of a point of the surface, m.
+static double surface_reach(const coat_def *def, const plume_mesh *surface)
+{
+	if (def->surface == COAT_SURFACE_PLANE)
+		return fmax(def->plane_size[0], def->plane_size[1]);
+	if (def->surface == COAT_SURFACE_SPHERE) {
+		plume_vec3 c = def->sphere_centre;
+		return fmax(fabs(c.x), fmax(fabs(c.y), fabs(c.z))) + def->sphere_radius;
+	}
+	double reach = 0.0; // a mesh's points are blends of its vertices
+	for (int i = 0; i < surface->vertex_count; ++i) {
+		plume_vec3 p = surface->rest[i];
+		reach = fmax(reach, fmax(fabs(p.x), fmax(fabs(p.y), fabs(p.z))));
+	}
+	return reach;
+}
+
 /// Upper estimate of the follicle count, from the layout's own geometry.
 static double estimated_follicles(const coat_def *def, double area)
 {
@@ -583,6 +605,18 @@ plume_status coat_follicles(const coat_def *def, const plume_mesh *surface, plum
 			                       "--max-memory, or widen the spacing)",
 			                       def->spacing, sampler.area, estimate, COAT_MAX_FOLLICLES, bytes / 1e9,
 			                       (double)def->max_memory / 1e9);
+		}
+	}
+	if (status == 0 && def->layout == COAT_LAYOUT_POISSON) {
+		double cell = def->spacing * fmin(1.0, def->spacing_factor), reach = surface_reach(def, surface);
+		if (!(reach / cell <= COAT_MAX_CELL_INDEX)) {
+			plume_free((void *)sampler.vertex_normals);
+			plume_free(sampler.cumulative_area);
+			return plume_error_set(err, PLUME_ERROR_SPEC,
+			                       "$.follicles.spacing: %g m (%g m the smallest, with the gradient) is too fine for a "
+			                       "Poisson layout on a surface reaching %g m from the origin; allowed a smallest "
+			                       "spacing >= %g m (1e-15 of that reach)",
+			                       def->spacing, cell, reach, reach / COAT_MAX_CELL_INDEX);
 		}
 	}
 	// The coat is checked once its follicles are known, before any feather is built: every feather is

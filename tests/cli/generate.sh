@@ -40,6 +40,18 @@ check "another seed, another OBJ" bash -c "! cmp -s '$scratch/a/feather.obj' '$s
 check "--format writes only those" test "$(ls "$scratch/formats" | tr '\n' ' ')" = "feather.json feather.obj "
 "$plume" generate "$presets/blue.json" -o "$scratch/sized" --format png --size 300x400
 check "--size sets the PNG size" bash -c "od -An -tu1 -j16 -N8 '$scratch/sized/feather.png' | tr -s ' ' | grep -q '^ 0 0 1 44 0 0 1 144$'"
+# Without --size a picture is 1200 tall and as wide as the feather, at most 4096. A flat feather (barbs of
+# 100 m across a 1e-6 m rachis) is 4096 wide: its width, 2e11 pixels, was cast to an int (256 wide).
+cat >"$scratch/flat.json" <<'EOF'
+{"model": "streit-heidrich", "calamus_length": 0, "rachis_length": 1e-6, "rachis_width": 1e-7,
+ "rachis_side_curvature": 0, "rachis_front_curvature": 0, "barb_length": 100, "base_angle_deg": 90,
+ "tip_angle_deg": 90, "spacing_base": 2e-7, "spacing_tip": 2e-7, "barb_width_base": 1e-9, "barb_width_tip": 1e-9,
+ "key_barbs": [{"position": 0, "cvs": [[0, 0, 0], [0.5, 0, 0], [1, 0, 0]]},
+               {"position": 1, "cvs": [[0, 0, 0], [0.5, 0, 0], [1, 0, 0]]}]}
+EOF
+"$plume" generate "$scratch/flat.json" -o "$scratch/flat" --format png 2>"$scratch/err.txt"
+succeeded "a flat feather's picture"
+check "a flat feather's picture is 4096 x 1200" bash -c "od -An -tu1 -j16 -N8 '$scratch/flat/feather.png' | tr -s ' ' | grep -q '^ 0 0 16 0 0 0 4 176$'"
 "$plume" generate "$presets/hawk.json" -o "$scratch/textured" --format png --texture "$source_dir/examples/textures/bands.png"
 check "--texture renders" test -s "$scratch/textured/feather.png"
 check "textured differs from lines" bash -c "! cmp -s '$scratch/textured/feather.png' '$scratch/a/feather.png'"

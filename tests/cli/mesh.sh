@@ -42,6 +42,19 @@ assert h['excepted_count'] < h['vane_face_count'] and 20 <= h['vane_min_angle_de
 check "guides: exit 0" test $? -eq 0
 check "guides: aligned fraction 1" grep -q '"aligned_fraction": 1,' "$scratch/guides/report.json"
 
+# Without --size mesh.png is 1200 tall and as wide as the mesh, at most 16384 (--size's bound). A flat
+# mesh (guides 0.1 m long, 1e-8 m apart) is 16384 wide: its width, 1.2e10 pixels, was cast to an int.
+cat >"$scratch/flat.json" <<'EOF'
+{"mesh": {"edge_length": 0.001, "rachis_width_base": 0.0002, "rachis_width_tip": 0.0002},
+ "boundary": [[-0.05, -1e-9], [0.05, -1e-9], [0.05, 2e-8], [-0.05, 2e-8]],
+ "rachis": {"type": "catmull-rom", "points": [[0.0, 0.0], [0.0, 1e-8]]},
+ "guides": [[[0.0, 0.0], [-0.05, 0.0]], [[0.0, 1e-8], [-0.05, 1e-8]], [[0.0, 0.0], [0.05, 0.0]],
+            [[0.0, 1e-8], [0.05, 1e-8]]]}
+EOF
+"$plume" mesh "$scratch/flat.json" -o "$scratch/flat" --format png 2>"$scratch/err.txt"
+succeeded "a flat mesh's picture"
+check "a flat mesh's picture is 16384 x 1200" bash -c "od -An -tu1 -j16 -N8 '$scratch/flat/mesh.png' | tr -s ' ' | grep -q '^ 0 0 64 0 0 0 4 176$'"
+
 # Bad input: clear message, exit code, nothing written.
 expect_failure "missing -o" 2 "missing -o DIR" "$plume" mesh "$source_dir/examples/meshes/guides.json"
 expect_failure "bad edge length" 2 "--edge-length '-1'" "$plume" mesh "$source_dir/examples/meshes/guides.json" \

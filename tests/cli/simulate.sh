@@ -104,6 +104,10 @@ cat >"$scratch/filoplume.json" <<JSON
 JSON
 "$plume" simulate "$scratch/filoplume.json" -o "$scratch/filoplume" >/dev/null 2>&1
 succeeded "the filoplume runs"
+# --view: sscanf takes "nan" and "inf", which made a camera of NaN directions (an empty picture).
+expect_no_output "--view nan,0" 2 "--view takes AZIMUTH,ELEVATION in degrees (a finite azimuth, |elevation| <= 90), got 'nan,0'" \
+	"$scratch/view" "$plume" simulate "$scratch/filoplume.json" -o "$scratch/view" --view nan,0
+expect_no_output "--view 0,nan" 2 "got '0,nan'" "$scratch/view" "$plume" simulate "$scratch/filoplume.json" -o "$scratch/view" --view 0,nan
 check "no vane angle outside junction faces: null" /usr/bin/python3 -c '
 import json, sys
 s = json.load(open(sys.argv[1]))

@@ -270,6 +270,19 @@ expect_no_output "calibration count out of range" 3 '$.phases is 65, allowed a w
 echo "{$base, \"parameters\": [{\"path\": \"\$.material.barb_fraction\", \"distribution\": \"normal\", \"mean\": 0.14, \"std\": 0.02}], \"samples\": 3}" >"$scratch/bad-range.json"
 expect_no_output "distribution outside the range" 3 '$.material.barb_fraction is -0.06, allowed in (0, 1); bound it with "min"/"max"' \
 	"$scratch/bad" "$plume" sweep "$scratch/bad-range.json" -o "$scratch/bad"
+# An integer parameter's values lie in [-2^53, 2^53]: they were rounded with llround and cast to a JSON
+# integer past a long (the value -9223372036854775808 was refused, or the cast trapped the sanitizer).
+steps_base='"command": "lab traction", "spec": {"material": {"model": "mesoscale", "barb_fraction": 0.14}, "traction": {"steps": 4}}'
+echo "{$steps_base, \"parameters\": [{\"path\": \"\$.traction.steps\", \"grid\": {\"from\": 4, \"to\": 1e19, \"count\": 2}, \"integer\": true}]}" >"$scratch/big-grid.json"
+expect_no_output "an integer grid past 2^53" 3 '$.parameters[0].grid.to is 1e+19; an integer parameter takes values in [-2^53, 2^53]' \
+	"$scratch/bad" "$plume" sweep "$scratch/big-grid.json" -o "$scratch/bad"
+echo "{$steps_base, \"parameters\": [{\"path\": \"\$.traction.steps\", \"distribution\": \"lognormal\", \"log_mean\": 2, \"log_std\": 5, \"integer\": true}], \"samples\": 2}" >"$scratch/big-lognormal.json"
+expect_no_output "an unbounded integer distribution" 3 'the distribution reaches 9007199254740992, which is refused' \
+	"$scratch/bad" "$plume" sweep "$scratch/big-lognormal.json" -o "$scratch/bad"
+printf 'index,x,status\n0,4,ok\n1,1e300,ok\n' >"$scratch/big.csv"
+echo "{$steps_base, \"parameters\": [{\"path\": \"\$.traction.steps\", \"from_csv\": \"big.csv\", \"column\": \"x\", \"integer\": true}]}" >"$scratch/big-csv.json"
+expect_no_output "an integer column past 2^53" 3 "big.csv line 3: column x is '1e300'; an integer parameter takes values in [-2^53, 2^53]" \
+	"$scratch/bad" "$plume" sweep "$scratch/big-csv.json" -o "$scratch/bad"
 echo "{$base, \"parameters\": [{\"path\": \"\$.material.barb_fraction\", \"values\": [0.1, 1.5]}]}" >"$scratch/bad-value.json"
 expect_no_output "grid value outside the range" 3 'the value 1.5 is refused: $.material.barb_fraction is 1.5, allowed in (0, 1)' \
 	"$scratch/bad" "$plume" sweep "$scratch/bad-value.json" -o "$scratch/bad"
