@@ -49,6 +49,27 @@ bool cli_parse_size(const char *command, const char *text, int *width, int *heig
 /// fraction of the height on each side), in [256, 4096]; height when h is not > 0.
 int cli_image_width(double w, double h, int height, double margin);
 
+/// One numeric option of `plume lab calibrate` and the values it allows alone (the ranges
+/// between options, such as the band period against the sample's size, are the command's own
+/// check, cli/lab.c). `plume sweep` takes the same options as keys of a calibration's spec and
+/// checks them against the same table before any run.
+typedef struct cli_calibrate_option {
+	const char *key;    ///< the sweep's key: "phi", "macro_elements"
+	const char *option; ///< the command's option: "--phi", "--macro-elements"
+	const char *unit;   ///< printed after a value in messages: " Pa", " m" or ""
+	const char *what;   ///< said of the option in messages, or NULL
+	bool integer;       ///< an int field (a whole number), else a double
+	double lo, hi;      ///< the allowed range, closed at an end where the flag says so
+	bool lo_closed, hi_closed;
+	size_t offset; ///< of the value in plume_calibration_def
+} cli_calibrate_option;
+enum { CLI_CALIBRATE_OPTION_COUNT = 11 };
+extern const cli_calibrate_option cli_calibrate_options[CLI_CALIBRATE_OPTION_COUNT];
+/// Whether value is in the option's range (and whole, for an integer option).
+bool cli_calibrate_option_allows(const cli_calibrate_option *option, double value);
+/// "value, allowed in (lo, hi]" style text of the option's range: "(0, 1e12]", "[2, 4000000]".
+void cli_calibrate_option_range(const cli_calibrate_option *option, char *text, size_t size);
+
 /// After the options: exactly one positional argument (named input in the message,
 /// "SPEC.json") and an output folder. False after printing the usage error.
 bool cli_check_arguments(const char *command, int argc, char **argv, const char *input, const char *output_dir);

@@ -5,6 +5,7 @@
 #include <errno.h>
 #include <getopt.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -374,35 +375,82 @@ static int write_calibration(const char *dir, const plume_calibration_def *def, 
 
 /// The largest magnitude of any number plume reads from a file (src/io/spec.h): a lab file's
 /// E_B of 1e300 is refused, and so is the option's.
-static const double MAX_MAGNITUDE = 1e12;
+#define MAX_MAGNITUDE 1e12
 
-/// The values of calibrate's options, each against what it is allowed alone and then with the
-/// others (the tilted sample, --width by --aspect x --width, must hold whole barbs that its mesh
-/// resolves): a message naming the options. The library checks the same again (and what the
-/// options cannot reach) in the names of plume_calibration_def's fields.
+#define FIELD(name) offsetof(plume_calibration_def, name)
+const cli_calibrate_option cli_calibrate_options[CLI_CALIBRATE_OPTION_COUNT] = {
+    {"phi", "--phi", "", NULL, false, 0.0, 1.0, false, false, FIELD(mesoscale.bands.barb_fraction)},
+    {"Eb", "--Eb", " Pa", NULL, false, 0.0, MAX_MAGNITUDE, false, true, FIELD(mesoscale.E_b)},
+    {"EB", "--EB", " Pa", NULL, false, 0.0, MAX_MAGNITUDE, false, true, FIELD(mesoscale.E_B)},
+    {"compression", "--compression", " Pa", NULL, false, 0.0, MAX_MAGNITUDE, true, true,
+     FIELD(mesoscale.compression_coefficient)},
+    {"tilted_strain", "--tilted-strain", "", NULL, false, 0.0, 10.0, false, true, FIELD(tilted_strain_max)},
+    {"width", "--width", " m", NULL, false, 1e-6, 10.0, true, true, FIELD(sample.width)},
+    {"aspect", "--aspect", "", "the tilted sample's aspect ratio H/W", false, 1e-3, 1e3, true, true,
+     FIELD(aspect_ratio)},
+    // At most 10 m, the largest sample (--width): the period against the sample is checked below.
+    {"period", "--period", " m", NULL, false, 0.0, 10.0, false, true, FIELD(mesoscale.bands.period)},
+    {"elements", "--elements", "", NULL, true, 2.0, 4e6, true, true, FIELD(sample.element_count)},
+    {"macro_elements", "--macro-elements", "", NULL, true, 2.0, 4e6, true, true, FIELD(macroscale_elements)},
+    {"phases", "--phases", "", NULL, true, 1.0, 64.0, true, true, FIELD(phase_count)},
+};
+#undef FIELD
+
+bool cli_calibrate_option_allows(const cli_calibrate_option *option, double value)
+{
+	bool above = option->lo_closed ? value >= option->lo : value > option->lo;
+	bool below = option->hi_closed ? value <= option->hi : value < option->hi;
+	return above && below && (!option->integer || value == floor(value));
+}
+
+void cli_calibrate_option_range(const cli_calibrate_option *option, char *text, size_t size)
+{
+	// %.10g: an integer's bound whole ("4000000", not %g's "4e+06").
+	snprintf(text, size, "%c%.10g, %.10g%c", option->lo_closed ? '[' : '(', option->lo, option->hi,
+	         option->hi_closed ? ']' : ')');
+}
+
+/// The value of a calibrate option in def.
+static double option_value(const plume_calibration_def *def, const cli_calibrate_option *option)
+{
+	const char *field = (const char *)def + option->offset;
+	if (option->integer) {
+		int value;
+		memcpy(&value, field, sizeof value);
+		return value;
+	}
+	double value;
+	memcpy(&value, field, sizeof value);
+	return value;
+}
+
+/// The values of calibrate's options, each against what it is allowed alone
+/// (cli_calibrate_options, which the sweep checks too) and then with the others (the tilted
+/// sample, --width by --aspect x --width, must hold whole barbs that its mesh resolves): a
+/// message naming the options. The library checks the same again (and what the options
+/// cannot reach) in the names of plume_calibration_def's fields.
 static plume_status check_calibrate_options(const plume_calibration_def *def, plume_error *err)
 {
+	for (int i = 0; i < CLI_CALIBRATE_OPTION_COUNT; ++i) {
+		const cli_calibrate_option *option = &cli_calibrate_options[i];
+		double value = option_value(def, option);
+		if (!cli_calibrate_option_allows(option, value)) {
+			char range[64];
+			cli_calibrate_option_range(option, range, sizeof range);
+			return plume_error_set(err, PLUME_ERROR_SPEC, "%s is %g%s%s%s, allowed in %s", option->option, value,
+			                       option->unit, option->what != NULL ? ": " : "",
+			                       option->what != NULL ? option->what : "", range);
+		}
+	}
 	const double phi = def->mesoscale.bands.barb_fraction, period = def->mesoscale.bands.period;
 	const double width = def->sample.width, aspect = def->aspect_ratio, height = aspect * width;
 #define REQUIRE(condition, format, ...)                                                                                \
 	if (!(condition))                                                                                                  \
 		return plume_error_set(err, PLUME_ERROR_SPEC, format, __VA_ARGS__);
-	REQUIRE(phi > 0.0 && phi < 1.0, "--phi is %g, allowed in (0, 1)", phi);
-	REQUIRE(def->mesoscale.E_b > 0.0 && def->mesoscale.E_b <= MAX_MAGNITUDE, "--Eb is %g Pa, allowed in (0, 1e12]",
-	        def->mesoscale.E_b);
-	REQUIRE(def->mesoscale.E_B > 0.0 && def->mesoscale.E_B <= MAX_MAGNITUDE, "--EB is %g Pa, allowed in (0, 1e12]",
-	        def->mesoscale.E_B);
-	REQUIRE(def->mesoscale.compression_coefficient >= 0.0 && def->mesoscale.compression_coefficient <= MAX_MAGNITUDE,
-	        "--compression is %g Pa, allowed in [0, 1e12]", def->mesoscale.compression_coefficient);
-	REQUIRE(def->tilted_strain_max > 0.0 && def->tilted_strain_max <= 10.0, "--tilted-strain is %g, allowed in (0, 10]",
-	        def->tilted_strain_max);
-	REQUIRE(width >= 1e-6 && width <= 10.0, "--width is %g m, allowed in [1e-06, 10]", width);
-	REQUIRE(aspect >= 1e-3 && aspect <= 1e3,
-	        "--aspect is %g: the tilted sample's aspect ratio H/W, allowed in [0.001, 1000]", aspect);
 	REQUIRE(height >= 1e-6 && height <= 10.0,
 	        "--aspect %g and --width %g m make the tilted sample %g m high, allowed in [1e-06, 10]", aspect, width,
 	        height);
-	REQUIRE(period > 0.0 && period <= fmin(width, height),
+	REQUIRE(period <= fmin(width, height),
 	        "--period is %g m, allowed in (0, %g]: at most the side of the tilted sample, %g m wide (--width) and %g m "
 	        "high (--aspect x --width), so that it holds a whole barb",
 	        period, fmin(width, height), width, height);
@@ -416,11 +464,6 @@ static plume_status check_calibrate_options(const plume_calibration_def *def, pl
 	        "millionth of the %g x %g m tilted sample",
 	        number(phi).text, least, 1.0 - least, period, phi <= 0.5 ? "barb" : "barbule",
 	        period * fmin(phi, 1.0 - phi), width, height);
-	REQUIRE(def->sample.element_count >= 2 && def->sample.element_count <= 4000000,
-	        "--elements is %d, allowed in [2, 4000000]", def->sample.element_count);
-	REQUIRE(def->macroscale_elements >= 2 && def->macroscale_elements <= 4000000,
-	        "--macro-elements is %d, allowed in [2, 4000000]", def->macroscale_elements);
-	REQUIRE(def->phase_count >= 1 && def->phase_count <= 64, "--phases is %d, allowed in [1, 64]", def->phase_count);
 #undef REQUIRE
 	return PLUME_OK;
 }

@@ -85,12 +85,10 @@ static void print_plan(const sweep *s)
 
 int cli_sweep(int argc, char **argv)
 {
-	static const struct option options[] = {{"output", required_argument, NULL, 'o'},
-	                                        {"jobs", required_argument, NULL, 'j'},
-	                                        {"dry-run", no_argument, NULL, 'n'},
-	                                        {"max-runs", required_argument, NULL, 'R'},
-	                                        {"help", no_argument, NULL, 'h'},
-	                                        {NULL, 0, NULL, 0}};
+	static const struct option options[] = {
+	    {"output", required_argument, NULL, 'o'}, {"jobs", required_argument, NULL, 'j'},
+	    {"dry-run", no_argument, NULL, 'n'},      {"max-runs", required_argument, NULL, 'R'},
+	    {"help", no_argument, NULL, 'h'},         {NULL, 0, NULL, 0}};
 	const char *output_dir = NULL;
 	int jobs = 1;
 	bool dry_run = false;

@@ -66,7 +66,7 @@ typedef struct sweep_command {
 	const sweep_output *outputs;
 } sweep_command;
 
-enum { SWEEP_COMMAND_COUNT = 7, SWEEP_CALIBRATION_KEY_COUNT = 9 };
+enum { SWEEP_COMMAND_COUNT = 7 };
 extern const sweep_command sweep_commands[SWEEP_COMMAND_COUNT];
 /// The output of command that key names, or NULL. hole receives the text standing for
 /// the output's placeholder (a group name, an index); empty when it has none.
@@ -74,19 +74,8 @@ const sweep_output *sweep_output_find(const sweep_command *command, const char *
 /// The keys of a render frames spec; NULL-terminated.
 extern const char *const sweep_render_keys[];
 
-// The calibration has no spec file: its spec is an object of the command's options.
-typedef struct calibration_key {
-	const char *key;
-	const char *option;
-	bool integer;
-	/// Allowed values, as `plume lab calibrate` checks them (cli/lab.c): from lo to hi, each
-	/// end included when closed (integers: both included).
-	double lo;
-	double hi;
-	bool lo_closed;
-	bool hi_closed;
-} calibration_key;
-extern const calibration_key sweep_calibration_keys[SWEEP_CALIBRATION_KEY_COUNT];
+// The calibration has no spec file: its spec is an object of the command's options, the
+// keys of cli_calibrate_options (cli.h).
 
 // ---------------------------------------------------------------------------
 // The sweep (sweep_spec.c)

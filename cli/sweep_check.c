@@ -45,6 +45,8 @@ static const set_option set_options[] = {
     {PROBE_CALIBRATION, 0, "elements", NULL, "set $.spec.elements instead"},
     {PROBE_CALIBRATION, 0, "macro-elements", NULL, "set $.spec.macro_elements instead"},
     {PROBE_CALIBRATION, 0, "phases", NULL, "set $.spec.phases instead"},
+    {PROBE_CALIBRATION, 0, "compression", NULL, "set $.spec.compression instead"},
+    {PROBE_CALIBRATION, 0, "tilted-strain", NULL, "set $.spec.tilted_strain instead"},
     {PROBE_CALIBRATION, 0, "unconstrained", NULL, "set $.spec.unconstrained instead"},
     {PROBE_FEATHER, 's', "seed", "$.seed", "it would override the swept $.seed"},
     {PROBE_MESH, 's', "seed", "$.seed", "it would override the swept $.seed"},
@@ -230,11 +232,11 @@ static bool probe_spec(const sweep *s, json_t *spec, char *message, size_t size,
 		json_object_foreach (spec, name, value) {
 			size_t best = strcmp(name, "unconstrained") == 0 || strcmp(name, "description") == 0 ? 0 : SIZE_MAX;
 			const char *nearest = "phi";
-			for (int i = 0; i < SWEEP_CALIBRATION_KEY_COUNT && best != 0; ++i) {
-				size_t d = plume_edit_distance(sweep_calibration_keys[i].key, name);
+			for (int i = 0; i < CLI_CALIBRATE_OPTION_COUNT && best != 0; ++i) {
+				size_t d = plume_edit_distance(cli_calibrate_options[i].key, name);
 				if (d < best) {
 					best = d;
-					nearest = sweep_calibration_keys[i].key;
+					nearest = cli_calibrate_options[i].key;
 				}
 			}
 			if (best != 0) {
@@ -242,18 +244,17 @@ static bool probe_spec(const sweep *s, json_t *spec, char *message, size_t size,
 				return false;
 			}
 		}
-		for (int i = 0; i < SWEEP_CALIBRATION_KEY_COUNT; ++i) {
-			const calibration_key *k = sweep_calibration_keys + i;
+		for (int i = 0; i < CLI_CALIBRATE_OPTION_COUNT; ++i) {
+			const cli_calibrate_option *k = &cli_calibrate_options[i];
 			json_t *v = json_object_get(spec, k->key);
 			if (v == NULL)
 				continue;
 			double x = json_number_value(v);
-			bool above = k->lo_closed ? x >= k->lo : x > k->lo, below = k->hi_closed ? x <= k->hi : x < k->hi;
-			bool ok = json_is_number(v) && above && below && (!k->integer || x == floor(x));
-			if (!ok) {
-				snprintf(message, size, "$.%s is %.10g, allowed %s in %c%g, %g%c", k->key, x,
-				         k->integer ? "a whole number" : "a number", k->lo_closed ? '[' : '(', k->lo, k->hi,
-				         k->hi_closed ? ']' : ')');
+			if (!json_is_number(v) || !cli_calibrate_option_allows(k, x)) {
+				char range[64];
+				cli_calibrate_option_range(k, range, sizeof range);
+				snprintf(message, size, "$.%s is %.10g, allowed %s in %s", k->key, x,
+				         k->integer ? "a whole number" : "a number", range);
 				return false;
 			}
 		}

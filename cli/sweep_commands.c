@@ -187,19 +187,3 @@ const sweep_output *sweep_output_find(const sweep_command *command, const char *
 			return o;
 	return NULL;
 }
-
-const calibration_key sweep_calibration_keys[SWEEP_CALIBRATION_KEY_COUNT] = {
-    // The single-option ranges of cli/lab.c's check_calibration (the ones between options,
-    // such as the period against the sample's size, stay its own).
-    {"phi", "--phi", false, 0.0, 1.0, false, false},
-    {"Eb", "--Eb", false, 0.0, 1e12, false, true},
-    {"EB", "--EB", false, 0.0, 1e12, false, true},
-    {"aspect", "--aspect", false, 0.001, 1000.0, true, true},
-    {"period", "--period", false, 0.0, 10.0, false, true},
-    {"width", "--width", false, 1e-6, 10.0, true, true},
-    {"elements", "--elements", true, 2.0, 4e6, true, true},
-    {"macro_elements", "--macro-elements", true, 2.0, 4e6, true, true},
-    {"phases", "--phases", true, 1.0, 64.0, true, true},
-};
-_Static_assert(sizeof sweep_calibration_keys / sizeof sweep_calibration_keys[0] == SWEEP_CALIBRATION_KEY_COUNT,
-               "every calibration option listed");

@@ -159,19 +159,19 @@ pid_t sweep_run_start(const sweep *s, const char *dir, int index, char *failure,
 	}
 	// The command line; relative names, so that messages do not depend on DIR.
 	char *args[64];
-	static char values[SWEEP_CALIBRATION_KEY_COUNT][64];
+	static char values[CLI_CALIBRATE_OPTION_COUNT][64];
 	int n = 0;
 	args[n++] = "plume";
 	for (int i = 0; i < 2 && s->command->words[i] != NULL; ++i)
 		args[n++] = (char *)s->command->words[i];
 	if (s->command->probe == PROBE_CALIBRATION) {
 		json_t *run = sweep_run_spec(s, index);
-		for (int i = 0; i < SWEEP_CALIBRATION_KEY_COUNT; ++i) {
-			json_t *v = json_object_get(run, sweep_calibration_keys[i].key);
+		for (int i = 0; i < CLI_CALIBRATE_OPTION_COUNT; ++i) {
+			json_t *v = json_object_get(run, cli_calibrate_options[i].key);
 			if (v == NULL)
 				continue;
 			snprintf(values[i], sizeof values[i], "%.17g", json_number_value(v));
-			args[n++] = (char *)sweep_calibration_keys[i].option;
+			args[n++] = (char *)cli_calibrate_options[i].option;
 			args[n++] = values[i];
 		}
 		if (json_is_true(json_object_get(run, "unconstrained")))

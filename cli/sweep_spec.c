@@ -500,13 +500,14 @@ bool sweep_load(sweep *s, const char *file)
 		json_t *value;
 		json_object_foreach (s->spec, key, value) {
 			bool known = strcmp(key, "unconstrained") == 0 || strcmp(key, "description") == 0;
-			for (int i = 0; i < SWEEP_CALIBRATION_KEY_COUNT; ++i)
-				known = known || strcmp(sweep_calibration_keys[i].key, key) == 0;
+			char list[256] = "";
+			for (int i = 0; i < CLI_CALIBRATE_OPTION_COUNT; ++i) {
+				known = known || strcmp(cli_calibrate_options[i].key, key) == 0;
+				size_t used = strlen(list);
+				snprintf(list + used, sizeof list - used, "%s, ", cli_calibrate_options[i].key);
+			}
 			if (!known)
-				return sweep_error(s,
-				                   "$.spec.%s is not a calibration option (phi, Eb, EB, aspect, period, width, "
-				                   "elements, macro_elements, phases, unconstrained)",
-				                   key);
+				return sweep_error(s, "$.spec.%s is not a calibration option (%sunconstrained)", key, list);
 		}
 	}
 

@@ -70,11 +70,11 @@ expect_failure "unknown action" 2 "unknown action 'pull'" "$plume" lab pull
 expect_failure "calibrate without moduli" 2 "needs --phi, --Eb and --EB" "$plume" lab calibrate --phi 0.14
 expect_failure "calibrate phi 0" 3 "allowed in (0, 1)" "$plume" lab calibrate --phi 0 --Eb 3.92e4 --EB 2.57e9
 expect_failure "calibrate phi 1.5" 3 "allowed in (0, 1)" "$plume" lab calibrate --phi 1.5 --Eb 3.92e4 --EB 2.57e9
-expect_failure "calibrate negative Eb" 3 "--Eb is -1 Pa, allowed in (0, 1e12]" "$plume" lab calibrate --phi 0.14 --Eb -1 --EB 2.57e9
+expect_failure "calibrate negative Eb" 3 "--Eb is -1 Pa, allowed in (0, 1e+12]" "$plume" lab calibrate --phi 0.14 --Eb -1 --EB 2.57e9
 # The bounds of a lab file (|x| <= 1e12) hold for the options too: --EB 1e300 diverged (free forces 6.24e+284).
-expect_failure "calibrate EB 1e300" 3 "--EB is 1e+300 Pa, allowed in (0, 1e12]" "$plume" lab calibrate --phi 0.14 --Eb 3.92e4 --EB 1e300
+expect_failure "calibrate EB 1e300" 3 "--EB is 1e+300 Pa, allowed in (0, 1e+12]" "$plume" lab calibrate --phi 0.14 --Eb 3.92e4 --EB 1e300
 check "calibrate EB 1e300: nothing on stdout" test ! -s "$scratch/out.txt"
-expect_failure "calibrate compression 1e300" 3 "--compression is 1e+300 Pa, allowed in [0, 1e12]" "$plume" lab calibrate --phi 0.14 --Eb 3.92e4 --EB 2.57e9 --compression 1e300
+expect_failure "calibrate compression 1e300" 3 "--compression is 1e+300 Pa, allowed in [0, 1e+12]" "$plume" lab calibrate --phi 0.14 --Eb 3.92e4 --EB 2.57e9 --compression 1e300
 # Each value error names its option (--width 0 blamed "band period 0.0004 m").
 expect_failure "calibrate width 0" 3 "--width is 0 m, allowed in [1e-06, 10]" "$plume" lab calibrate --phi 0.14 --Eb 3.92e4 --EB 2.57e9 --width 0
 expect_failure "calibrate period past the sample" 3 "--period is 0.01 m, allowed in (0, 0.004]" "$plume" lab calibrate --phi 0.14 --Eb 3.92e4 --EB 2.57e9 --period 0.01

@@ -267,6 +267,13 @@ expect_no_output "calibration value out of range" 3 'the value 2000000000000 is 
 echo '{"command": "lab calibrate", "spec": {"phi": 0.14, "Eb": 3.92e4, "EB": 2.57e9}, "parameters": [{"path": "$.phases", "values": [2, 65]}]}' >"$scratch/bad-cal-phases.json"
 expect_no_output "calibration count out of range" 3 '$.phases is 65, allowed a whole number in [1, 64]' \
 	"$scratch/bad" "$plume" sweep "$scratch/bad-cal-phases.json" -o "$scratch/bad"
+# Every option of the command is a key, checked against the same table (cli_calibrate_options).
+echo '{"command": "lab calibrate", "spec": {"phi": 0.14, "Eb": 3.92e4, "EB": 2.57e9}, "parameters": [{"path": "$.compression", "values": [0, -1]}]}' >"$scratch/bad-cal-compression.json"
+expect_no_output "calibration compression out of range" 3 '$.compression is -1, allowed a number in [0, 1e+12]' \
+	"$scratch/bad" "$plume" sweep "$scratch/bad-cal-compression.json" -o "$scratch/bad"
+echo '{"command": "lab calibrate", "spec": {"phi": 0.14, "Eb": 3.92e4, "EB": 2.57e9}, "parameters": [{"path": "$.macro_elements", "values": [200, 4000001]}]}' >"$scratch/bad-cal-macro.json"
+expect_no_output "calibration macro elements out of range" 3 '$.macro_elements is 4000001, allowed a whole number in [2, 4000000]' \
+	"$scratch/bad" "$plume" sweep "$scratch/bad-cal-macro.json" -o "$scratch/bad"
 echo "{$base, \"parameters\": [{\"path\": \"\$.material.barb_fraction\", \"distribution\": \"normal\", \"mean\": 0.14, \"std\": 0.02}], \"samples\": 3}" >"$scratch/bad-range.json"
 expect_no_output "distribution outside the range" 3 '$.material.barb_fraction is -0.06, allowed in (0, 1); bound it with "min"/"max"' \
 	"$scratch/bad" "$plume" sweep "$scratch/bad-range.json" -o "$scratch/bad"
