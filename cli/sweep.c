@@ -93,6 +93,15 @@ int cli_sweep(int argc, char **argv)
 	int jobs = 1;
 	bool dry_run = false;
 	long max_runs = SWEEP_DEFAULT_MAX_RUNS;
+	// Under a launcher only rank 0 speaks, from the first usage error on: every other rank
+	// writes its messages to /dev/null (each reads the same command line and sweep, so
+	// rank 0 says what they would).
+	bool quiet = false;
+#ifdef PLUME_WITH_MPI
+	quiet = sweep_mpi_launched() && sweep_mpi_launcher_rank() != 0;
+#endif
+	if (quiet && freopen("/dev/null", "w", stderr) == NULL)
+		return CLI_EXIT_IO;
 	int option;
 	optind = 1;
 	opterr = 0;
@@ -115,7 +124,10 @@ int cli_sweep(int argc, char **argv)
 				return cli_usage_error("sweep", "--max-runs expects a whole number in [1, 1000000], got '%s'", optarg);
 			break;
 		}
-		case 'h': cli_help_sweep(); return CLI_EXIT_OK;
+		case 'h':
+			if (!quiet)
+				cli_help_sweep();
+			return CLI_EXIT_OK;
 		case ':': return cli_usage_error("sweep", "option '%s' needs a value", argv[optind - 1]);
 		default: return cli_usage_error("sweep", "unknown option '%s'", argv[optind - 1]);
 		}
@@ -135,11 +147,7 @@ int cli_sweep(int argc, char **argv)
 	}
 #endif
 	// Every rank reads the sweep (it is small; the workers start runs from it); only
-	// rank 0 checks it, speaks and writes DIR.
-	FILE *saved_stderr = NULL;
-	if (rank != 0)
-		saved_stderr = freopen("/dev/null", "w", stderr);
-	(void)saved_stderr;
+	// rank 0 checks it, speaks (above) and writes DIR.
 	sweep s;
 	int code = CLI_EXIT_OK;
 	if (!sweep_load(&s, argv[optind]))

@@ -213,6 +213,8 @@ void sweep_runs_remove(const char *dir);
 #ifdef PLUME_WITH_MPI
 /// Whether this process was started by an MPI launcher (mpirun, srun).
 bool sweep_mpi_launched(void);
+/// The rank the launcher gave this process, before MPI starts; 0 when none.
+int sweep_mpi_launcher_rank(void);
 /// Rank 0: hands the missing runs out one at a time as ranks become free, gathers the rows.
 bool sweep_mpi_schedule(sweep_state *state, int size);
 /// Ranks other than 0: runs what rank 0 hands out until it says stop.

@@ -24,6 +24,19 @@ bool sweep_mpi_launched(void)
 	return getenv("OMPI_COMM_WORLD_SIZE") != NULL || getenv("PMI_SIZE") != NULL || getenv("PMIX_RANK") != NULL;
 }
 
+/// The rank the launcher gave this process, read before MPI starts (so that a usage error
+/// prints once, not once a rank); 0 when no launcher says.
+int sweep_mpi_launcher_rank(void)
+{
+	static const char *const names[] = {"OMPI_COMM_WORLD_RANK", "PMIX_RANK", "PMI_RANK", "SLURM_PROCID"};
+	for (size_t i = 0; i < sizeof names / sizeof names[0]; ++i) {
+		const char *value = getenv(names[i]);
+		if (value != NULL)
+			return atoi(value);
+	}
+	return 0;
+}
+
 /// Rank 0: hands the missing runs out one at a time as ranks become free, gathers the rows.
 bool sweep_mpi_schedule(sweep_state *state, int size)
 {

@@ -67,6 +67,12 @@ if "$plume" help sweep | grep -q 'This plume was built with MPI' && command -v m
 	succeeded "mpirun -n 3 --dry-run succeeds"
 	check "mpirun -n 3 --dry-run: the plan printed once" cmp -s "$scratch/plan.csv" "$scratch/mpi-plan.csv"
 	check "mpirun -n 3 --dry-run: nothing written" test ! -e "$scratch/none"
+	# A usage error and --help are printed by rank 0 alone (every rank printed them).
+	mpirun --allow-run-as-root --oversubscribe -n 3 "$plume" sweep --bogus "$scratch/grid.json" -o "$scratch/none" \
+		>/dev/null 2>"$scratch/err.txt"
+	check "mpirun -n 3: a usage error printed once" test "$(grep -c "unknown option '--bogus'" "$scratch/err.txt")" -eq 1
+	mpirun --allow-run-as-root --oversubscribe -n 3 "$plume" sweep --help >"$scratch/out.txt" 2>/dev/null
+	check "mpirun -n 3: --help printed once" test "$(grep -c '^Usage' "$scratch/out.txt")" -eq 1
 else
 	echo "SKIP: MPI part: this plume was built without MPI (libopenmpi-dev not found at configure time)"
 fi
