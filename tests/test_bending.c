@@ -167,6 +167,22 @@ static void test_rolled_cylinder(void **state)
 		}
 }
 
+/// A strip too long for its cells is refused before its counts are cast to int (a 1e12 m strip
+/// of 1 mm cells was undefined behaviour); NaN sizes and barb angles are refused too.
+static void test_strip_bounds(void **state)
+{
+	(void)state;
+	plume_mesh *mesh = NULL;
+	plume_error err;
+	assert_int_equal(plume_lab_strip_mesh(PLUME_STRIP_RIGHT, 1e12, 0.01, 1, 10, 0, &mesh, &err), PLUME_ERROR_SPEC);
+	assert_null(mesh);
+	assert_non_null(strstr(err.message, "allowed at most 1e+08"));
+	assert_int_equal(plume_lab_strip_mesh(PLUME_STRIP_RIGHT, NAN, 0.01, 1, 10, 0, &mesh, &err), PLUME_ERROR_SPEC);
+	assert_int_equal(plume_lab_strip_mesh(PLUME_STRIP_RIGHT, 0.1, 0.01, 1, 10, NAN, &mesh, &err), PLUME_ERROR_SPEC);
+	assert_int_equal(plume_lab_strip_mesh(PLUME_STRIP_RIGHT, 0.1, 0.01, 1, 10, 0, &mesh, &err), PLUME_OK);
+	plume_mesh_destroy(mesh);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -174,6 +190,7 @@ int main(void)
 	    cmocka_unit_test(test_cantilever_anisotropic),
 	    cmocka_unit_test(test_cantilever_paper_hinge_is_mesh_dependent),
 	    cmocka_unit_test(test_rolled_cylinder),
+	    cmocka_unit_test(test_strip_bounds),
 	};
 	int64_t before = plume_bytes_in_use();
 	int failed = cmocka_run_group_tests(tests, NULL, NULL);

@@ -71,6 +71,9 @@ static plume_status add_groups(plume_mesh *mesh, const strip_rows *rows, int acr
 	return status;
 }
 
+/// The largest strip plume_lab_strip_mesh builds (the studies' finest is about 1e5 vertices).
+#define STRIP_MAX_VERTICES 1e8
+
 plume_status plume_lab_strip_mesh(plume_strip_family family, double length, double width, int clamp_cells, int across,
                                   double barb_angle, plume_mesh **out, plume_error *err)
 {
@@ -80,6 +83,14 @@ plume_status plume_lab_strip_mesh(plume_strip_family family, double length, doub
 		return plume_error_set(err, PLUME_ERROR_SPEC, "strip: invalid family, size or refinement");
 	double dy = width / across, dx, sigma;
 	family_lattice(family, dy, &dx, &sigma);
+	// The rows' vertex counts are ints (a larger one cast from a double is undefined) and no
+	// study meshes a strip past STRIP_MAX_VERTICES.
+	double estimate = (length / dx + clamp_cells + 2.0) * (across + 1.0);
+	if (!(estimate <= STRIP_MAX_VERTICES) || !isfinite(barb_angle))
+		return plume_error_set(err, PLUME_ERROR_SPEC,
+		                       "strip: %g m long, %g m wide, %d rows of cells across and %d clamped make about %.3g "
+		                       "vertices, allowed at most %g (and a finite barb angle)",
+		                       length, width, across, clamp_cells, estimate, STRIP_MAX_VERTICES);
 	double clamp = clamp_cells * dx;
 	int rows_count = across + 1;
 	strip_rows rows = {plume_alloc(sizeof(int) * (size_t)rows_count), plume_alloc(sizeof(int) * (size_t)rows_count),
