@@ -117,8 +117,10 @@ bool sweep_write_summary(const sweep_state *state)
 		json_object_set_new(outputs, s->outputs[o], entry);
 		char output_name[128];
 		sanitize(s->outputs[o], output_name, sizeof output_name);
-		// Histogram of a random sweep: a step outline over 12 bins (or fewer for few runs).
-		if ((s->random_count > 0 || zipped) && n >= 2 && y[n - 1] > y[0]) {
+		// Histogram of a random sweep: a step outline over 12 bins (or fewer for few runs). Not
+		// of outputs whose span overflows a double (-1e308 to 1e308): the bins' width would be
+		// infinite, and a bin index NaN.
+		if ((s->random_count > 0 || zipped) && n >= 2 && y[n - 1] > y[0] && isfinite(y[n - 1] - y[0])) {
 			int bins = n < 24 ? (n + 1) / 2 : 12;
 			double hx[2 * 64 + 2], hy[2 * 64 + 2];
 			double width = (y[n - 1] - y[0]) / bins;
