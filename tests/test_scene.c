@@ -267,6 +267,35 @@ static void test_handle_pose_interpolation(void **state)
 	assert_close(r.m[1][0], sin(1), 1e-15);
 }
 
+/// A key without rotation (its axis the default z) takes the other key's axis, as a body's
+/// keys do (docs/body.md "Interpolation"): from rest to 90 degrees about x, a quarter of the
+/// way is 22.5 degrees about x. The handle's pose took the nearer key's axis, so it turned
+/// about z for the first half and jumped to x at the middle.
+static void test_handle_pose_axis_of_a_key_without_rotation(void **state)
+{
+	(void)state;
+	double pi = acos(-1.0);
+	plume_keyframe keys[2] = {{0, {0, 0, 0}, {0, 0, 1}, 0}, {1, {0, 0, 0}, {1, 0, 0}, pi / 2}};
+	plume_scene_handle handle = {0};
+	handle.keyframe_count = 2;
+	handle.keyframes = keys;
+	plume_vec3 t;
+	plume_mat3 r;
+	plume_scene_handle_pose(&handle, 0.25, &t, &r);
+	assert_close(r.m[0][0], 1, 1e-15);
+	assert_close(r.m[1][1], cos(pi / 8), 1e-15);
+	assert_close(r.m[2][1], sin(pi / 8), 1e-15);
+	// Two different axes: the shorter arc between the keys (slerp), continuous at the middle.
+	plume_keyframe turned[2] = {{0, {0, 0, 0}, {1, 0, 0}, pi / 2}, {1, {0, 0, 0}, {0, 1, 0}, pi / 2}};
+	handle.keyframes = turned;
+	plume_mat3 before, after;
+	plume_scene_handle_pose(&handle, 0.5 - 1e-9, &t, &before);
+	plume_scene_handle_pose(&handle, 0.5 + 1e-9, &t, &after);
+	for (int i = 0; i < 3; ++i)
+		for (int j = 0; j < 3; ++j)
+			assert_close(before.m[i][j], after.m[i][j], 1e-7);
+}
+
 /// Loads a scene from text (written to a temporary file, so relative paths are the source tree's).
 static plume_scene *load_text(const char *text)
 {
@@ -800,6 +829,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test(test_handle_pose_interpolation),
+	    cmocka_unit_test(test_handle_pose_axis_of_a_key_without_rotation),
 	    cmocka_unit_test(test_bad_scenes),
 	    cmocka_unit_test(test_bending_key),
 	    cmocka_unit_test(test_figure1_anisotropic_bends_the_rachis),

@@ -10,6 +10,7 @@
 #include "core/alloc.h"
 #include "plume/body.h"
 #include "plume/scene.h"
+#include "sim/body_internal.h"
 #include "sim/scene_contact.h"
 
 void plume_scene_destroy(plume_scene *scene)
@@ -32,37 +33,11 @@ void plume_scene_destroy(plume_scene *scene)
 	plume_free(scene);
 }
 
-static double ease(plume_interpolation interpolation, double s)
-{
-	return interpolation == PLUME_INTERPOLATION_SMOOTH ? s * s * (3 - 2 * s) : s;
-}
-
 void plume_scene_handle_pose(const plume_scene_handle *handle, double t, plume_vec3 *translation, plume_mat3 *rotation)
 {
-	*translation = plume_v3(0, 0, 0);
-	*rotation = plume_m3_identity();
-	int count = handle->keyframe_count;
-	if (count == 0)
-		return;
-	const plume_keyframe *keys = handle->keyframes;
-	plume_keyframe pose = keys[count - 1];
-	if (t <= keys[0].time) {
-		pose = keys[0];
-	} else {
-		for (int k = 0; k + 1 < count; ++k)
-			if (t < keys[k + 1].time) {
-				double s = ease(handle->interpolation, (t - keys[k].time) / (keys[k + 1].time - keys[k].time));
-				pose.translation = plume_v3_lerp(keys[k].translation, keys[k + 1].translation, s);
-				// Rotations interpolate by angle about the later key's axis when the axes agree,
-				// which is what scenes use (one axis per handle); otherwise the nearer key's axis.
-				pose.axis = s < 0.5 ? keys[k].axis : keys[k + 1].axis;
-				pose.angle = keys[k].angle + s * (keys[k + 1].angle - keys[k].angle);
-				break;
-			}
-	}
-	*translation = pose.translation;
-	if (pose.angle != 0)
-		*rotation = plume_m3_rotation(plume_v3_normalize(pose.axis), pose.angle);
+	// A handle's keys move as a body's (docs/body.md "Interpolation"): taking the nearer key's
+	// axis turned a handle keyed from rest to a rotation about x about z for half the interval.
+	plume_keyframes_pose(handle->keyframes, handle->keyframe_count, handle->interpolation, t, translation, rotation);
 }
 
 void plume_scene_body_pose(const plume_scene *scene, double t, plume_vec3 *out)
