@@ -328,6 +328,13 @@ static void read_handles(plume_spec_reader *reader, const json_t *root, plume_sc
 				plume_spec_fail(reader, radius_path, "is %g, allowed > 0", handle->radius);
 			if (reader->status == PLUME_OK)
 				add_near_group(reader, path, scene->mesh, handle, (int)h);
+		} else if (reader->status == PLUME_OK && json_object_get(object, "radius") != NULL) {
+			// Alone it selected nothing: the whole group was held.
+			char radius_path[96];
+			plume_spec_path(radius_path, sizeof radius_path, path, "radius");
+			plume_spec_fail(reader, radius_path,
+			                "given without \"near\"; a radius selects the group's vertices within it of a point "
+			                "[x, y] of the reference plane (give both, or neither to hold the whole group)");
 		}
 		read_vec3(reader, object, path, "pivot", &handle->pivot);
 		const char *interpolation = NULL;
@@ -410,7 +417,11 @@ static void read_forces(plume_spec_reader *reader, const json_t *root, plume_sce
 			return;
 		}
 		snprintf(scene->forces[i].group, sizeof scene->forces[i].group, "%s", group);
-		read_vec3(reader, object, path, "force", &scene->forces[i].force);
+		if (!read_vec3(reader, object, path, "force", &scene->forces[i].force) && reader->status == PLUME_OK) {
+			char force_path[96];
+			plume_spec_path(force_path, sizeof force_path, path, "force");
+			plume_spec_fail(reader, force_path, "missing; a force is [x, y, z] in N, shared by the group's vertices");
+		}
 		scene->force_count = (int)i + 1;
 	}
 }

@@ -78,6 +78,10 @@ bad "unknown key" 'did you mean "duration"' '"durations": 1'
 bad "unknown integrator" '$.integrator: unknown value "bdf3"' '"integrator": "bdf3"'
 bad "negative normal drag" '$.air.normal_drag is -1, allowed >= 0' '"air": {"normal_drag": -1}'
 bad "NaN wind" '$.air.wind: element 1 is not a number' '"air": {"wind": [0, "NaN", 0]}'
+# A radius without a point to measure it from selected nothing less: the whole group was held.
+bad "radius without near" '$.handles[0].radius: given without "near"' '"handles": [{"group": "left_edge", "radius": 0.004}]'
+# A force entry without its force pulled with nothing (a zero force) and said nothing.
+bad "force without force" '$.forces[0].force: missing; a force is [x, y, z] in N' '"forces": [{"group": "rachis_tip"}]'
 # A handle that pulls a barb away from the clamp holding its other end (the Streit-Heidrich
 # bristle's one barb, its vane tip pulled along it): the barb constraint cannot hold, and the
 # run used to end "completed" with the barb stretched 264 %.
