@@ -890,7 +890,7 @@ int cli_simulate(int argc, char **argv)
 	if (frames_every > 0)
 		scene->frame_every = frames_every;
 	run.scene = scene;
-	run.total_steps = (int)ceil(scene->duration / scene->sim.time_step - 1e-9);
+	run.total_steps = (int)fmax(1.0, ceil(scene->duration / scene->sim.time_step - 1e-9)); // as the runner's
 	// Before the run: the frames' bytes (an OBJ line is at most about 80 bytes, three
 	// %.17g coordinates; a PNG at most its raw pixels) and what sim.glb holds in memory
 	// (glb_estimate). size_t products: nothing here wraps.

@@ -138,7 +138,7 @@ struct plume_scene_runner {
 	plume_vec3 *body_positions;
 	plume_scene_surfaces *surfaces;
 	plume_scene_summary summary;
-	int step_count; ///< the scene's steps: ceil(duration / time_step)
+	int step_count; ///< the scene's steps: ceil(duration / time_step), at least 1
 	double start;   ///< omp_get_wtime() at creation
 };
 
@@ -185,7 +185,9 @@ static plume_status runner_begin(plume_scene_runner *runner, plume_error *err)
 		status = check_frame(runner->surfaces, sim, runner->body_positions, 0, summary, err);
 	if (status != PLUME_OK)
 		return status;
-	double step_count = ceil(scene->duration / scene->sim.time_step - 1e-9);
+	// At least one step: a duration below 1e-9 of a step rounded to none, and the run wrote
+	// frame 0 alone as a completed simulation.
+	double step_count = fmax(1.0, ceil(scene->duration / scene->sim.time_step - 1e-9));
 	if (!(step_count >= 0.0 && step_count <= PLUME_SCENE_MAX_STEPS))
 		return plume_error_set(err, PLUME_ERROR_SPEC,
 		                       "scene: duration %g s in steps of %g s is %.3g steps; "

@@ -57,6 +57,13 @@ check "frames keep the mesh's vertex count" test "$(grep -c '^v ' "$out/frames/0
 "$plume" simulate "$scratch/swing.json" -o "$scratch/again" >/dev/null 2>&1
 check "same scene, same frames" cmp -s "$out/frames/0003.obj" "$scratch/again/frames/0003.obj"
 
+# A positive duration takes at least one step: under 1e-9 of a step it rounded to none, and
+# the run wrote frame 0 alone as a completed simulation of 0 steps.
+"$plume" simulate "$scratch/swing.json" -o "$scratch/tiny" --duration 1e-12 >/dev/null 2>&1
+succeeded "a duration far below the time step runs"
+check "a duration far below the time step takes one step" grep -q '"steps": 1,' "$scratch/tiny/summary.json"
+check "its stats have that step" test "$(wc -l <"$scratch/tiny/stats.csv")" -eq 2
+
 # Rerunning into the same folder replaces the frames and keeps other files.
 echo keep >"$scratch/again/notes.txt"
 "$plume" simulate "$scratch/swing.json" -o "$scratch/again" >/dev/null 2>&1
