@@ -438,27 +438,48 @@ static void scene_relative(const char *file, const char *name, char *out, size_t
 	}
 }
 
+/// An inline feather spec's error, "file: $.key: ...", at the scene's path of the spec:
+/// "file: $.feathers[2].feather.key: ..." ("$.key" names no key of the scene).
+static void inline_error_path(plume_error *err, const char *file, const char *where)
+{
+	if (err == NULL)
+		return;
+	size_t length = strlen(file);
+	if (strncmp(err->message, file, length) != 0 || strncmp(err->message + length, ": $", 3) != 0)
+		return;
+	char message[sizeof err->message];
+	snprintf(message, sizeof message, "%s: %s%s", file, where, err->message + length + 3);
+	memcpy(err->message, message, sizeof message);
+}
+
 /// Generates (or reads) the feather of value (at JSON path `where`): a generator spec inline or
 /// by path (relative to the scene), or a feather written by `plume generate --format json`.
+/// Errors name the scene and `where`.
 static plume_status load_feather(const char *file, const json_t *value, const char *where,
                                  const plume_spec_options *options, plume_feather **out, plume_error *err)
 {
-	if (json_is_object(value))
-		return plume_spec_generate_json(file, value, options, out, err);
+	if (json_is_object(value)) {
+		plume_status status = plume_spec_generate_json(file, value, options, out, err);
+		if (status != PLUME_OK)
+			inline_error_path(err, file, where);
+		return status;
+	}
 	if (!json_is_string(value))
 		return plume_error_set(err, PLUME_ERROR_SPEC, "%s: %s: expected a feather spec (an object) or the path of one",
 		                       file, where);
 	char path[4096];
 	scene_relative(file, json_string_value(value), path, sizeof path);
 	json_t *spec = plume_spec_load(path, err);
-	if (spec == NULL) {
-		plume_error_prefix(err, file);
-		return err != NULL ? err->status : PLUME_ERROR_IO;
-	}
-	plume_status status = json_object_get(spec, "model") != NULL
+	plume_status status = spec == NULL ? (err != NULL ? err->status : PLUME_ERROR_IO)
+	                      : json_object_get(spec, "model") != NULL
 	                          ? plume_spec_generate_json(path, spec, options, out, err)
 	                          : plume_read_json(path, out, err);
 	json_decref(spec);
+	if (status != PLUME_OK) {
+		char prefix[4200];
+		snprintf(prefix, sizeof prefix, "%s: %s", file, where);
+		plume_error_prefix(err, prefix);
+	}
 	return status;
 }
 

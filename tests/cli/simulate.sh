@@ -85,6 +85,17 @@ bad "unknown key" 'did you mean "duration"' '"durations": 1'
 bad "unknown integrator" '$.integrator: unknown value "bdf3"' '"integrator": "bdf3"'
 bad "negative normal drag" '$.air.normal_drag is -1, allowed >= 0' '"air": {"normal_drag": -1}'
 bad "NaN wind" '$.air.wind: element 1 is not a number' '"air": {"wind": [0, "NaN", 0]}'
+# An inline feather's errors are at the scene's path of it ($.feather.x), not at the scene's
+# top ($.x, which names no key of the scene); a feather file that cannot be read names the key.
+printf '{"feather": {"model": "franco-walter", "x": 1}, "duration": 0.011}\n' >"$scratch/inline.json"
+expect_no_output "an inline feather's unknown key" 3 'inline.json: $.feather.x: unknown key' \
+	"$scratch/inline-out" "$plume" simulate "$scratch/inline.json" -o "$scratch/inline-out"
+printf '{"feathers": [{"feather": {"model": "franco-walter", "shaft_samples": -1}}], "duration": 0.011}\n' >"$scratch/inline.json"
+expect_no_output "an inline feather's bad value in a list" 3 'inline.json: $.feathers[0].feather.shaft_samples is -1' \
+	"$scratch/inline-out" "$plume" simulate "$scratch/inline.json" -o "$scratch/inline-out"
+printf '{"feathers": [{"feather": "missing.json"}], "duration": 0.011}\n' >"$scratch/inline.json"
+expect_no_output "a missing feather file names the key" 4 'inline.json: $.feathers[0].feather: ' \
+	"$scratch/inline-out" "$plume" simulate "$scratch/inline.json" -o "$scratch/inline-out"
 # A radius without a point to measure it from selected nothing less: the whole group was held.
 bad "radius without near" '$.handles[0].radius: given without "near"' '"handles": [{"group": "left_edge", "radius": 0.004}]'
 # A force entry without its force pulled with nothing (a zero force) and said nothing.
