@@ -722,6 +722,33 @@ static void expect_error(const char *text, plume_status status, const char *mess
 #define FEATHER                                                                                                        \
 	"\"feather\": \"" PLUME_SOURCE_DIR "/examples/franco-walter/blue.json\", \"mesh\": {\"edge_length\": 0.01}"
 
+/// The forces of a scene add up where their groups share vertices, as forces do: two forces
+/// on the rachis tip move it as their sum does. Each replaced the load of the one before on
+/// the vertices they shared (plume_sim_set_group_load), so only the last one pulled.
+static void test_forces_add_up(void **state)
+{
+	(void)state;
+#define PULLED "{\"feather\": " BLUE ", " SETTINGS ", \"forces\": ["
+	trajectory two = run_text(PULLED "{\"group\": \"rachis_tip\", \"force\": [0, 0, 0.002]}, "
+	                                 "{\"group\": \"rachis_tip\", \"force\": [0.001, 0, 0]}]}",
+	                          NULL);
+	trajectory sum = run_text(PULLED "{\"group\": \"rachis_tip\", \"force\": [0.001, 0, 0.002]}]}", NULL);
+	trajectory last = run_text(PULLED "{\"group\": \"rachis_tip\", \"force\": [0.001, 0, 0]}]}", NULL);
+#undef PULLED
+	assert_int_equal(two.states, sum.states);
+	double worst = 0, apart = 0;
+	for (size_t i = 0; i < (size_t)two.states * (size_t)two.vertex_count; ++i) {
+		worst = fmax(worst, plume_v3_length(plume_v3_sub(two.positions[i], sum.positions[i])));
+		apart = fmax(apart, plume_v3_length(plume_v3_sub(sum.positions[i], last.positions[i])));
+	}
+	printf("two forces against their sum: %.3g m (their sum against the last alone: %.3g m)\n", worst, apart);
+	assert_true(worst < 1e-10);
+	assert_true(apart > 1e-6);
+	free(two.positions);
+	free(sum.positions);
+	free(last.positions);
+}
+
 static void test_bad_scenes(void **state)
 {
 	(void)state;
@@ -831,6 +858,7 @@ int main(void)
 	    cmocka_unit_test(test_handle_pose_interpolation),
 	    cmocka_unit_test(test_handle_pose_axis_of_a_key_without_rotation),
 	    cmocka_unit_test(test_bad_scenes),
+	    cmocka_unit_test(test_forces_add_up),
 	    cmocka_unit_test(test_bending_key),
 	    cmocka_unit_test(test_figure1_anisotropic_bends_the_rachis),
 	    cmocka_unit_test(test_figure1_full_amplitude_buckles_without_collapse),

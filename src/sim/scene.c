@@ -169,7 +169,7 @@ static plume_status runner_begin(plume_scene_runner *runner, plume_error *err)
 	if (status == PLUME_OK)
 		status = add_follicle_handles(scene, sim, runner->ids, err);
 	for (int l = 0; l < scene->force_count && status == PLUME_OK; ++l)
-		status = plume_sim_set_group_load(sim, scene->forces[l].group, scene->forces[l].force, err);
+		status = plume_sim_add_group_load(sim, scene->forces[l].group, scene->forces[l].force, err); // they add up
 	summary->vertex_count = scene->mesh->vertex_count;
 	summary->feather_count = scene->feather_count;
 	summary->face_count = scene->mesh->face_count;
