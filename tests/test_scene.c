@@ -772,6 +772,12 @@ static void test_bad_scenes(void **state)
 	             "$.bending: unknown value \"paper_hinge\"; did you mean \"paper-hinge\"? (allowed: fundamental-form, "
 	             "paper-hinge)");
 	expect_error("{" FEATHER ", \"bending\": 1}", PLUME_ERROR_SPEC, "$.bending");
+	// A vertex follows one handle: two handles holding it were resolved by the later one.
+	expect_error("{" FEATHER ", \"handles\": [{\"group\": \"rachis_clamp\"}, {\"group\": \"rachis\", \"keyframes\": "
+	             "[{\"time\": 0}, {\"time\": 1, \"translation\": [0, 0, 0.01]}]}]}",
+	             PLUME_ERROR_SPEC, "$.handles[1].group: \"rachis\" holds vertex ");
+	expect_error("{" FEATHER ", \"handles\": [{\"group\": \"rachis_clamp\"}, {\"group\": \"rachis_clamp\"}]}",
+	             PLUME_ERROR_SPEC, "which $.handles[0] (\"rachis_clamp\") holds too; a vertex follows one handle");
 	// Many feathers.
 	expect_error("{\"feathers\": [{\"feather\": " BLUE ", \"name\": \"wing\"}, {\"feather\": " BLUE
 	             ", \"name\": \"wing\"}]}",

@@ -353,6 +353,44 @@ static void read_handles(plume_spec_reader *reader, const json_t *root, plume_sc
 	}
 }
 
+/// The group a handle was given as in the scene (a "near" selection's source group).
+static const char *handle_given_group(const plume_scene_handle *handle)
+{
+	return handle->source_group[0] != '\0' ? handle->source_group : handle->group;
+}
+
+/// A vertex follows one handle: two handles that share a vertex were resolved by the later one
+/// (its target overwrote the earlier's, and both reported its reaction).
+static void check_handle_overlap(plume_spec_reader *reader, const plume_scene *scene)
+{
+	if (reader->status != PLUME_OK || scene->handle_count < 2)
+		return;
+	int *owner = plume_alloc(sizeof(int) * (size_t)scene->mesh->vertex_count);
+	if (owner == NULL) {
+		plume_spec_fail(reader, "$.handles", "out of memory");
+		return;
+	}
+	for (int v = 0; v < scene->mesh->vertex_count; ++v)
+		owner[v] = -1;
+	for (int h = 0; h < scene->handle_count && reader->status == PLUME_OK; ++h) {
+		const plume_vertex_group *group = plume_mesh_find_group(scene->mesh, scene->handles[h].group);
+		for (int i = 0; group != NULL && i < group->count && reader->status == PLUME_OK; ++i) {
+			int v = group->vertices[i], other = owner[v];
+			if (other >= 0 && other != h) {
+				char path[64];
+				snprintf(path, sizeof path, "$.handles[%d].group", h);
+				plume_spec_fail(reader, path,
+				                "\"%s\" holds vertex %d, which $.handles[%d] (\"%s\") holds too; a vertex follows "
+				                "one handle (hold groups that share no vertex, or one of the two)",
+				                handle_given_group(scene->handles + h), v, other,
+				                handle_given_group(scene->handles + other));
+			}
+			owner[v] = h;
+		}
+	}
+	plume_free(owner);
+}
+
 /// A vertex may be in one handle: the scene's handles must leave alone the calamus of every
 /// feather its follicle moves with the body.
 static void check_follicle_handles(plume_spec_reader *reader, const plume_scene *scene)
@@ -1238,6 +1276,7 @@ static plume_status scene_from_json(const char *path, json_t *root, const plume_
 		status = build_mesh(path, root, &feather_options, scene, err);
 	if (status == PLUME_OK) {
 		read_handles(&reader, root, scene);
+		check_handle_overlap(&reader, scene);
 		check_follicle_handles(&reader, scene);
 		read_forces(&reader, root, scene);
 		status = reader.status;
