@@ -771,7 +771,8 @@ static void test_bad_scenes(void **state)
 	expect_error("{" FEATHER ", \"bending\": \"paper_hinge\"}", PLUME_ERROR_SPEC,
 	             "$.bending: unknown value \"paper_hinge\"; did you mean \"paper-hinge\"? (allowed: fundamental-form, "
 	             "paper-hinge)");
-	expect_error("{" FEATHER ", \"bending\": 1}", PLUME_ERROR_SPEC, "$.bending");
+	expect_error("{" FEATHER ", \"bending\": 1}", PLUME_ERROR_SPEC,
+	             "$.bending: expected true, false or a model's name (fundamental-form, paper-hinge), got a number");
 	// A vertex follows one handle: two handles holding it were resolved by the later one.
 	expect_error("{" FEATHER ", \"handles\": [{\"group\": \"rachis_clamp\"}, {\"group\": \"rachis\", \"keyframes\": "
 	             "[{\"time\": 0}, {\"time\": 1, \"translation\": [0, 0, 0.01]}]}]}",

@@ -1186,9 +1186,16 @@ static void read_bending(plume_spec_reader *reader, const json_t *root, plume_si
 		plume_spec_bool(reader, root, "$", "bending", &def->bending);
 		return;
 	}
-	const char *name;
-	if (!plume_spec_string(reader, root, "$", "bending", &name))
+	if (!json_is_string(value)) { // "expected a string" left out the booleans
+		plume_spec_fail(reader, "$.bending", "expected true, false or a model's name (%s, %s), got %s",
+		                bending_models[0], bending_models[1],
+		                json_is_number(value)   ? "a number"
+		                : json_is_array(value)  ? "an array"
+		                : json_is_object(value) ? "an object"
+		                                        : "null");
 		return;
+	}
+	const char *name = json_string_value(value);
 	int model = word_index(reader, "$.bending", name, bending_models);
 	if (model >= 0)
 		def->bending_model = (plume_bending_model)model;
