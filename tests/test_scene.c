@@ -764,6 +764,12 @@ static void test_bad_scenes(void **state)
 	expect_error("{" FEATHER ", \"materials\": {\"vane\": {\"model\": \"orthotropc\"}}}", PLUME_ERROR_SPEC,
 	             "did you mean \"orthotropic\"?");
 	expect_error("{" FEATHER ", \"duraton\": 1}", PLUME_ERROR_SPEC, "duration");
+	// A modulus of the other model was ignored unchecked.
+	expect_error("{" FEATHER ", \"materials\": {\"vane\": {\"poisson_ratio\": -0.5}}}", PLUME_ERROR_SPEC,
+	             "$.materials.vane.poisson_ratio: belongs to the isotropic model, and this material is orthotropic; "
+	             "set \"model\": \"isotropic\"");
+	expect_error("{" FEATHER ", \"materials\": {\"rachis\": {\"E_ww\": 1e5}}}", PLUME_ERROR_SPEC,
+	             "$.materials.rachis.E_ww: belongs to the orthotropic model, and this material is isotropic");
 	expect_error("{\"mesh\": {}}", PLUME_ERROR_SPEC, "exactly one of \"feather\"");
 	expect_error("{" FEATHER
 	             ", \"handles\": [{\"group\": \"rachis_tip\", \"keyframes\": [{\"time\": 1}, {\"time\": 0.5}]}]}",

@@ -129,6 +129,22 @@ static void read_material(plume_spec_reader *reader, const json_t *object, const
 	plume_spec_number(reader, object, path, "bending_along", &m->bending_along);
 	plume_spec_number(reader, object, path, "bending_across", &m->bending_across);
 	plume_spec_number(reader, object, path, "compression_coefficient", &m->compression_coefficient);
+	// A modulus of the other model was ignored, unchecked (an orthotropic vane took "poisson_ratio":
+	// -0.5 and ran on its E_ww, E_vw): the model was likely left out.
+	static const char *const orthotropic_only[] = {"E_vv", "E_ww", "E_vw", NULL};
+	static const char *const isotropic_only[] = {"youngs_modulus", "poisson_ratio", NULL};
+	bool orthotropic = m->kind == PLUME_MATERIAL_ORTHOTROPIC;
+	const char *const *unused = orthotropic ? isotropic_only : orthotropic_only;
+	for (int k = 0; unused[k] != NULL && reader->status == PLUME_OK; ++k)
+		if (json_object_get(object, unused[k]) != NULL) {
+			char child[128];
+			plume_spec_path(child, sizeof child, path, unused[k]);
+			plume_spec_fail(reader, child,
+			                "belongs to the %s model, and this material is %s; set \"model\": \"%s\", or leave "
+			                "the key out",
+			                orthotropic ? "isotropic" : "orthotropic", orthotropic ? "orthotropic" : "isotropic",
+			                orthotropic ? "isotropic" : "orthotropic");
+		}
 }
 
 static void read_materials(plume_spec_reader *reader, const json_t *root, plume_sim_def *def)
