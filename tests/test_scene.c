@@ -816,6 +816,15 @@ static void test_bad_scenes(void **state)
 	             ", \"position\": [0, 0, 0.05], \"follicle\": {\"bone\": \"cret\"}}]}",
 	             PLUME_ERROR_SPEC,
 	             "$.feathers[0].follicle.bone: unknown bone \"cret\"; did you mean \"crest\"? (the body has: crest)");
+	// An empty name followed the body as a whole, silently; a name past a bone's 31 bytes was cut
+	// to them (and could then name another bone).
+	expect_error("{" BODY ", \"feathers\": [{\"feather\": " BLUE
+	             ", \"position\": [0, 0, 0.05], \"follicle\": {\"bone\": \"\"}}]}",
+	             PLUME_ERROR_SPEC, "$.feathers[0].follicle.bone: \"\" is not a bone's name; allowed 1 to 31 bytes");
+	expect_error("{" BODY ", \"feathers\": [{\"feather\": " BLUE
+	             ", \"position\": [0, 0, 0.05], \"follicle\": {\"bone\": \"crest-crest-crest-crest-crest-crest\"}}]}",
+	             PLUME_ERROR_SPEC,
+	             "$.feathers[0].follicle.bone: \"crest-crest-crest-crest-crest-crest\" is not a bone's name");
 	expect_error("{" BODY ", \"feathers\": [{\"feather\": " BLUE
 	             ", \"position\": [0, 0, 0.05], \"follicle\": {}}], \"handles\": [{\"group\": \"rachis_clamp\"}]}",
 	             PLUME_ERROR_SPEC, "$.handles[0].group: \"rachis_clamp\" holds feather \"f0\"'s calamus");

@@ -688,8 +688,19 @@ static void read_attachment(plume_spec_reader *reader, const json_t *object, con
 		plume_spec_path(follicle_path, sizeof follicle_path, path, "follicle");
 		plume_spec_check_keys(reader, follicle, follicle_path, follicle_keys);
 		const char *bone = NULL;
-		if (plume_spec_string(reader, follicle, follicle_path, "bone", &bone))
-			snprintf(item->bone, sizeof item->bone, "%s", bone);
+		if (plume_spec_string(reader, follicle, follicle_path, "bone", &bone)) {
+			size_t length = strlen(bone);
+			if (length == 0 || length >= sizeof item->bone) { // "" followed the body as a whole
+				char bone_path[128];
+				plume_spec_path(bone_path, sizeof bone_path, follicle_path, "bone");
+				plume_spec_fail(reader, bone_path,
+				                "\"%.64s\" is not a bone's name; allowed 1 to %d bytes (leave \"bone\" out to "
+				                "follow the body as a whole)",
+				                bone, (int)sizeof item->bone - 1);
+				return;
+			}
+			memcpy(item->bone, bone, length + 1);
+		}
 		plume_spec_bool(reader, follicle, follicle_path, "nearest_bone", &item->nearest_bone);
 		if (reader->status == PLUME_OK && bone != NULL && item->nearest_bone)
 			plume_spec_fail(reader, follicle_path, "names a bone and asks for the nearest one; give one of the two");
