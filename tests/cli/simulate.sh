@@ -63,6 +63,17 @@ check "same scene, same frames" cmp -s "$out/frames/0003.obj" "$scratch/again/fr
 succeeded "a duration far below the time step runs"
 check "a duration far below the time step takes one step" grep -q '"steps": 1,' "$scratch/tiny/summary.json"
 check "its stats have that step" test "$(wc -l <"$scratch/tiny/stats.csv")" -eq 2
+# seconds_per_cycle divides the wall time by the cycles simulated, the steps' time (docs/scene.md):
+# 0.05 s asked in steps of 0.011 s runs 5 steps, 0.055 s, 5 cycles of 0.011 s. It took the
+# duration asked instead (4.5 cycles; with --duration 1e-12 one step counted as 1e-12 s).
+sed 's/"duration": 0.055,/"cycle_period": 0.011, "duration": 0.055,/' "$scratch/swing.json" >"$scratch/cycle.json"
+"$plume" simulate "$scratch/cycle.json" -o "$scratch/cycle" --duration 0.05 >/dev/null 2>&1
+check "seconds_per_cycle: the wall time over the cycles of the steps run" /usr/bin/python3 -c '
+import json, sys
+s = json.load(open(sys.argv[1]))
+assert s["steps"] == 5 and abs(s["time"] - 0.055) < 1e-12, s
+assert abs(s["seconds_per_cycle"] - s["wall_seconds"] / 5) <= 1e-6 * s["seconds_per_cycle"], s
+' "$scratch/cycle/summary.json"
 
 # Rerunning into the same folder replaces the frames and keeps other files.
 echo keep >"$scratch/again/notes.txt"
