@@ -36,7 +36,8 @@ void cli_help_simulate(void)
 	     "  DIR/frames/NNNN.png   a shaded view of each frame, with --png\n"
 	     "  DIR/stats.csv         per step: time, Newton iterations, gradient norm,\n"
 	     "                        energy, largest barb-edge strain, wall seconds, the\n"
-	     "                        kinetic, elastic and gravitational energy (J), and\n"
+	     "                        kinetic, elastic and gravitational energy (J), the\n"
+	     "                        substeps (above 1 for a retried step), and\n"
 	     "                        per handle N (in the scene's order) the reaction force\n"
 	     "                        handleN_f{x,y,z} (N) and displacement handleN_d{x,y,z} (m)\n"
 	     "  DIR/summary.json      steps, iterations, timings, largest barb strain,\n"
@@ -362,6 +363,7 @@ static plume_status on_step(void *user, int step, double time, const plume_sim *
 		        report->newton_iterations, report->gradient_norm, report->energy, report->max_barb_strain, wall_seconds,
 		        e.kinetic, elastic, e.gravity, e.contact, e.friction, vane.min_principal_stretch,
 		        vane.max_out_of_plane);
+		fprintf(run->stats, ",%d", report->substeps); // 1, or 2, 4, ... for a retried step
 		// fmin/fmax skip NaN: a measure that is never defined stays NaN (null in summary.json).
 		run->min_stretch = fmin(run->min_stretch, vane.min_principal_stretch);
 		run->max_out_of_plane = fmax(run->max_out_of_plane, vane.max_out_of_plane);
@@ -664,7 +666,7 @@ static plume_status run_scene(const plume_scene *scene, cli_output *output, run_
 	fprintf(run->stats,
 	        "time,newton_iterations,gradient_norm,energy,max_barb_strain,wall_seconds,kinetic_energy,"
 	        "elastic_energy,gravitational_energy,contact_energy,friction_potential,vane_min_principal_stretch,"
-	        "vane_max_out_of_plane");
+	        "vane_max_out_of_plane,substeps");
 	for (int h = 0; h < scene->handle_count; ++h)
 		fprintf(run->stats, ",handle%d_fx,handle%d_fy,handle%d_fz,handle%d_dx,handle%d_dy,handle%d_dz", h, h, h, h, h,
 		        h);

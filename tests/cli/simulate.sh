@@ -33,7 +33,7 @@ check "summary has rachis_tip_deflection" grep -q '"rachis_tip_deflection"' "$ou
 # The vane's shape and the handle's reaction per step, their extremes in the summary:
 # a feather held at its clamp sags under gravity (its vane leaves the plane by a little,
 # well under its length) and stretches by next to nothing; the clamp carries its weight (+z).
-check "stats has the vane's shape" grep -q "^time,.*,gravitational_energy,contact_energy,friction_potential,vane_min_principal_stretch,vane_max_out_of_plane,handle0_fx," "$out/stats.csv"
+check "stats has the vane's shape" grep -q "^time,.*,gravitational_energy,contact_energy,friction_potential,vane_min_principal_stretch,vane_max_out_of_plane,substeps,handle0_fx," "$out/stats.csv"
 check "vane shape and reactions: plausible, summary gives their extremes" /usr/bin/python3 -c '
 import csv, json, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
@@ -74,6 +74,21 @@ s = json.load(open(sys.argv[1]))
 assert s["steps"] == 5 and abs(s["time"] - 0.055) < 1e-12, s
 assert abs(s["seconds_per_cycle"] - s["wall_seconds"] / 5) <= 1e-6 * s["seconds_per_cycle"], s
 ' "$scratch/cycle/summary.json"
+
+# A retried step shows in stats.csv (docs/simulation.md, "Failures"): its substeps column. A
+# tip pulled by 0.2 N with at most 6 Newton iterations a solve retries its second step.
+sed 's/"duration": 0.055,/"duration": 0.033, "forces": [{"group": "rachis_tip", "force": [0, 0, -0.2]}], "solver": {"max_iterations": 6},/' \
+	"$scratch/swing.json" >"$scratch/retry.json"
+"$plume" simulate "$scratch/retry.json" -o "$scratch/retry" >/dev/null 2>&1
+succeeded "a run with a retried step"
+check "stats.csv gives each step's substeps, the retried ones as summary.json counts them" /usr/bin/python3 -c '
+import csv, json, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+summary = json.load(open(sys.argv[2]))
+substeps = [int(r["substeps"]) for r in rows]
+assert summary["retried_steps"] == sum(n > 1 for n in substeps) >= 1, (substeps, summary["retried_steps"])
+assert all(n in (1, 2, 4, 8, 16) for n in substeps), substeps
+' "$scratch/retry/stats.csv" "$scratch/retry/summary.json"
 
 # Rerunning into the same folder replaces the frames and keeps other files.
 echo keep >"$scratch/again/notes.txt"
