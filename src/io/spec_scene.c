@@ -1290,6 +1290,15 @@ static plume_status scene_from_json(const char *path, json_t *root, const plume_
 		plume_spec_fail(&reader, "$.duration", "is %g, allowed > 0 (seconds)", scene->duration);
 	if (reader.status == PLUME_OK && scene->frame_every < 1)
 		plume_spec_fail(&reader, "$.frame_every", "is %d, allowed >= 1", scene->frame_every);
+	// Air acts on the velocity relative to the wind, and a static solve has no velocity: it
+	// leaves the air out (src/sim/potential.c), so a wind or gusts there blew on nothing.
+	const plume_air_def *air = &scene->sim.air;
+	if (reader.status == PLUME_OK && scene->quasi_static && air->density > 0 &&
+	    (air->wind.x != 0 || air->wind.y != 0 || air->wind.z != 0 || air->gust_speed > 0))
+		plume_spec_fail(&reader, "$.air",
+		                "a quasi-static scene leaves the air out of its static solve, so its wind (%g, %g, %g) m/s "
+		                "and gusts (%g m/s) would move nothing; drop \"quasi_static\" to feel them, or the wind",
+		                air->wind.x, air->wind.y, air->wind.z, air->gust_speed);
 	plume_status status = reader.status;
 	if (status == PLUME_OK) {
 		status = plume_sim_def_validate(&scene->sim, 0, err);

@@ -124,6 +124,8 @@ expect_no_output "a missing feather file names the key" 4 'inline.json: $.feathe
 	"$scratch/inline-out" "$plume" simulate "$scratch/inline.json" -o "$scratch/inline-out"
 # A radius without a point to measure it from selected nothing less: the whole group was held.
 bad "radius without near" '$.handles[0].radius: given without "near"' '"handles": [{"group": "left_edge", "radius": 0.004}]'
+# The static solve leaves the air out: a quasi-static scene in a wind ran as if in still air.
+bad "quasi-static in a wind" '$.air: a quasi-static scene leaves the air out of its static solve' '"quasi_static": true, "air": {"wind": [0, 0, 10]}'
 # A force entry without its force pulled with nothing (a zero force) and said nothing.
 bad "force without force" '$.forces[0].force: missing; a force is [x, y, z] in N' '"forces": [{"group": "rachis_tip"}]'
 # A handle that pulls a barb away from the clamp holding its other end (the Streit-Heidrich
