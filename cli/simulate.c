@@ -907,23 +907,29 @@ int cli_simulate(int argc, char **argv)
 	    (size_t)((run.png ? 1 : 0) + (run.render ? 1 : 0)) * 4 * (size_t)run.view.width * (size_t)run.view.height;
 	glb_estimate glb = estimate_glb(scene, run.glb_feather, frame_count);
 	size_t total = frame_count * frame_bytes + glb.memory;
+	// The keys that set the frames: the options when given, else the scene's.
+	const char *duration_key = duration > 0 ? "--duration" : "$.duration";
+	const char *every_key = frames_every > 0 ? "--frames-every" : "$.frame_every";
 	if (total > max_bytes) {
 		fprintf(stderr,
-		        "plume: %s: $.duration: %zu frames of up to %.3g MB each would write %.3g GB, and sim.glb%s would hold "
-		        "%.3g GB in memory: %.3g GB; the limit is %.3g GB (raise it with --max-memory, or raise $.frame_every "
+		        "plume: %s: %s: %zu frames of up to %.3g MB each would write %.3g GB, and sim.glb%s would hold "
+		        "%.3g GB in memory: %.3g GB; the limit is %.3g GB (raise it with --max-memory, or raise %s "
 		        "or $.time_step%s)\n",
-		        argv[optind], frame_count, (double)frame_bytes / 1e6, (double)(frame_count * frame_bytes) / 1e9,
+		        argv[optind], duration_key, frame_count, (double)frame_bytes / 1e6,
+		        (double)(frame_count * frame_bytes) / 1e9,
 		        run.glb_feather ? " with the carried feathers (--glb-feather)" : "", (double)glb.memory / 1e9,
-		        (double)total / 1e9, (double)max_bytes / 1e9, run.glb_feather ? ", or leave out --glb-feather" : "");
+		        (double)total / 1e9, (double)max_bytes / 1e9, every_key,
+		        run.glb_feather ? ", or leave out --glb-feather" : "");
 		plume_scene_destroy(scene);
 		return CLI_EXIT_LIMIT;
 	}
 	if (frame_count > SIM_GLB_MAX_FRAMES || glb.file > UINT32_MAX) {
 		fprintf(stderr,
-		        "plume: %s: $.duration: %zu frames%s make a sim.glb of about %.3g GB; a GLB file holds at most 4 GiB "
-		        "and %d frames (one morph target each) (raise $.frame_every or $.time_step, or shorten the run%s)\n",
-		        argv[optind], frame_count, run.glb_feather ? " with --glb-feather" : "", (double)glb.file / 1e9,
-		        SIM_GLB_MAX_FRAMES, run.glb_feather ? ", or leave out --glb-feather" : "");
+		        "plume: %s: %s: %zu frames%s make a sim.glb of about %.3g GB; a GLB file holds at most 4 GiB "
+		        "and %d frames (one morph target each) (raise %s or $.time_step, or shorten the run%s)\n",
+		        argv[optind], duration_key, frame_count, run.glb_feather ? " with --glb-feather" : "",
+		        (double)glb.file / 1e9, SIM_GLB_MAX_FRAMES, every_key,
+		        run.glb_feather ? ", or leave out --glb-feather" : "");
 		plume_scene_destroy(scene);
 		return CLI_EXIT_LIMIT;
 	}

@@ -75,6 +75,11 @@ assert s["steps"] == 5 and abs(s["time"] - 0.055) < 1e-12, s
 assert abs(s["seconds_per_cycle"] - s["wall_seconds"] / 5) <= 1e-6 * s["seconds_per_cycle"], s
 ' "$scratch/cycle/summary.json"
 
+# The limits on the frames name the option that set them: --duration, not the scene's $.duration.
+expect_no_output "--duration past sim.glb's frames" 5 "swing.json: --duration: 90911 frames make a sim.glb" \
+	"$scratch/long" "$plume" simulate "$scratch/swing.json" -o "$scratch/long" --duration 1000 --frames-every 1
+check "--duration past sim.glb's frames: says to raise --frames-every" grep -qF "(raise --frames-every or \$.time_step" "$scratch/err.txt"
+
 # A retried step shows in stats.csv (docs/simulation.md, "Failures"): its substeps column. A
 # tip pulled by 0.2 N with at most 6 Newton iterations a solve retries its second step.
 sed 's/"duration": 0.055,/"duration": 0.033, "forces": [{"group": "rachis_tip", "force": [0, 0, -0.2]}], "solver": {"max_iterations": 6},/' \
