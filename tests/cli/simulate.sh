@@ -101,6 +101,19 @@ echo keep >"$scratch/again/notes.txt"
 check "rerun keeps the user's files" test -s "$scratch/again/notes.txt"
 check "rerun leaves no staging" test -z "$(ls -A "$scratch/again" | grep plume-staging)"
 
+# -o . (and ..): the staging folder went beside "." -- inside the folder itself -- and linking the
+# folder's own files into it recursed into it until the path was too long (exit 4).
+mkdir -p "$scratch/here/inner"
+echo mine >"$scratch/here/notes.txt"
+(cd "$scratch/here" && "$plume" simulate "$scratch/swing.json" -o . >/dev/null 2>"$scratch/err.txt")
+succeeded "simulate -o ."
+check "-o .: the run's files" test -s "$scratch/here/summary.json" -a -s "$scratch/here/frames/0003.obj"
+check "-o .: the user's files kept" test -s "$scratch/here/notes.txt"
+check "-o .: no staging left" test -z "$(ls -A "$scratch" "$scratch/here" | grep plume-staging)"
+(cd "$scratch/here/inner" && "$plume" simulate "$scratch/swing.json" -o .. >/dev/null 2>"$scratch/err.txt")
+succeeded "simulate -o .. (again, into the earlier run)"
+check "-o ..: the user's files kept" test -s "$scratch/here/notes.txt" -a -d "$scratch/here/inner"
+
 # Bad scenes: clear error, exit 3, nothing written.
 bad() { # bad NAME FRAGMENT JSON-MEMBERS
 	printf '{"feather": "%s/examples/franco-walter/blue.json", "mesh": {"edge_length": 0.01}, %s}\n' "$source_dir" "$3" >"$scratch/bad.json"
