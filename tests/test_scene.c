@@ -803,6 +803,9 @@ static void test_bad_scenes(void **state)
 	             "did you mean \"position\"");
 	expect_error("{\"feathers\": [{\"feather\": " BLUE ", \"rotation_deg\": 10, \"rotation_axis\": [0, 0, 0]}]}",
 	             PLUME_ERROR_SPEC, "$.feathers[0].rotation_axis: is the zero vector");
+	// An axis alone placed the feather unturned, silently.
+	expect_error("{\"feathers\": [{\"feather\": " BLUE ", \"rotation_axis\": [1, 0, 0]}]}", PLUME_ERROR_SPEC,
+	             "$.feathers[0].rotation_axis: given without \"rotation_deg\"");
 	expect_error("{\"feathers\": [{\"feather\": " BLUE "}, {\"feather\": " BLUE
 	             ", \"position\": [0.1, 0, 0]}], \"handles\": [{\"group\": \"f2/rachis_clamp\"}]}",
 	             PLUME_ERROR_SPEC, "$.handles[0].group: unknown vertex group \"f2/rachis_clamp\"");

@@ -659,6 +659,15 @@ static void read_attachment(plume_spec_reader *reader, const json_t *object, con
 	read_vec3(reader, object, path, "position", &item->translation);
 	read_vec3(reader, object, path, "rotation_axis", &axis);
 	plume_spec_number(reader, object, path, "rotation_deg", &degrees);
+	if (reader->status == PLUME_OK && json_object_get(object, "rotation_axis") != NULL &&
+	    json_object_get(object, "rotation_deg") == NULL) { // an axis alone turned nothing
+		char axis_path[96];
+		plume_spec_path(axis_path, sizeof axis_path, path, "rotation_axis");
+		plume_spec_fail(reader, axis_path,
+		                "given without \"rotation_deg\"; an axis alone turns nothing (give the "
+		                "angle in degrees too)");
+		return;
+	}
 	item->rotation = plume_m3_identity();
 	if (reader->status == PLUME_OK && degrees != 0) {
 		if (plume_v3_length(axis) == 0) {
