@@ -1167,13 +1167,18 @@ static plume_status build_mesh(const char *file, const json_t *root, const plume
 	plume_status status;
 	if (feather != NULL) {
 		status = load_feather(file, feather, "$.feather", options, &scene->feather, err);
-		if (status == PLUME_OK)
+		if (status == PLUME_OK) {
 			status = plume_mesh_from_feather(scene->feather, &mesh_def, &scene->mesh, &scene->mesh_report, err);
+			if (status != PLUME_OK) // as a list's entry says it ("$.feathers[2] (feather \"f2\"): meshing: ...")
+				plume_error_prefix(err, "$.feather: meshing");
+		}
 	} else {
 		plume_mesh_guides_storage storage;
 		status = plume_spec_mesh_guides(&reader, guides, "$.guides", &storage);
 		if (status == PLUME_OK) {
 			status = plume_mesh_from_guides(&storage.guides, &mesh_def, &scene->mesh, &scene->mesh_report, err);
+			if (status != PLUME_OK)
+				plume_error_prefix(err, "$.guides: meshing");
 			plume_mesh_guides_storage_free(&storage);
 		}
 	}

@@ -147,7 +147,7 @@ expect_no_output "mesh at 0.5 mm past --max-memory 1M" 5 'the limit is 0.00105 G
 $T "$plume" mesh "$examples/meshes/guides.json" -o "$scratch/m4" --max-memory 2M -f obj 2>"$scratch/err.txt"
 check "mesh --max-memory 2M meshes the example ($(cat "$scratch/err.txt"))" test -s "$scratch/m4/mesh.obj"
 edit "$bad/scene-short.json" "$bad/scene-fine.json" "d['mesh']['edge_length'] = 1e-6"
-expect_no_output "scene mesh past the limit" 5 'scene-fine.json: edge_length 1e-06 m on a' "$scratch/m5" \
+expect_no_output "scene mesh past the limit" 5 'scene-fine.json: $.feather: meshing: edge_length 1e-06 m on a' "$scratch/m5" \
 	$T "$plume" simulate "$bad/scene-fine.json" -o "$scratch/m5"
 
 # --- a Franco-Walter feather past the limit: barbs x samples (plume_fw_estimate_bytes) -------

@@ -144,6 +144,10 @@ expect_no_output "a missing feather file names the key" 4 'inline.json: $.feathe
 bad "radius without near" '$.handles[0].radius: given without "near"' '"handles": [{"group": "left_edge", "radius": 0.004}]'
 # The static solve leaves the air out: a quasi-static scene in a wind ran as if in still air.
 bad "quasi-static in a wind" '$.air: a quasi-static scene leaves the air out of its static solve' '"quasi_static": true, "air": {"wind": [0, 0, 10]}'
+# The mesher's refusal names what it meshed, as a list's entry does ($.feathers[2] (feather "f2"): meshing: ...).
+printf '{"feather": "%s/examples/franco-walter/blue.json", "mesh": {"edge_length": 10}}\n' "$source_dir" >"$scratch/coarse.json"
+expect_no_output "a mesh the mesher refuses" 3 'coarse.json: $.feather: meshing: no vane to mesh at edge_length 10 m' \
+	"$scratch/coarse" "$plume" simulate "$scratch/coarse.json" -o "$scratch/coarse"
 # A force entry without its force pulled with nothing (a zero force) and said nothing.
 bad "force without force" '$.forces[0].force: missing; a force is [x, y, z] in N' '"forces": [{"group": "rachis_tip"}]'
 # A handle that pulls a barb away from the clamp holding its other end (the Streit-Heidrich
