@@ -395,8 +395,33 @@ void cli_scene_bounds(const plume_scene *scene, plume_vec3 *lo, plume_vec3 *hi)
 		for (int k = 0; k < scene->handles[h].keyframe_count; ++k)
 			reach = fmax(reach, plume_v3_length(scene->handles[h].keyframes[k].translation));
 	double pad = fmax(reach, 0.1 * plume_v3_length(plume_v3_sub(*hi, *lo)));
+	// A handle that turns the feather takes it out of that box (a clamp turned 180 degrees
+	// about z showed the calamus alone): the rest box's corners as each handle carries them,
+	// at 64 times over the run and at every key, are in the picture too.
+	plume_vec3 rest_lo = *lo, rest_hi = *hi;
 	*lo = plume_v3(lo->x - pad, lo->y - pad, lo->z - pad);
 	*hi = plume_v3(hi->x + pad, hi->y + pad, hi->z + pad);
+	for (int h = 0; h < scene->handle_count; ++h) {
+		const plume_scene_handle *handle = scene->handles + h;
+		for (int j = 0; j <= 64 + handle->keyframe_count; ++j) {
+			double t = j <= 64 ? scene->duration * j / 64 : handle->keyframes[j - 65].time;
+			plume_vec3 translation;
+			plume_mat3 rotation;
+			plume_scene_handle_pose(handle, t, &translation, &rotation);
+			// A translation alone stays within the box above (its reach is in pad): unchanged.
+			double margin = memcmp(&rotation, &(plume_mat3){{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}}, sizeof rotation) != 0
+			                    ? 0.1 * plume_v3_length(plume_v3_sub(rest_hi, rest_lo))
+			                    : 0;
+			for (int c = 0; c < 8; ++c) {
+				plume_vec3 corner = plume_v3(c & 1 ? rest_hi.x : rest_lo.x, c & 2 ? rest_hi.y : rest_lo.y,
+				                             c & 4 ? rest_hi.z : rest_lo.z);
+				plume_vec3 arm = plume_m3_apply(rotation, plume_v3_sub(corner, handle->pivot));
+				plume_vec3 p = plume_v3_add(plume_v3_add(handle->pivot, arm), translation);
+				*lo = plume_v3(fmin(lo->x, p.x - margin), fmin(lo->y, p.y - margin), fmin(lo->z, p.z - margin));
+				*hi = plume_v3(fmax(hi->x, p.x + margin), fmax(hi->y, p.y + margin), fmax(hi->z, p.z + margin));
+			}
+		}
+	}
 }
 
 /// The group whose rigid motion carries the rest vane's plane for vane_max_out_of_plane: the
