@@ -967,8 +967,10 @@ plume_status plume_sim_step(plume_sim *sim, plume_solve_report *report, plume_er
 		plume_integrator_restore(&sim->integrator, sim->vertex_count);
 		if (report != NULL)
 			*report = total;
-		return plume_error_set(err, status, "step at t = %.6g s failed with %d substeps: %s", sim->time, total.substeps,
-		                       last.message);
+		// Both ends: "at t" read as the step's time, which stats.csv and summary.json's failed_time
+		// give as its end.
+		return plume_error_set(err, status, "the step from t = %.6g s to %.6g s failed with %d substeps: %s", sim->time,
+		                       sim->time + sim->def.time_step, total.substeps, last.message);
 	}
 	sim->time += sim->def.time_step;
 	finish_handles(sim);

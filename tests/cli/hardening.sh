@@ -83,7 +83,7 @@ check "first step fails: frame 0 kept" test -s "$scratch/fail/frames/0000.obj"
 check "first step fails: only frame 0" test "$(ls "$scratch/fail/frames" | wc -l)" -eq 1
 check "first step fails: summary says not completed" grep -q '"completed": false' "$scratch/fail/summary.json"
 check "first step fails: summary names the step" grep -q '"failed_step": 1,' "$scratch/fail/summary.json"
-check "first step fails: summary has the reason" grep -q '"error": "simulation: step at' "$scratch/fail/summary.json"
+check "first step fails: summary has the reason" grep -q '"error": "simulation: the step from t = 0 s to' "$scratch/fail/summary.json"
 check "first step fails: no staging left" test -z "$(ls -A "$scratch" | grep plume-staging)"
 
 # --- render of a simulation folder whose feather.json holds 1e308: segfaulted -------------

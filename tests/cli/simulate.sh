@@ -123,6 +123,22 @@ expect_no_output "--duration past sim.glb's frames" 5 "swing.json: --duration: 9
 	"$scratch/long" "$plume" simulate "$scratch/swing.json" -o "$scratch/long" --duration 1000 --frames-every 1
 check "--duration past sim.glb's frames: says to raise --frames-every" grep -qF "(raise --frames-every or \$.time_step" "$scratch/err.txt"
 
+# A failed step names its start and its end; failed_time (as stats.csv's times) is its end. The
+# message said "step at t = 0.033 s" for the step summary.json put at 0.044 s.
+cat >"$scratch/jerk.json" <<JSON
+{"feather": "$source_dir/examples/franco-walter/blue.json", "mesh": {"edge_length": 0.01},
+ "handles": [{"group": "rachis_clamp", "keyframes": [{"time": 0.033}, {"time": 0.044, "translation": [0, 0, 2]}]}],
+ "duration": 0.066, "solver": {"max_iterations": 5, "max_substep_halvings": 0}}
+JSON
+expect_failure "a step that fails" 1 "the step from t = 0.033 s to 0.044 s failed with 1 substeps" \
+	"$plume" simulate "$scratch/jerk.json" -o "$scratch/jerk"
+check "the failed step: summary.json's failed_time is its end" /usr/bin/python3 -c '
+import json, sys
+s = json.load(open(sys.argv[1]))
+assert not s["completed"] and s["failed_step"] == 4 and abs(s["failed_time"] - 0.044) < 1e-12, s
+assert "the step from t = 0.033 s to 0.044 s failed" in s["error"], s
+' "$scratch/jerk/summary.json"
+
 # A retried step shows in stats.csv (docs/simulation.md, "Failures"): its substeps column. A
 # tip pulled by 0.2 N with at most 6 Newton iterations a solve retries its second step.
 sed 's/"duration": 0.055,/"duration": 0.033, "forces": [{"group": "rachis_tip", "force": [0, 0, -0.2]}], "solver": {"max_iterations": 6},/' \
