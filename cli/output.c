@@ -534,6 +534,17 @@ plume_status cli_output_begin(cli_output *output, const char *dir, plume_error *
 			return plume_error_set(err, PLUME_ERROR_IO, "%s: exists and is not a folder", output->dir);
 		output->dir_existed = true;
 	}
+	// DIR named "." or ".." (or ending in "/." or "/.."): its last component is no name in its
+	// parent, so the staging folder "beside" it went inside it (or below it), and linking DIR's
+	// files into the staging folder recursed into itself. The folder's own path instead.
+	const char *last = strrchr(output->dir, '/');
+	last = last != NULL ? last + 1 : output->dir;
+	if (output->dir_existed && (strcmp(last, ".") == 0 || strcmp(last, "..") == 0)) {
+		char resolved[PATH_MAX];
+		if (realpath(output->dir, resolved) == NULL || strlen(resolved) + 64 >= sizeof output->dir)
+			return plume_error_set(err, PLUME_ERROR_IO, "'%s': not a usable output folder", dir);
+		snprintf(output->dir, sizeof output->dir, "%s", resolved);
+	}
 	const char *slash = strrchr(output->dir, '/');
 	int parent = slash != NULL ? (int)(slash - output->dir + 1) : 0;
 	char prefix[2200], parent_dir[2100];

@@ -36,7 +36,8 @@ void cli_help_simulate(void)
 	     "  DIR/frames/NNNN.png   a shaded view of each frame, with --png\n"
 	     "  DIR/stats.csv         per step: time, Newton iterations, gradient norm,\n"
 	     "                        energy, largest barb-edge strain, wall seconds, the\n"
-	     "                        kinetic, elastic and gravitational energy (J), and\n"
+	     "                        kinetic, elastic and gravitational energy (J), the\n"
+	     "                        substeps (above 1 for a retried step), and\n"
 	     "                        per handle N (in the scene's order) the reaction force\n"
 	     "                        handleN_f{x,y,z} (N) and displacement handleN_d{x,y,z} (m)\n"
 	     "  DIR/summary.json      steps, iterations, timings, largest barb strain,\n"
@@ -362,6 +363,7 @@ static plume_status on_step(void *user, int step, double time, const plume_sim *
 		        report->newton_iterations, report->gradient_norm, report->energy, report->max_barb_strain, wall_seconds,
 		        e.kinetic, elastic, e.gravity, e.contact, e.friction, vane.min_principal_stretch,
 		        vane.max_out_of_plane);
+		fprintf(run->stats, ",%d", report->substeps); // 1, or 2, 4, ... for a retried step
 		// fmin/fmax skip NaN: a measure that is never defined stays NaN (null in summary.json).
 		run->min_stretch = fmin(run->min_stretch, vane.min_principal_stretch);
 		run->max_out_of_plane = fmax(run->max_out_of_plane, vane.max_out_of_plane);
@@ -393,8 +395,33 @@ void cli_scene_bounds(const plume_scene *scene, plume_vec3 *lo, plume_vec3 *hi)
 		for (int k = 0; k < scene->handles[h].keyframe_count; ++k)
 			reach = fmax(reach, plume_v3_length(scene->handles[h].keyframes[k].translation));
 	double pad = fmax(reach, 0.1 * plume_v3_length(plume_v3_sub(*hi, *lo)));
+	// A handle that turns the feather takes it out of that box (a clamp turned 180 degrees
+	// about z showed the calamus alone): the rest box's corners as each handle carries them,
+	// at 64 times over the run and at every key, are in the picture too.
+	plume_vec3 rest_lo = *lo, rest_hi = *hi;
 	*lo = plume_v3(lo->x - pad, lo->y - pad, lo->z - pad);
 	*hi = plume_v3(hi->x + pad, hi->y + pad, hi->z + pad);
+	for (int h = 0; h < scene->handle_count; ++h) {
+		const plume_scene_handle *handle = scene->handles + h;
+		for (int j = 0; j <= 64 + handle->keyframe_count; ++j) {
+			double t = j <= 64 ? scene->duration * j / 64 : handle->keyframes[j - 65].time;
+			plume_vec3 translation;
+			plume_mat3 rotation;
+			plume_scene_handle_pose(handle, t, &translation, &rotation);
+			// A translation alone stays within the box above (its reach is in pad): unchanged.
+			double margin = memcmp(&rotation, &(plume_mat3){{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}}, sizeof rotation) != 0
+			                    ? 0.1 * plume_v3_length(plume_v3_sub(rest_hi, rest_lo))
+			                    : 0;
+			for (int c = 0; c < 8; ++c) {
+				plume_vec3 corner = plume_v3(c & 1 ? rest_hi.x : rest_lo.x, c & 2 ? rest_hi.y : rest_lo.y,
+				                             c & 4 ? rest_hi.z : rest_lo.z);
+				plume_vec3 arm = plume_m3_apply(rotation, plume_v3_sub(corner, handle->pivot));
+				plume_vec3 p = plume_v3_add(plume_v3_add(handle->pivot, arm), translation);
+				*lo = plume_v3(fmin(lo->x, p.x - margin), fmin(lo->y, p.y - margin), fmin(lo->z, p.z - margin));
+				*hi = plume_v3(fmax(hi->x, p.x + margin), fmax(hi->y, p.y + margin), fmax(hi->z, p.z + margin));
+			}
+		}
+	}
 }
 
 /// The group whose rigid motion carries the rest vane's plane for vane_max_out_of_plane: the
@@ -442,8 +469,9 @@ static plume_status write_summary(cli_output *output, const plume_scene *scene, 
 	json_object_set_new(root, "vertex_count", json_integer(summary->vertex_count));
 	json_object_set_new(root, "feather_count", json_integer(scene->feather_count));
 	json_object_set_new(root, "duration", json_real(scene->duration));
-	// The cost of one cycle of a cyclic scene: the wall time over the cycles simulated.
-	double simulated = fmin(summary->steps * scene->sim.time_step, scene->duration);
+	// The cost of one cycle of a cyclic scene: the wall time over the cycles simulated, the
+	// steps' time (the duration asked for, which the last step may pass, was not what ran).
+	double simulated = summary->steps * scene->sim.time_step;
 	if (scene->cycle_period > 0) {
 		json_object_set_new(root, "cycle_period", json_real(scene->cycle_period));
 		if (simulated > 0)
@@ -663,7 +691,7 @@ static plume_status run_scene(const plume_scene *scene, cli_output *output, run_
 	fprintf(run->stats,
 	        "time,newton_iterations,gradient_norm,energy,max_barb_strain,wall_seconds,kinetic_energy,"
 	        "elastic_energy,gravitational_energy,contact_energy,friction_potential,vane_min_principal_stretch,"
-	        "vane_max_out_of_plane");
+	        "vane_max_out_of_plane,substeps");
 	for (int h = 0; h < scene->handle_count; ++h)
 		fprintf(run->stats, ",handle%d_fx,handle%d_fy,handle%d_fz,handle%d_dx,handle%d_dy,handle%d_dz", h, h, h, h, h,
 		        h);
@@ -890,7 +918,7 @@ int cli_simulate(int argc, char **argv)
 	if (frames_every > 0)
 		scene->frame_every = frames_every;
 	run.scene = scene;
-	run.total_steps = (int)ceil(scene->duration / scene->sim.time_step - 1e-9);
+	run.total_steps = (int)fmax(1.0, ceil(scene->duration / scene->sim.time_step - 1e-9)); // as the runner's
 	// Before the run: the frames' bytes (an OBJ line is at most about 80 bytes, three
 	// %.17g coordinates; a PNG at most its raw pixels) and what sim.glb holds in memory
 	// (glb_estimate). size_t products: nothing here wraps.
@@ -904,23 +932,29 @@ int cli_simulate(int argc, char **argv)
 	    (size_t)((run.png ? 1 : 0) + (run.render ? 1 : 0)) * 4 * (size_t)run.view.width * (size_t)run.view.height;
 	glb_estimate glb = estimate_glb(scene, run.glb_feather, frame_count);
 	size_t total = frame_count * frame_bytes + glb.memory;
+	// The keys that set the frames: the options when given, else the scene's.
+	const char *duration_key = duration > 0 ? "--duration" : "$.duration";
+	const char *every_key = frames_every > 0 ? "--frames-every" : "$.frame_every";
 	if (total > max_bytes) {
 		fprintf(stderr,
-		        "plume: %s: $.duration: %zu frames of up to %.3g MB each would write %.3g GB, and sim.glb%s would hold "
-		        "%.3g GB in memory: %.3g GB; the limit is %.3g GB (raise it with --max-memory, or raise $.frame_every "
+		        "plume: %s: %s: %zu frames of up to %.3g MB each would write %.3g GB, and sim.glb%s would hold "
+		        "%.3g GB in memory: %.3g GB; the limit is %.3g GB (raise it with --max-memory, or raise %s "
 		        "or $.time_step%s)\n",
-		        argv[optind], frame_count, (double)frame_bytes / 1e6, (double)(frame_count * frame_bytes) / 1e9,
+		        argv[optind], duration_key, frame_count, (double)frame_bytes / 1e6,
+		        (double)(frame_count * frame_bytes) / 1e9,
 		        run.glb_feather ? " with the carried feathers (--glb-feather)" : "", (double)glb.memory / 1e9,
-		        (double)total / 1e9, (double)max_bytes / 1e9, run.glb_feather ? ", or leave out --glb-feather" : "");
+		        (double)total / 1e9, (double)max_bytes / 1e9, every_key,
+		        run.glb_feather ? ", or leave out --glb-feather" : "");
 		plume_scene_destroy(scene);
 		return CLI_EXIT_LIMIT;
 	}
 	if (frame_count > SIM_GLB_MAX_FRAMES || glb.file > UINT32_MAX) {
 		fprintf(stderr,
-		        "plume: %s: $.duration: %zu frames%s make a sim.glb of about %.3g GB; a GLB file holds at most 4 GiB "
-		        "and %d frames (one morph target each) (raise $.frame_every or $.time_step, or shorten the run%s)\n",
-		        argv[optind], frame_count, run.glb_feather ? " with --glb-feather" : "", (double)glb.file / 1e9,
-		        SIM_GLB_MAX_FRAMES, run.glb_feather ? ", or leave out --glb-feather" : "");
+		        "plume: %s: %s: %zu frames%s make a sim.glb of about %.3g GB; a GLB file holds at most 4 GiB "
+		        "and %d frames (one morph target each) (raise %s or $.time_step, or shorten the run%s)\n",
+		        argv[optind], duration_key, frame_count, run.glb_feather ? " with --glb-feather" : "",
+		        (double)glb.file / 1e9, SIM_GLB_MAX_FRAMES, every_key,
+		        run.glb_feather ? ", or leave out --glb-feather" : "");
 		plume_scene_destroy(scene);
 		return CLI_EXIT_LIMIT;
 	}

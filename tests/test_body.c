@@ -774,7 +774,7 @@ static void test_json_errors(void **state)
 	     "\"head\": [0, 0, 1]}]",
 	     "b.json: $.bones[1].parent: unknown bone \"amr\"; did you mean \"arm\"? (bones: arm, b; null for a root)"},
 	    {sphere, "\"bones\": [{\"name\": \"a\", \"parent\": \"a\", \"head\": [0, 0, 0]}]",
-	     "b.json: $.bones[0].parent: is 0; allowed -1 (a root) or another bone, 0 to 0"},
+	     "b.json: $.bones[0].parent: \"a\" is the bone itself; a bone's parent is another bone, or null for a root"},
 	    {sphere, "\"bones\": [{\"name\": \"a\"}]", "b.json: $.bones[0].head: missing"},
 	    {sphere, "\"bones\": [{\"head\": [0, 0, 0]}]", "b.json: $.bones[0].name: missing; every bone has a name"},
 	    {sphere, "\"bones\": [{\"name\": \"a\", \"head\": [0, 0, 0], \"length\": 1}]",

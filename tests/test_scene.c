@@ -267,6 +267,35 @@ static void test_handle_pose_interpolation(void **state)
 	assert_close(r.m[1][0], sin(1), 1e-15);
 }
 
+/// A key without rotation (its axis the default z) takes the other key's axis, as a body's
+/// keys do (docs/body.md "Interpolation"): from rest to 90 degrees about x, a quarter of the
+/// way is 22.5 degrees about x. The handle's pose took the nearer key's axis, so it turned
+/// about z for the first half and jumped to x at the middle.
+static void test_handle_pose_axis_of_a_key_without_rotation(void **state)
+{
+	(void)state;
+	double pi = acos(-1.0);
+	plume_keyframe keys[2] = {{0, {0, 0, 0}, {0, 0, 1}, 0}, {1, {0, 0, 0}, {1, 0, 0}, pi / 2}};
+	plume_scene_handle handle = {0};
+	handle.keyframe_count = 2;
+	handle.keyframes = keys;
+	plume_vec3 t;
+	plume_mat3 r;
+	plume_scene_handle_pose(&handle, 0.25, &t, &r);
+	assert_close(r.m[0][0], 1, 1e-15);
+	assert_close(r.m[1][1], cos(pi / 8), 1e-15);
+	assert_close(r.m[2][1], sin(pi / 8), 1e-15);
+	// Two different axes: the shorter arc between the keys (slerp), continuous at the middle.
+	plume_keyframe turned[2] = {{0, {0, 0, 0}, {1, 0, 0}, pi / 2}, {1, {0, 0, 0}, {0, 1, 0}, pi / 2}};
+	handle.keyframes = turned;
+	plume_mat3 before, after;
+	plume_scene_handle_pose(&handle, 0.5 - 1e-9, &t, &before);
+	plume_scene_handle_pose(&handle, 0.5 + 1e-9, &t, &after);
+	for (int i = 0; i < 3; ++i)
+		for (int j = 0; j < 3; ++j)
+			assert_close(before.m[i][j], after.m[i][j], 1e-7);
+}
+
 /// Loads a scene from text (written to a temporary file, so relative paths are the source tree's).
 static plume_scene *load_text(const char *text)
 {
@@ -693,6 +722,33 @@ static void expect_error(const char *text, plume_status status, const char *mess
 #define FEATHER                                                                                                        \
 	"\"feather\": \"" PLUME_SOURCE_DIR "/examples/franco-walter/blue.json\", \"mesh\": {\"edge_length\": 0.01}"
 
+/// The forces of a scene add up where their groups share vertices, as forces do: two forces
+/// on the rachis tip move it as their sum does. Each replaced the load of the one before on
+/// the vertices they shared (plume_sim_set_group_load), so only the last one pulled.
+static void test_forces_add_up(void **state)
+{
+	(void)state;
+#define PULLED "{\"feather\": " BLUE ", " SETTINGS ", \"forces\": ["
+	trajectory two = run_text(PULLED "{\"group\": \"rachis_tip\", \"force\": [0, 0, 0.002]}, "
+	                                 "{\"group\": \"rachis_tip\", \"force\": [0.001, 0, 0]}]}",
+	                          NULL);
+	trajectory sum = run_text(PULLED "{\"group\": \"rachis_tip\", \"force\": [0.001, 0, 0.002]}]}", NULL);
+	trajectory last = run_text(PULLED "{\"group\": \"rachis_tip\", \"force\": [0.001, 0, 0]}]}", NULL);
+#undef PULLED
+	assert_int_equal(two.states, sum.states);
+	double worst = 0, apart = 0;
+	for (size_t i = 0; i < (size_t)two.states * (size_t)two.vertex_count; ++i) {
+		worst = fmax(worst, plume_v3_length(plume_v3_sub(two.positions[i], sum.positions[i])));
+		apart = fmax(apart, plume_v3_length(plume_v3_sub(sum.positions[i], last.positions[i])));
+	}
+	printf("two forces against their sum: %.3g m (their sum against the last alone: %.3g m)\n", worst, apart);
+	assert_true(worst < 1e-10);
+	assert_true(apart > 1e-6);
+	free(two.positions);
+	free(sum.positions);
+	free(last.positions);
+}
+
 static void test_bad_scenes(void **state)
 {
 	(void)state;
@@ -708,6 +764,12 @@ static void test_bad_scenes(void **state)
 	expect_error("{" FEATHER ", \"materials\": {\"vane\": {\"model\": \"orthotropc\"}}}", PLUME_ERROR_SPEC,
 	             "did you mean \"orthotropic\"?");
 	expect_error("{" FEATHER ", \"duraton\": 1}", PLUME_ERROR_SPEC, "duration");
+	// A modulus of the other model was ignored unchecked.
+	expect_error("{" FEATHER ", \"materials\": {\"vane\": {\"poisson_ratio\": -0.5}}}", PLUME_ERROR_SPEC,
+	             "$.materials.vane.poisson_ratio: belongs to the isotropic model, and this material is orthotropic; "
+	             "set \"model\": \"isotropic\"");
+	expect_error("{" FEATHER ", \"materials\": {\"rachis\": {\"E_ww\": 1e5}}}", PLUME_ERROR_SPEC,
+	             "$.materials.rachis.E_ww: belongs to the orthotropic model, and this material is isotropic");
 	expect_error("{\"mesh\": {}}", PLUME_ERROR_SPEC, "exactly one of \"feather\"");
 	expect_error("{" FEATHER
 	             ", \"handles\": [{\"group\": \"rachis_tip\", \"keyframes\": [{\"time\": 1}, {\"time\": 0.5}]}]}",
@@ -715,7 +777,14 @@ static void test_bad_scenes(void **state)
 	expect_error("{" FEATHER ", \"bending\": \"paper_hinge\"}", PLUME_ERROR_SPEC,
 	             "$.bending: unknown value \"paper_hinge\"; did you mean \"paper-hinge\"? (allowed: fundamental-form, "
 	             "paper-hinge)");
-	expect_error("{" FEATHER ", \"bending\": 1}", PLUME_ERROR_SPEC, "$.bending");
+	expect_error("{" FEATHER ", \"bending\": 1}", PLUME_ERROR_SPEC,
+	             "$.bending: expected true, false or a model's name (fundamental-form, paper-hinge), got a number");
+	// A vertex follows one handle: two handles holding it were resolved by the later one.
+	expect_error("{" FEATHER ", \"handles\": [{\"group\": \"rachis_clamp\"}, {\"group\": \"rachis\", \"keyframes\": "
+	             "[{\"time\": 0}, {\"time\": 1, \"translation\": [0, 0, 0.01]}]}]}",
+	             PLUME_ERROR_SPEC, "$.handles[1].group: \"rachis\" holds vertex ");
+	expect_error("{" FEATHER ", \"handles\": [{\"group\": \"rachis_clamp\"}, {\"group\": \"rachis_clamp\"}]}",
+	             PLUME_ERROR_SPEC, "which $.handles[0] (\"rachis_clamp\") holds too; a vertex follows one handle");
 	// Many feathers.
 	expect_error("{\"feathers\": [{\"feather\": " BLUE ", \"name\": \"wing\"}, {\"feather\": " BLUE
 	             ", \"name\": \"wing\"}]}",
@@ -734,6 +803,9 @@ static void test_bad_scenes(void **state)
 	             "did you mean \"position\"");
 	expect_error("{\"feathers\": [{\"feather\": " BLUE ", \"rotation_deg\": 10, \"rotation_axis\": [0, 0, 0]}]}",
 	             PLUME_ERROR_SPEC, "$.feathers[0].rotation_axis: is the zero vector");
+	// An axis alone placed the feather unturned, silently.
+	expect_error("{\"feathers\": [{\"feather\": " BLUE ", \"rotation_axis\": [1, 0, 0]}]}", PLUME_ERROR_SPEC,
+	             "$.feathers[0].rotation_axis: given without \"rotation_deg\"");
 	expect_error("{\"feathers\": [{\"feather\": " BLUE "}, {\"feather\": " BLUE
 	             ", \"position\": [0.1, 0, 0]}], \"handles\": [{\"group\": \"f2/rachis_clamp\"}]}",
 	             PLUME_ERROR_SPEC, "$.handles[0].group: unknown vertex group \"f2/rachis_clamp\"");
@@ -747,6 +819,15 @@ static void test_bad_scenes(void **state)
 	             ", \"position\": [0, 0, 0.05], \"follicle\": {\"bone\": \"cret\"}}]}",
 	             PLUME_ERROR_SPEC,
 	             "$.feathers[0].follicle.bone: unknown bone \"cret\"; did you mean \"crest\"? (the body has: crest)");
+	// An empty name followed the body as a whole, silently; a name past a bone's 31 bytes was cut
+	// to them (and could then name another bone).
+	expect_error("{" BODY ", \"feathers\": [{\"feather\": " BLUE
+	             ", \"position\": [0, 0, 0.05], \"follicle\": {\"bone\": \"\"}}]}",
+	             PLUME_ERROR_SPEC, "$.feathers[0].follicle.bone: \"\" is not a bone's name; allowed 1 to 31 bytes");
+	expect_error("{" BODY ", \"feathers\": [{\"feather\": " BLUE
+	             ", \"position\": [0, 0, 0.05], \"follicle\": {\"bone\": \"crest-crest-crest-crest-crest-crest\"}}]}",
+	             PLUME_ERROR_SPEC,
+	             "$.feathers[0].follicle.bone: \"crest-crest-crest-crest-crest-crest\" is not a bone's name");
 	expect_error("{" BODY ", \"feathers\": [{\"feather\": " BLUE
 	             ", \"position\": [0, 0, 0.05], \"follicle\": {}}], \"handles\": [{\"group\": \"rachis_clamp\"}]}",
 	             PLUME_ERROR_SPEC, "$.handles[0].group: \"rachis_clamp\" holds feather \"f0\"'s calamus");
@@ -800,7 +881,9 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test(test_handle_pose_interpolation),
+	    cmocka_unit_test(test_handle_pose_axis_of_a_key_without_rotation),
 	    cmocka_unit_test(test_bad_scenes),
+	    cmocka_unit_test(test_forces_add_up),
 	    cmocka_unit_test(test_bending_key),
 	    cmocka_unit_test(test_figure1_anisotropic_bends_the_rachis),
 	    cmocka_unit_test(test_figure1_full_amplitude_buckles_without_collapse),

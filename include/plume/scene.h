@@ -130,6 +130,7 @@ plume_status plume_scene_parse(const char *text, const char *name, const plume_s
 void plume_scene_destroy(plume_scene *scene);
 
 /// Where a handle is at time t: translation and rotation for plume_sim_set_handle.
+/// Between keys as a body's keys (docs/body.md "Interpolation").
 void plume_scene_handle_pose(const plume_scene_handle *handle, double t, plume_vec3 *translation, plume_mat3 *rotation);
 
 /// The body's vertex positions at time t (plume_body_pose) into out[plume_body_vertex_count];

@@ -210,6 +210,9 @@ int plume_sim_handle_count(const plume_sim *sim);
 /// hung on them); replaces any load set on that group before. Unknown group, or a force that
 /// is not finite: PLUME_ERROR_SPEC.
 plume_status plume_sim_set_group_load(plume_sim *sim, const char *group, plume_vec3 force, plume_error *err);
+/// The same force added to the loads the group's vertices already carry: forces of groups
+/// that share vertices add up there (a scene's "forces", docs/scene.md).
+plume_status plume_sim_add_group_load(plume_sim *sim, const char *group, plume_vec3 force, plume_error *err);
 
 /// What one solve did.
 typedef struct plume_solve_report {

@@ -113,7 +113,7 @@ class Simulation(Closable):
 
     @property
     def steps_total(self) -> int:
-        """Steps `plume simulate` runs for this scene: ceil(duration / time_step)."""
+        """Steps `plume simulate` runs for this scene: ceil(duration / time_step), at least 1."""
         self._live()
         return int(lib.plume_scene_runner_step_count(self._runner))
 

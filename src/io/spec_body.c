@@ -407,13 +407,16 @@ static void read_bones(plume_spec_reader *reader, const json_t *body, const char
 			snprintf(list + used, sizeof list - used, "%s%s", c > 0 ? ", " : "", names[c]);
 		}
 		names[n] = NULL;
-		if (storage->bones[b].parent < 0) {
-			char bone_path[224], child[256];
-			plume_spec_index_path(bone_path, sizeof bone_path, bones_path, b);
-			plume_spec_path(child, sizeof child, bone_path, "parent");
+		char bone_path[224], child[256];
+		plume_spec_index_path(bone_path, sizeof bone_path, bones_path, b);
+		plume_spec_path(child, sizeof child, bone_path, "parent");
+		if (storage->bones[b].parent < 0)
 			plume_spec_fail(reader, child, "unknown bone \"%s\"; did you mean \"%s\"? (bones: %s; null for a root)",
 			                parents[b], plume_spec_nearest(parents[b], names), list);
-		}
+		else if (storage->bones[b].parent == (int)b)
+			plume_spec_fail(reader, child,
+			                "\"%s\" is the bone itself; a bone's parent is another bone, or null for a root",
+			                parents[b]);
 	}
 	default_tails(storage->bones, (int)n, tail_given);
 }

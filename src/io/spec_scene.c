@@ -129,6 +129,22 @@ static void read_material(plume_spec_reader *reader, const json_t *object, const
 	plume_spec_number(reader, object, path, "bending_along", &m->bending_along);
 	plume_spec_number(reader, object, path, "bending_across", &m->bending_across);
 	plume_spec_number(reader, object, path, "compression_coefficient", &m->compression_coefficient);
+	// A modulus of the other model was ignored, unchecked (an orthotropic vane took "poisson_ratio":
+	// -0.5 and ran on its E_ww, E_vw): the model was likely left out.
+	static const char *const orthotropic_only[] = {"E_vv", "E_ww", "E_vw", NULL};
+	static const char *const isotropic_only[] = {"youngs_modulus", "poisson_ratio", NULL};
+	bool orthotropic = m->kind == PLUME_MATERIAL_ORTHOTROPIC;
+	const char *const *unused = orthotropic ? isotropic_only : orthotropic_only;
+	for (int k = 0; unused[k] != NULL && reader->status == PLUME_OK; ++k)
+		if (json_object_get(object, unused[k]) != NULL) {
+			char child[128];
+			plume_spec_path(child, sizeof child, path, unused[k]);
+			plume_spec_fail(reader, child,
+			                "belongs to the %s model, and this material is %s; set \"model\": \"%s\", or leave "
+			                "the key out",
+			                orthotropic ? "isotropic" : "orthotropic", orthotropic ? "orthotropic" : "isotropic",
+			                orthotropic ? "isotropic" : "orthotropic");
+		}
 }
 
 static void read_materials(plume_spec_reader *reader, const json_t *root, plume_sim_def *def)
@@ -328,6 +344,13 @@ static void read_handles(plume_spec_reader *reader, const json_t *root, plume_sc
 				plume_spec_fail(reader, radius_path, "is %g, allowed > 0", handle->radius);
 			if (reader->status == PLUME_OK)
 				add_near_group(reader, path, scene->mesh, handle, (int)h);
+		} else if (reader->status == PLUME_OK && json_object_get(object, "radius") != NULL) {
+			// Alone it selected nothing: the whole group was held.
+			char radius_path[96];
+			plume_spec_path(radius_path, sizeof radius_path, path, "radius");
+			plume_spec_fail(reader, radius_path,
+			                "given without \"near\"; a radius selects the group's vertices within it of a point "
+			                "[x, y] of the reference plane (give both, or neither to hold the whole group)");
 		}
 		read_vec3(reader, object, path, "pivot", &handle->pivot);
 		const char *interpolation = NULL;
@@ -344,6 +367,44 @@ static void read_handles(plume_spec_reader *reader, const json_t *root, plume_sc
 			read_keyframes(reader, keyframes, key_path, handle);
 		}
 	}
+}
+
+/// The group a handle was given as in the scene (a "near" selection's source group).
+static const char *handle_given_group(const plume_scene_handle *handle)
+{
+	return handle->source_group[0] != '\0' ? handle->source_group : handle->group;
+}
+
+/// A vertex follows one handle: two handles that share a vertex were resolved by the later one
+/// (its target overwrote the earlier's, and both reported its reaction).
+static void check_handle_overlap(plume_spec_reader *reader, const plume_scene *scene)
+{
+	if (reader->status != PLUME_OK || scene->handle_count < 2)
+		return;
+	int *owner = plume_alloc(sizeof(int) * (size_t)scene->mesh->vertex_count);
+	if (owner == NULL) {
+		plume_spec_fail(reader, "$.handles", "out of memory");
+		return;
+	}
+	for (int v = 0; v < scene->mesh->vertex_count; ++v)
+		owner[v] = -1;
+	for (int h = 0; h < scene->handle_count && reader->status == PLUME_OK; ++h) {
+		const plume_vertex_group *group = plume_mesh_find_group(scene->mesh, scene->handles[h].group);
+		for (int i = 0; group != NULL && i < group->count && reader->status == PLUME_OK; ++i) {
+			int v = group->vertices[i], other = owner[v];
+			if (other >= 0 && other != h) {
+				char path[64];
+				snprintf(path, sizeof path, "$.handles[%d].group", h);
+				plume_spec_fail(reader, path,
+				                "\"%s\" holds vertex %d, which $.handles[%d] (\"%s\") holds too; a vertex follows "
+				                "one handle (hold groups that share no vertex, or one of the two)",
+				                handle_given_group(scene->handles + h), v, other,
+				                handle_given_group(scene->handles + other));
+			}
+			owner[v] = h;
+		}
+	}
+	plume_free(owner);
 }
 
 /// A vertex may be in one handle: the scene's handles must leave alone the calamus of every
@@ -410,7 +471,11 @@ static void read_forces(plume_spec_reader *reader, const json_t *root, plume_sce
 			return;
 		}
 		snprintf(scene->forces[i].group, sizeof scene->forces[i].group, "%s", group);
-		read_vec3(reader, object, path, "force", &scene->forces[i].force);
+		if (!read_vec3(reader, object, path, "force", &scene->forces[i].force) && reader->status == PLUME_OK) {
+			char force_path[96];
+			plume_spec_path(force_path, sizeof force_path, path, "force");
+			plume_spec_fail(reader, force_path, "missing; a force is [x, y, z] in N, shared by the group's vertices");
+		}
 		scene->force_count = (int)i + 1;
 	}
 }
@@ -427,27 +492,48 @@ static void scene_relative(const char *file, const char *name, char *out, size_t
 	}
 }
 
+/// An inline feather spec's error, "file: $.key: ...", at the scene's path of the spec:
+/// "file: $.feathers[2].feather.key: ..." ("$.key" names no key of the scene).
+static void inline_error_path(plume_error *err, const char *file, const char *where)
+{
+	if (err == NULL)
+		return;
+	size_t length = strlen(file);
+	if (strncmp(err->message, file, length) != 0 || strncmp(err->message + length, ": $", 3) != 0)
+		return;
+	char message[sizeof err->message];
+	snprintf(message, sizeof message, "%s: %s%s", file, where, err->message + length + 3);
+	memcpy(err->message, message, sizeof message);
+}
+
 /// Generates (or reads) the feather of value (at JSON path `where`): a generator spec inline or
 /// by path (relative to the scene), or a feather written by `plume generate --format json`.
+/// Errors name the scene and `where`.
 static plume_status load_feather(const char *file, const json_t *value, const char *where,
                                  const plume_spec_options *options, plume_feather **out, plume_error *err)
 {
-	if (json_is_object(value))
-		return plume_spec_generate_json(file, value, options, out, err);
+	if (json_is_object(value)) {
+		plume_status status = plume_spec_generate_json(file, value, options, out, err);
+		if (status != PLUME_OK)
+			inline_error_path(err, file, where);
+		return status;
+	}
 	if (!json_is_string(value))
 		return plume_error_set(err, PLUME_ERROR_SPEC, "%s: %s: expected a feather spec (an object) or the path of one",
 		                       file, where);
 	char path[4096];
 	scene_relative(file, json_string_value(value), path, sizeof path);
 	json_t *spec = plume_spec_load(path, err);
-	if (spec == NULL) {
-		plume_error_prefix(err, file);
-		return err != NULL ? err->status : PLUME_ERROR_IO;
-	}
-	plume_status status = json_object_get(spec, "model") != NULL
+	plume_status status = spec == NULL ? (err != NULL ? err->status : PLUME_ERROR_IO)
+	                      : json_object_get(spec, "model") != NULL
 	                          ? plume_spec_generate_json(path, spec, options, out, err)
 	                          : plume_read_json(path, out, err);
 	json_decref(spec);
+	if (status != PLUME_OK) {
+		char prefix[4200];
+		snprintf(prefix, sizeof prefix, "%s: %s", file, where);
+		plume_error_prefix(err, prefix);
+	}
 	return status;
 }
 
@@ -573,6 +659,15 @@ static void read_attachment(plume_spec_reader *reader, const json_t *object, con
 	read_vec3(reader, object, path, "position", &item->translation);
 	read_vec3(reader, object, path, "rotation_axis", &axis);
 	plume_spec_number(reader, object, path, "rotation_deg", &degrees);
+	if (reader->status == PLUME_OK && json_object_get(object, "rotation_axis") != NULL &&
+	    json_object_get(object, "rotation_deg") == NULL) { // an axis alone turned nothing
+		char axis_path[96];
+		plume_spec_path(axis_path, sizeof axis_path, path, "rotation_axis");
+		plume_spec_fail(reader, axis_path,
+		                "given without \"rotation_deg\"; an axis alone turns nothing (give the "
+		                "angle in degrees too)");
+		return;
+	}
 	item->rotation = plume_m3_identity();
 	if (reader->status == PLUME_OK && degrees != 0) {
 		if (plume_v3_length(axis) == 0) {
@@ -602,8 +697,19 @@ static void read_attachment(plume_spec_reader *reader, const json_t *object, con
 		plume_spec_path(follicle_path, sizeof follicle_path, path, "follicle");
 		plume_spec_check_keys(reader, follicle, follicle_path, follicle_keys);
 		const char *bone = NULL;
-		if (plume_spec_string(reader, follicle, follicle_path, "bone", &bone))
-			snprintf(item->bone, sizeof item->bone, "%s", bone);
+		if (plume_spec_string(reader, follicle, follicle_path, "bone", &bone)) {
+			size_t length = strlen(bone);
+			if (length == 0 || length >= sizeof item->bone) { // "" followed the body as a whole
+				char bone_path[128];
+				plume_spec_path(bone_path, sizeof bone_path, follicle_path, "bone");
+				plume_spec_fail(reader, bone_path,
+				                "\"%.64s\" is not a bone's name; allowed 1 to %d bytes (leave \"bone\" out to "
+				                "follow the body as a whole)",
+				                bone, (int)sizeof item->bone - 1);
+				return;
+			}
+			memcpy(item->bone, bone, length + 1);
+		}
 		plume_spec_bool(reader, follicle, follicle_path, "nearest_bone", &item->nearest_bone);
 		if (reader->status == PLUME_OK && bone != NULL && item->nearest_bone)
 			plume_spec_fail(reader, follicle_path, "names a bone and asks for the nearest one; give one of the two");
@@ -1061,13 +1167,18 @@ static plume_status build_mesh(const char *file, const json_t *root, const plume
 	plume_status status;
 	if (feather != NULL) {
 		status = load_feather(file, feather, "$.feather", options, &scene->feather, err);
-		if (status == PLUME_OK)
+		if (status == PLUME_OK) {
 			status = plume_mesh_from_feather(scene->feather, &mesh_def, &scene->mesh, &scene->mesh_report, err);
+			if (status != PLUME_OK) // as a list's entry says it ("$.feathers[2] (feather \"f2\"): meshing: ...")
+				plume_error_prefix(err, "$.feather: meshing");
+		}
 	} else {
 		plume_mesh_guides_storage storage;
 		status = plume_spec_mesh_guides(&reader, guides, "$.guides", &storage);
 		if (status == PLUME_OK) {
 			status = plume_mesh_from_guides(&storage.guides, &mesh_def, &scene->mesh, &scene->mesh_report, err);
+			if (status != PLUME_OK)
+				plume_error_prefix(err, "$.guides: meshing");
 			plume_mesh_guides_storage_free(&storage);
 		}
 	}
@@ -1116,9 +1227,16 @@ static void read_bending(plume_spec_reader *reader, const json_t *root, plume_si
 		plume_spec_bool(reader, root, "$", "bending", &def->bending);
 		return;
 	}
-	const char *name;
-	if (!plume_spec_string(reader, root, "$", "bending", &name))
+	if (!json_is_string(value)) { // "expected a string" left out the booleans
+		plume_spec_fail(reader, "$.bending", "expected true, false or a model's name (%s, %s), got %s",
+		                bending_models[0], bending_models[1],
+		                json_is_number(value)   ? "a number"
+		                : json_is_array(value)  ? "an array"
+		                : json_is_object(value) ? "an object"
+		                                        : "null");
 		return;
+	}
+	const char *name = json_string_value(value);
 	int model = word_index(reader, "$.bending", name, bending_models);
 	if (model >= 0)
 		def->bending_model = (plume_bending_model)model;
@@ -1186,6 +1304,15 @@ static plume_status scene_from_json(const char *path, json_t *root, const plume_
 		plume_spec_fail(&reader, "$.duration", "is %g, allowed > 0 (seconds)", scene->duration);
 	if (reader.status == PLUME_OK && scene->frame_every < 1)
 		plume_spec_fail(&reader, "$.frame_every", "is %d, allowed >= 1", scene->frame_every);
+	// Air acts on the velocity relative to the wind, and a static solve has no velocity: it
+	// leaves the air out (src/sim/potential.c), so a wind or gusts there blew on nothing.
+	const plume_air_def *air = &scene->sim.air;
+	if (reader.status == PLUME_OK && scene->quasi_static && air->density > 0 &&
+	    (air->wind.x != 0 || air->wind.y != 0 || air->wind.z != 0 || air->gust_speed > 0))
+		plume_spec_fail(&reader, "$.air",
+		                "a quasi-static scene leaves the air out of its static solve, so its wind (%g, %g, %g) m/s "
+		                "and gusts (%g m/s) would move nothing; drop \"quasi_static\" to feel them, or the wind",
+		                air->wind.x, air->wind.y, air->wind.z, air->gust_speed);
 	plume_status status = reader.status;
 	if (status == PLUME_OK) {
 		status = plume_sim_def_validate(&scene->sim, 0, err);
@@ -1206,6 +1333,7 @@ static plume_status scene_from_json(const char *path, json_t *root, const plume_
 		status = build_mesh(path, root, &feather_options, scene, err);
 	if (status == PLUME_OK) {
 		read_handles(&reader, root, scene);
+		check_handle_overlap(&reader, scene);
 		check_follicle_handles(&reader, scene);
 		read_forces(&reader, root, scene);
 		status = reader.status;

@@ -470,9 +470,8 @@ static quaternion slerp(quaternion a, quaternion b, double s)
 	return (quaternion){q.w / norm, q.x / norm, q.y / norm, q.z / norm};
 }
 
-/// The keys' translation and rotation at t (identity without keys); see plume_body_pose.
-static void keyed_pose(const plume_keyframe *keys, int count, plume_interpolation interpolation, double t,
-                       plume_vec3 *translation, plume_mat3 *rotation)
+void plume_keyframes_pose(const plume_keyframe *keys, int count, plume_interpolation interpolation, double t,
+                          plume_vec3 *translation, plume_mat3 *rotation)
 {
 	*translation = plume_v3(0, 0, 0);
 	*rotation = plume_m3_identity();
@@ -534,7 +533,7 @@ static rigid body_motion(const plume_body *body, double t)
 {
 	plume_vec3 shift;
 	plume_mat3 rotation;
-	keyed_pose(body->keyframes, body->keyframe_count, body->interpolation, t, &shift, &rotation);
+	plume_keyframes_pose(body->keyframes, body->keyframe_count, body->interpolation, t, &shift, &rotation);
 	return about(rotation, body->pivot, shift);
 }
 
@@ -542,7 +541,7 @@ static rigid bone_local(const body_bone *bone, double t)
 {
 	plume_vec3 shift;
 	plume_mat3 rotation;
-	keyed_pose(bone->keyframes, bone->keyframe_count, bone->interpolation, t, &shift, &rotation);
+	plume_keyframes_pose(bone->keyframes, bone->keyframe_count, bone->interpolation, t, &shift, &rotation);
 	return about(rotation, bone->head, shift);
 }
 

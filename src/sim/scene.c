@@ -10,6 +10,7 @@
 #include "core/alloc.h"
 #include "plume/body.h"
 #include "plume/scene.h"
+#include "sim/body_internal.h"
 #include "sim/scene_contact.h"
 
 void plume_scene_destroy(plume_scene *scene)
@@ -32,37 +33,11 @@ void plume_scene_destroy(plume_scene *scene)
 	plume_free(scene);
 }
 
-static double ease(plume_interpolation interpolation, double s)
-{
-	return interpolation == PLUME_INTERPOLATION_SMOOTH ? s * s * (3 - 2 * s) : s;
-}
-
 void plume_scene_handle_pose(const plume_scene_handle *handle, double t, plume_vec3 *translation, plume_mat3 *rotation)
 {
-	*translation = plume_v3(0, 0, 0);
-	*rotation = plume_m3_identity();
-	int count = handle->keyframe_count;
-	if (count == 0)
-		return;
-	const plume_keyframe *keys = handle->keyframes;
-	plume_keyframe pose = keys[count - 1];
-	if (t <= keys[0].time) {
-		pose = keys[0];
-	} else {
-		for (int k = 0; k + 1 < count; ++k)
-			if (t < keys[k + 1].time) {
-				double s = ease(handle->interpolation, (t - keys[k].time) / (keys[k + 1].time - keys[k].time));
-				pose.translation = plume_v3_lerp(keys[k].translation, keys[k + 1].translation, s);
-				// Rotations interpolate by angle about the later key's axis when the axes agree,
-				// which is what scenes use (one axis per handle); otherwise the nearer key's axis.
-				pose.axis = s < 0.5 ? keys[k].axis : keys[k + 1].axis;
-				pose.angle = keys[k].angle + s * (keys[k + 1].angle - keys[k].angle);
-				break;
-			}
-	}
-	*translation = pose.translation;
-	if (pose.angle != 0)
-		*rotation = plume_m3_rotation(plume_v3_normalize(pose.axis), pose.angle);
+	// A handle's keys move as a body's (docs/body.md "Interpolation"): taking the nearer key's
+	// axis turned a handle keyed from rest to a rotation about x about z for half the interval.
+	plume_keyframes_pose(handle->keyframes, handle->keyframe_count, handle->interpolation, t, translation, rotation);
 }
 
 void plume_scene_body_pose(const plume_scene *scene, double t, plume_vec3 *out)
@@ -163,7 +138,7 @@ struct plume_scene_runner {
 	plume_vec3 *body_positions;
 	plume_scene_surfaces *surfaces;
 	plume_scene_summary summary;
-	int step_count; ///< the scene's steps: ceil(duration / time_step)
+	int step_count; ///< the scene's steps: ceil(duration / time_step), at least 1
 	double start;   ///< omp_get_wtime() at creation
 };
 
@@ -194,7 +169,7 @@ static plume_status runner_begin(plume_scene_runner *runner, plume_error *err)
 	if (status == PLUME_OK)
 		status = add_follicle_handles(scene, sim, runner->ids, err);
 	for (int l = 0; l < scene->force_count && status == PLUME_OK; ++l)
-		status = plume_sim_set_group_load(sim, scene->forces[l].group, scene->forces[l].force, err);
+		status = plume_sim_add_group_load(sim, scene->forces[l].group, scene->forces[l].force, err); // they add up
 	summary->vertex_count = scene->mesh->vertex_count;
 	summary->feather_count = scene->feather_count;
 	summary->face_count = scene->mesh->face_count;
@@ -210,7 +185,9 @@ static plume_status runner_begin(plume_scene_runner *runner, plume_error *err)
 		status = check_frame(runner->surfaces, sim, runner->body_positions, 0, summary, err);
 	if (status != PLUME_OK)
 		return status;
-	double step_count = ceil(scene->duration / scene->sim.time_step - 1e-9);
+	// At least one step: a duration below 1e-9 of a step rounded to none, and the run wrote
+	// frame 0 alone as a completed simulation.
+	double step_count = fmax(1.0, ceil(scene->duration / scene->sim.time_step - 1e-9));
 	if (!(step_count >= 0.0 && step_count <= PLUME_SCENE_MAX_STEPS))
 		return plume_error_set(err, PLUME_ERROR_SPEC,
 		                       "scene: duration %g s in steps of %g s is %.3g steps; "

@@ -755,7 +755,8 @@ int plume_sim_add_handle(plume_sim *sim, const char *group_name, plume_error *er
 	return sim->handle_count++;
 }
 
-plume_status plume_sim_set_group_load(plume_sim *sim, const char *group_name, plume_vec3 force, plume_error *err)
+/// Shares force among the group's vertices: replacing their loads, or adding to them.
+static plume_status group_load(plume_sim *sim, const char *group_name, plume_vec3 force, bool add, plume_error *err)
 {
 	PLUME_ASSERT_HANDLE(sim);
 	PLUME_ASSERT(group_name != NULL);
@@ -766,9 +767,21 @@ plume_status plume_sim_set_group_load(plume_sim *sim, const char *group_name, pl
 		return plume_error_set(err, PLUME_ERROR_SPEC, "the load on group \"%s\" is (%g, %g, %g) N; allowed finite",
 		                       group_name, force.x, force.y, force.z);
 	plume_vec3 share = plume_v3_scale(force, 1.0 / group->count);
-	for (int i = 0; i < group->count; ++i)
-		sim->load[group->vertices[i]] = share;
+	for (int i = 0; i < group->count; ++i) {
+		plume_vec3 *load = sim->load + group->vertices[i];
+		*load = add ? plume_v3_add(*load, share) : share;
+	}
 	return PLUME_OK;
+}
+
+plume_status plume_sim_set_group_load(plume_sim *sim, const char *group_name, plume_vec3 force, plume_error *err)
+{
+	return group_load(sim, group_name, force, false, err);
+}
+
+plume_status plume_sim_add_group_load(plume_sim *sim, const char *group_name, plume_vec3 force, plume_error *err)
+{
+	return group_load(sim, group_name, force, true, err);
 }
 
 void plume_sim_set_handle(plume_sim *sim, int index, plume_vec3 translation, plume_mat3 rotation, plume_vec3 pivot)
@@ -954,8 +967,10 @@ plume_status plume_sim_step(plume_sim *sim, plume_solve_report *report, plume_er
 		plume_integrator_restore(&sim->integrator, sim->vertex_count);
 		if (report != NULL)
 			*report = total;
-		return plume_error_set(err, status, "step at t = %.6g s failed with %d substeps: %s", sim->time, total.substeps,
-		                       last.message);
+		// Both ends: "at t" read as the step's time, which stats.csv and summary.json's failed_time
+		// give as its end.
+		return plume_error_set(err, status, "the step from t = %.6g s to %.6g s failed with %d substeps: %s", sim->time,
+		                       sim->time + sim->def.time_step, total.substeps, last.message);
 	}
 	sim->time += sim->def.time_step;
 	finish_handles(sim);

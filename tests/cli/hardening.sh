@@ -83,7 +83,7 @@ check "first step fails: frame 0 kept" test -s "$scratch/fail/frames/0000.obj"
 check "first step fails: only frame 0" test "$(ls "$scratch/fail/frames" | wc -l)" -eq 1
 check "first step fails: summary says not completed" grep -q '"completed": false' "$scratch/fail/summary.json"
 check "first step fails: summary names the step" grep -q '"failed_step": 1,' "$scratch/fail/summary.json"
-check "first step fails: summary has the reason" grep -q '"error": "simulation: step at' "$scratch/fail/summary.json"
+check "first step fails: summary has the reason" grep -q '"error": "simulation: the step from t = 0 s to' "$scratch/fail/summary.json"
 check "first step fails: no staging left" test -z "$(ls -A "$scratch" | grep plume-staging)"
 
 # --- render of a simulation folder whose feather.json holds 1e308: segfaulted -------------
@@ -147,7 +147,7 @@ expect_no_output "mesh at 0.5 mm past --max-memory 1M" 5 'the limit is 0.00105 G
 $T "$plume" mesh "$examples/meshes/guides.json" -o "$scratch/m4" --max-memory 2M -f obj 2>"$scratch/err.txt"
 check "mesh --max-memory 2M meshes the example ($(cat "$scratch/err.txt"))" test -s "$scratch/m4/mesh.obj"
 edit "$bad/scene-short.json" "$bad/scene-fine.json" "d['mesh']['edge_length'] = 1e-6"
-expect_no_output "scene mesh past the limit" 5 'scene-fine.json: edge_length 1e-06 m on a' "$scratch/m5" \
+expect_no_output "scene mesh past the limit" 5 'scene-fine.json: $.feather: meshing: edge_length 1e-06 m on a' "$scratch/m5" \
 	$T "$plume" simulate "$bad/scene-fine.json" -o "$scratch/m5"
 
 # --- a Franco-Walter feather past the limit: barbs x samples (plume_fw_estimate_bytes) -------
