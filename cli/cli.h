@@ -95,6 +95,9 @@ typedef struct cli_output {
 	char dir[2048];
 	char stage[4160];
 	bool dir_existed;
+	/// The length of the path of the topmost of DIR's parent folders this run made (they are
+	/// removed again when it aborts, if empty); 0 when every one existed.
+	int parents_made;
 	bool stage_inside; ///< staged inside DIR (its parent is not writable): committed entry by entry
 	int stage_slot;    ///< 1 + its slot in output.c's list for the signal handler, 0 when none
 	char names[32][80];

@@ -517,6 +517,42 @@ static plume_status stage_inside_dir(cli_output *output, plume_error *err)
 	return make_stage(output, &made, err);
 }
 
+/// Removes the parent folders of DIR that make_parents made, deepest first, each only if empty.
+static void remove_parents(const cli_output *output)
+{
+	if (output->parents_made == 0)
+		return;
+	char path[sizeof output->dir];
+	snprintf(path, sizeof path, "%s", output->dir);
+	for (char *slash = strrchr(path, '/'); slash != NULL; slash = strrchr(path, '/')) {
+		*slash = '\0';
+		if ((int)strlen(path) < output->parents_made || rmdir(path) != 0)
+			break;
+	}
+}
+
+/// Makes DIR's missing parent folders (mkdir -p), so that "created if missing" holds for a
+/// nested DIR too; DIR itself is the staging folder's rename.
+static plume_status make_parents(cli_output *output, plume_error *err)
+{
+	char *dir = output->dir;
+	for (char *slash = strchr(dir + 1, '/'); slash != NULL; slash = strchr(slash + 1, '/')) {
+		*slash = '\0';
+		int made = mkdir(dir, 0777) == 0 ? 0 : errno;
+		if (made == 0 && output->parents_made == 0)
+			output->parents_made = (int)strlen(dir);
+		if (made != 0 && made != EEXIST) {
+			plume_status status =
+			    plume_error_set(err, PLUME_ERROR_IO, "%s: cannot make the folder: %s", dir, strerror(made));
+			*slash = '/';
+			remove_parents(output);
+			return status;
+		}
+		*slash = '/';
+	}
+	return PLUME_OK;
+}
+
 plume_status cli_output_begin(cli_output *output, const char *dir, plume_error *err)
 {
 	memset(output, 0, sizeof *output);
@@ -533,6 +569,10 @@ plume_status cli_output_begin(cli_output *output, const char *dir, plume_error *
 		if (!S_ISDIR(info.st_mode))
 			return plume_error_set(err, PLUME_ERROR_IO, "%s: exists and is not a folder", output->dir);
 		output->dir_existed = true;
+	} else {
+		plume_status status = make_parents(output, err);
+		if (status != PLUME_OK)
+			return status;
 	}
 	// DIR named "." or ".." (or ending in "/." or "/.."): its last component is no name in its
 	// parent, so the staging folder "beside" it went inside it (or below it), and linking DIR's
@@ -562,6 +602,8 @@ plume_status cli_output_begin(cli_output *output, const char *dir, plume_error *
 	snprintf(output->stage, sizeof output->stage, "%.*s%s%ld-XXXXXX", parent, output->dir, prefix, (long)getpid());
 	bool made;
 	plume_status status = make_stage(output, &made, err);
+	if (status != PLUME_OK && !output->dir_existed)
+		remove_parents(output);
 	if (status == PLUME_OK || made || !output->dir_existed)
 		return status;
 	// An existing DIR in a parent we may not write: stage inside DIR, move entry by entry.
@@ -1226,6 +1268,7 @@ void cli_output_abort(cli_output *output, plume_error *err)
 	if (output->stage[0] != '\0')
 		cli_remove_tree(output->stage);
 	untrack_stage(output);
+	remove_parents(output);
 }
 
 // ---------------------------------------------------------------------------

@@ -80,6 +80,13 @@ check "missing spec writes nothing" test ! -e "$scratch/x4"
 mkdir -p "$scratch/a-folder"
 expect_no_output "a folder for the spec" 4 "a-folder: cannot read: Is a directory" "$scratch/x4b" \
 	"$plume" generate "$scratch/a-folder" -o "$scratch/x4b"
+# -o DIR is created if missing, its missing parents too (it failed with exit 4, "No such file
+# or directory"), and a run refused before it writes makes none of them.
+"$plume" generate "$source_dir/examples/franco-walter/blue.json" -o "$scratch/new/deeper/out" --format obj >/dev/null 2>"$scratch/err.txt"
+succeeded "-o in folders that do not exist yet"
+check "-o in folders that do not exist yet: written" test -s "$scratch/new/deeper/out/feather.obj"
+expect_no_output "-o in new folders, a bad spec" 3 "barb_count is 9000" "$scratch/new2" \
+	"$plume" generate "$scratch/range.json" -o "$scratch/new2/deeper/out"
 # An empty --format item is refused wherever it is ("png," once passed, "png,,obj" did not).
 for list in png, ,png png,,obj; do
 	expect_no_output "--format '$list'" 2 "--format '$list' has an empty item" "$scratch/x4c" \
