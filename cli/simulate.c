@@ -821,6 +821,7 @@ int cli_simulate(int argc, char **argv)
 	run_state run = {0};
 	run.view = plume_shell_view_default_def();
 	int spp = 4;
+	bool size_given = false, view_given = false, spp_given = false;
 	double duration = 0; // 0: the scene's
 	int frames_every = 0;
 	int option;
@@ -838,6 +839,7 @@ int cli_simulate(int argc, char **argv)
 		case 'S':
 			if (!cli_parse_size("simulate", optarg, &run.view.width, &run.view.height))
 				return CLI_EXIT_USAGE;
+			size_given = true;
 			break;
 		case 'V': {
 			double azimuth, elevation;
@@ -851,6 +853,7 @@ int cli_simulate(int argc, char **argv)
 				    optarg);
 			run.view.azimuth = azimuth * acos(-1.0) / 180;
 			run.view.elevation = elevation * acos(-1.0) / 180;
+			view_given = true;
 			break;
 		}
 		case 'R': run.render = true; break;
@@ -862,6 +865,7 @@ int cli_simulate(int argc, char **argv)
 			if (end == optarg || *end != '\0' || value < 1 || value > 4096)
 				return cli_usage_error("simulate", "--spp takes a whole number in [1, 4096], got '%s'", optarg);
 			spp = (int)value;
+			spp_given = true;
 			break;
 		}
 		case 'M':
@@ -891,6 +895,15 @@ int cli_simulate(int argc, char **argv)
 	}
 	if (!cli_check_arguments("simulate", argc, argv, "SCENE.json", output_dir))
 		return CLI_EXIT_USAGE;
+	// A picture's options without the pictures were ignored: refused, so that a run asked for
+	// pictures of some size or view does not finish without any.
+	if (size_given && !run.png && !run.render)
+		return cli_usage_error("simulate", "--size sets the pictures of --png and --render; give one of them");
+	if (view_given && !run.png)
+		return cli_usage_error("simulate", "--view sets the camera of --png (--render's camera frames the whole "
+		                                   "sequence); give --png");
+	if (spp_given && !run.render)
+		return cli_usage_error("simulate", "--spp sets the samples per pixel of --render; give --render");
 
 	plume_error err = {0}, failure = {0};
 	plume_scene *scene = NULL;

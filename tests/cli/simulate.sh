@@ -235,6 +235,13 @@ cat >"$scratch/filoplume.json" <<JSON
 JSON
 "$plume" simulate "$scratch/filoplume.json" -o "$scratch/filoplume" >/dev/null 2>&1
 succeeded "the filoplume runs"
+# Picture options without the pictures they set were ignored, and the run ended without any.
+expect_no_output "--size without --png or --render" 2 "--size sets the pictures of --png and --render; give one of them" \
+	"$scratch/view" "$plume" simulate "$scratch/filoplume.json" -o "$scratch/view" --size 200x200
+expect_no_output "--view without --png" 2 "--view sets the camera of --png" \
+	"$scratch/view" "$plume" simulate "$scratch/filoplume.json" -o "$scratch/view" --render --view 10,10
+expect_no_output "--spp without --render" 2 "--spp sets the samples per pixel of --render; give --render" \
+	"$scratch/view" "$plume" simulate "$scratch/filoplume.json" -o "$scratch/view" --png --spp 8
 # --view: sscanf takes "nan" and "inf", which made a camera of NaN directions (an empty picture).
 expect_no_output "--view nan,0" 2 "--view takes AZIMUTH,ELEVATION in degrees (a finite azimuth, |elevation| <= 90), got 'nan,0'" \
 	"$scratch/view" "$plume" simulate "$scratch/filoplume.json" -o "$scratch/view" --view nan,0
