@@ -409,7 +409,7 @@ static plume_status newton(plume_sim *sim, const sim_problem *problem, plume_sol
 	double previous_closest = INFINITY;
 	// The last iterate's residual over its tolerance, q, and Newton's last measure of its
 	// quadratic convergence, C in q_{k+1} = C q_k^2, from two iterates a full step apart.
-	double previous_ratio = 0, contraction = 0, last_residual = 0;
+	double previous_ratio = 0, contraction = 0, last_residual = 0, last_scale = 0;
 	// Whether the exact Hessian ran out of shifts since the last full step: the exact one is
 	// then tried again only after the full step after that. Traced on Figure 1 at 2.5 mm,
 	// the next exact attempt ran out too about half the time (three more factorisations
@@ -457,6 +457,7 @@ static plume_status newton(plume_sim *sim, const sim_problem *problem, plume_sol
 			contraction = ratio / (previous_ratio * previous_ratio);
 		previous_ratio = ratio;
 		last_residual = residual;
+		last_scale = tolerance_scale;
 		report->energy = phi;
 		report->gradient_norm = free_norm2(sim, sim->residual);
 		report->max_barb_strain = plume_sim_max_barb_strain(sim, x);
@@ -598,12 +599,17 @@ static plume_status newton(plume_sim *sim, const sim_problem *problem, plume_sol
 	report->max_barb_strain = plume_sim_max_barb_strain(sim, x);
 	// How far from converged, in the terms of the test above: a step that stalls a few times
 	// above its tolerance with its barbs feasible (a vane at an unstable equilibrium, docs/
-	// simulation.md, Speed) reads differently from one that is far off.
+	// simulation.md, Speed) reads differently from one that is far off. The tolerance is
+	// relative to the largest force, so a residual can be huge and within it: then the barbs
+	// are what failed, and the message says so.
+	const char *failed =
+	    previous_ratio <= 1 ? "the forces balance, the barbs do not hold" : "the forces do not balance";
 	return plume_error_set(err, PLUME_ERROR_NUMERIC,
-	                       "Newton did not converge in %d iterations (largest force residual %.3g N, %.3g times "
-	                       "its tolerance; gradient norm %.3g N; barb strain %.3g, tolerance %.0e)",
-	                       report->newton_iterations, last_residual, previous_ratio, report->gradient_norm,
-	                       report->max_barb_strain, STRAIN_TOLERANCE);
+	                       "Newton did not converge in %d iterations (%s: largest force residual %.3g N, %.3g times "
+	                       "its tolerance, %.0e of the largest force, %.3g N; gradient norm %.3g N; barb strain %.3g, "
+	                       "tolerance %.0e)",
+	                       report->newton_iterations, failed, last_residual, previous_ratio, solver->tolerance,
+	                       last_scale, report->gradient_norm, report->max_barb_strain, STRAIN_TOLERANCE);
 }
 
 plume_status plume_sim_newton(plume_sim *sim, const sim_problem *problem, plume_solve_report *report, plume_error *err)

@@ -77,7 +77,7 @@ expect_no_output "step count overflow" 3 'scene-steps.json: $.duration: 1e+09 s 
 # --- the first simulation step fails: frame 0 and a summary that says where and why --------
 edit "$examples/scenes/falling.json" "$bad/scene-fail.json" \
 	"d['feather'] = '$examples/franco-walter/hawk.json'; d['mesh']['edge_length'] = 0.02; d['duration'] = 0.05; d['solver'] = {'max_iterations': 1, 'max_substep_halvings': 0}"
-expect_failure "first step fails" 1 'Newton did not converge in 1 iterations (largest force residual' \
+expect_failure "first step fails" 1 'Newton did not converge in 1 iterations (the forces do not balance: largest force residual' \
 	$T "$plume" simulate "$bad/scene-fail.json" -o "$scratch/fail"
 check "first step fails: frame 0 kept" test -s "$scratch/fail/frames/0000.obj"
 check "first step fails: only frame 0" test "$(ls "$scratch/fail/frames" | wc -l)" -eq 1
