@@ -88,6 +88,14 @@ typedef struct cli_image_options {
 	const plume_texture *texture; ///< NULL: the line style
 } cli_image_options;
 
+/// Makes the missing parent folders of path (mkdir -p of its parent): 0, or the errno of the
+/// folder that could not be made (*made then its path's length, and none left made). *made:
+/// the length of the path of the topmost folder made, 0 when every one existed.
+int cli_make_parents(const char *path, int *made);
+/// Removes the folders cli_make_parents made for path (made: its *made), deepest first, each
+/// only if empty.
+void cli_remove_parents(const char *path, int made);
+
 // A set of output files written all together or not at all: files go to a
 // staging folder beside the destination, which replaces it in one rename only
 // when every one of them was written (cli/output.c says how).

@@ -517,40 +517,38 @@ static plume_status stage_inside_dir(cli_output *output, plume_error *err)
 	return make_stage(output, &made, err);
 }
 
-/// Removes the parent folders of DIR that make_parents made, deepest first, each only if empty.
-static void remove_parents(const cli_output *output)
+void cli_remove_parents(const char *path, int made)
 {
-	if (output->parents_made == 0)
+	if (made == 0)
 		return;
-	char path[sizeof output->dir];
-	snprintf(path, sizeof path, "%s", output->dir);
-	for (char *slash = strrchr(path, '/'); slash != NULL; slash = strrchr(path, '/')) {
+	char folder[PATH_MAX];
+	snprintf(folder, sizeof folder, "%s", path);
+	for (char *slash = strrchr(folder, '/'); slash != NULL; slash = strrchr(folder, '/')) {
 		*slash = '\0';
-		if ((int)strlen(path) < output->parents_made || rmdir(path) != 0)
+		if ((int)strlen(folder) < made || rmdir(folder) != 0)
 			break;
 	}
 }
 
-/// Makes DIR's missing parent folders (mkdir -p), so that "created if missing" holds for a
-/// nested DIR too; DIR itself is the staging folder's rename.
-static plume_status make_parents(cli_output *output, plume_error *err)
+int cli_make_parents(const char *path, int *made)
 {
-	char *dir = output->dir;
-	for (char *slash = strchr(dir + 1, '/'); slash != NULL; slash = strchr(slash + 1, '/')) {
+	*made = 0;
+	char folder[PATH_MAX];
+	if (snprintf(folder, sizeof folder, "%s", path) >= (int)sizeof folder)
+		return ENAMETOOLONG;
+	for (char *slash = strchr(folder + 1, '/'); slash != NULL; slash = strchr(slash + 1, '/')) {
 		*slash = '\0';
-		int made = mkdir(dir, 0777) == 0 ? 0 : errno;
-		if (made == 0 && output->parents_made == 0)
-			output->parents_made = (int)strlen(dir);
-		if (made != 0 && made != EEXIST) {
-			plume_status status =
-			    plume_error_set(err, PLUME_ERROR_IO, "%s: cannot make the folder: %s", dir, strerror(made));
-			*slash = '/';
-			remove_parents(output);
-			return status;
+		int failure = mkdir(folder, 0777) == 0 ? 0 : errno;
+		if (failure == 0 && *made == 0)
+			*made = (int)strlen(folder);
+		if (failure != 0 && failure != EEXIST) {
+			cli_remove_parents(path, *made);
+			*made = (int)(slash - folder); // the folder that could not be made, for the message
+			return failure;
 		}
 		*slash = '/';
 	}
-	return PLUME_OK;
+	return 0;
 }
 
 plume_status cli_output_begin(cli_output *output, const char *dir, plume_error *err)
@@ -570,9 +568,11 @@ plume_status cli_output_begin(cli_output *output, const char *dir, plume_error *
 			return plume_error_set(err, PLUME_ERROR_IO, "%s: exists and is not a folder", output->dir);
 		output->dir_existed = true;
 	} else {
-		plume_status status = make_parents(output, err);
-		if (status != PLUME_OK)
-			return status;
+		// "Created if missing": a nested new DIR with its missing parents (mkdir -p).
+		int failure = cli_make_parents(output->dir, &output->parents_made);
+		if (failure != 0)
+			return plume_error_set(err, PLUME_ERROR_IO, "%.*s: cannot make the folder: %s", output->parents_made,
+			                       output->dir, strerror(failure));
 	}
 	// DIR named "." or ".." (or ending in "/." or "/.."): its last component is no name in its
 	// parent, so the staging folder "beside" it went inside it (or below it), and linking DIR's
@@ -603,7 +603,7 @@ plume_status cli_output_begin(cli_output *output, const char *dir, plume_error *
 	bool made;
 	plume_status status = make_stage(output, &made, err);
 	if (status != PLUME_OK && !output->dir_existed)
-		remove_parents(output);
+		cli_remove_parents(output->dir, output->parents_made);
 	if (status == PLUME_OK || made || !output->dir_existed)
 		return status;
 	// An existing DIR in a parent we may not write: stage inside DIR, move entry by entry.
@@ -1268,7 +1268,7 @@ void cli_output_abort(cli_output *output, plume_error *err)
 	if (output->stage[0] != '\0')
 		cli_remove_tree(output->stage);
 	untrack_stage(output);
-	remove_parents(output);
+	cli_remove_parents(output->dir, output->parents_made);
 }
 
 // ---------------------------------------------------------------------------

@@ -239,6 +239,12 @@ bool sweep_state_begin(int *code, sweep_state *state, const sweep *s, const char
 
 	char path[PATH_MAX + 32];
 	char *document = sweep_document(s);
+	int made, failure = cli_make_parents(dir, &made);
+	if (failure != 0) {
+		fprintf(stderr, "plume: %.*s: cannot create: %s\n", made, dir, strerror(failure));
+		free(document);
+		return false;
+	}
 	if (mkdir(dir, 0777) != 0 && errno != EEXIST) {
 		fprintf(stderr, "plume: %s: cannot create: %s\n", dir, strerror(errno));
 		free(document);

@@ -44,7 +44,9 @@ check "sweep: the same E_B samples at each grid value" \
 	test "$(awk -F, 'NR >= 2 && NR <= 4 { print $3 }' "$scratch/j1/results.csv")" = "$(awk -F, 'NR >= 5 { print $3 }' "$scratch/j1/results.csv")"
 check "sweep.json: version and seed" grep -q '"plume_version"' "$scratch/j1/sweep.json"
 
-"$plume" sweep "$scratch/grid.json" -o "$scratch/j2" -j 2 >/dev/null 2>&1
+"$plume" sweep "$scratch/grid.json" -o "$scratch/nested/j2" -j 2 >/dev/null 2>"$scratch/err.txt"
+succeeded "sweep -j 2 into a folder whose parents do not exist yet (they are made)"
+mv "$scratch/nested/j2" "$scratch/j2"
 check "sweep -j 2: same results.csv bytes" cmp -s "$scratch/j1/results.csv" "$scratch/j2/results.csv"
 check "sweep -j 2: same stats.json" cmp -s "$scratch/j1/stats.json" "$scratch/j2/stats.json"
 
