@@ -583,7 +583,7 @@ plume_status cli_output_begin(cli_output *output, const char *dir, plume_error *
 		char resolved[PATH_MAX];
 		if (realpath(output->dir, resolved) == NULL || strlen(resolved) + 64 >= sizeof output->dir)
 			return plume_error_set(err, PLUME_ERROR_IO, "'%s': not a usable output folder", dir);
-		snprintf(output->dir, sizeof output->dir, "%s", resolved);
+		memcpy(output->dir, resolved, strlen(resolved) + 1); // fits: checked above
 	}
 	const char *slash = strrchr(output->dir, '/');
 	int parent = slash != NULL ? (int)(slash - output->dir + 1) : 0;
