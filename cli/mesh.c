@@ -67,6 +67,12 @@ static bool parse_mesh_formats(const char *list, unsigned *formats)
 		unsigned bit;
 	} names[] = {{"obj", CLI_FORMAT_OBJ}, {"png", CLI_FORMAT_PNG}, {"glb", CLI_FORMAT_GLB}};
 	*formats = 0;
+	// An empty item ("obj,", ",obj", "obj,,png") is a typo, refused as cli_parse_formats does.
+	size_t size = strlen(list);
+	if (size > 0 && (list[0] == ',' || list[size - 1] == ',' || strstr(list, ",,") != NULL)) {
+		cli_usage_error("mesh", "--format '%s' has an empty item; a mesh writes obj, png, glb", list);
+		return false;
+	}
 	for (const char *cursor = list; *cursor != '\0';) {
 		size_t length = strcspn(cursor, ",");
 		size_t i = 0;

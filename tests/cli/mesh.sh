@@ -73,6 +73,11 @@ expect_failure "format foo" 2 "unknown format 'foo' in --format: a mesh writes o
 check "format foo: no svg offered" bash -c "! grep -q svg '$scratch/err.txt'"
 expect_failure "format svg" 2 "unknown format 'svg' in --format: a mesh writes obj, png, glb" \
 	"$plume" mesh "$source_dir/examples/meshes/guides.json" -o "$scratch/bad" --format png,svg
+# An empty item is refused wherever it is ('obj,' was taken as obj; generate's list refused it).
+for list in obj, ,obj obj,,png; do
+	expect_failure "format '$list'" 2 "--format '$list' has an empty item; a mesh writes obj, png, glb" \
+		"$plume" mesh "$source_dir/examples/meshes/guides.json" -o "$scratch/bad" --format "$list"
+done
 check "bad formats: nothing written" test ! -e "$scratch/bad"
 "$plume" mesh "$source_dir/examples/meshes/guides.json" -o "$scratch/glb" --format glb,obj 2>"$scratch/err.txt"
 succeeded "format glb,obj"
