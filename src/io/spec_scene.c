@@ -1065,7 +1065,7 @@ static plume_status build_mesh(const char *file, const json_t *root, const plume
 			status = plume_mesh_from_feather(scene->feather, &mesh_def, &scene->mesh, &scene->mesh_report, err);
 	} else {
 		plume_mesh_guides_storage storage;
-		status = plume_spec_mesh_guides(&reader, guides, "$.guides", &storage);
+		status = plume_spec_mesh_guides(&reader, guides, "$.guides", mesh_def.max_memory, &storage);
 		if (status == PLUME_OK) {
 			status = plume_mesh_from_guides(&storage.guides, &mesh_def, &scene->mesh, &scene->mesh_report, err);
 			plume_mesh_guides_storage_free(&storage);

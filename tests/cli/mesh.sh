@@ -67,6 +67,17 @@ check "edge length 1e-300: a short message" test "$(wc -c <"$scratch/err.txt")" 
 # Small enough to need 26.9 GB: the memory estimate refuses it (exit 5).
 expect_no_output "edge length 1e-5" 5 "the limit is" "$scratch/tiny" \
 	"$plume" mesh "$source_dir/examples/franco-walter/hawk.json" -o "$scratch/tiny" --edge-length 1e-5
+# Splines sampled past --max-memory are refused before they are sampled (exit 5, naming the spline):
+# 10 KB of JSON, a guide of 500 points at 10000 samples a span, took 5 million points (200 MB).
+python3 -c "
+import json
+d = json.load(open('$source_dir/examples/meshes/guides.json'))
+d['guides'][1] = {'type': 'catmull-rom', 'samples': 10000,
+                  'points': [[0.001 - 0.027 * i / 499, 0.045 + 0.03 * i / 499] for i in range(500)]}
+json.dump(d, open('$scratch/samples.json', 'w'))"
+expect_no_output "guides sampled past --max-memory" 5 \
+	"samples.json: \$.guides[1]: the splines up to here sample into 4990114 points, about 0.319 GB at 64 B a point; the limit is 0.105 GB" \
+	"$scratch/heavy" "$plume" mesh "$scratch/samples.json" -o "$scratch/heavy" --max-memory 100M
 # --format lists what a mesh is written as, not a feather's formats.
 expect_failure "format foo" 2 "unknown format 'foo' in --format: a mesh writes obj, png, glb" \
 	"$plume" mesh "$source_dir/examples/meshes/guides.json" -o "$scratch/bad" --format foo
