@@ -78,6 +78,15 @@ json.dump(d, open('$scratch/samples.json', 'w'))"
 expect_no_output "guides sampled past --max-memory" 5 \
 	"samples.json: \$.guides[1]: the splines up to here sample into 4990114 points, about 0.319 GB at 64 B a point; the limit is 0.105 GB" \
 	"$scratch/heavy" "$plume" mesh "$scratch/samples.json" -o "$scratch/heavy" --max-memory 100M
+# The outputs are held to --max-memory too: a 16384x16384 mesh.png is a 1 GiB surface (it was
+# drawn at --max-memory 100M, 1 GB of RSS); without png the same --size is nothing to write.
+expect_no_output "a picture past --max-memory" 5 \
+	"guides.json: writing png, obj (--format, --size) takes up to 1.07 GB besides the mesh's" \
+	"$scratch/huge" "$plume" mesh "$source_dir/examples/meshes/guides.json" -o "$scratch/huge" \
+	--size 16384x16384 --max-memory 100M
+"$plume" mesh "$source_dir/examples/meshes/guides.json" -o "$scratch/huge" --format obj --size 16384x16384 \
+	--max-memory 100M 2>"$scratch/err.txt"
+succeeded "--size without png: nothing past --max-memory"
 # --format lists what a mesh is written as, not a feather's formats.
 expect_failure "format foo" 2 "unknown format 'foo' in --format: a mesh writes obj, png, glb" \
 	"$plume" mesh "$source_dir/examples/meshes/guides.json" -o "$scratch/bad" --format foo
