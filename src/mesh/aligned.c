@@ -2419,10 +2419,28 @@ static plume_status mesh_run(const mesh_input *input, const plume_mesh_def *def,
 	                                        {0.0, 0.4, false},  {32.0, 0.15, true}};
 	const double bound = PLUME_MESH_QUALITY_ANGLE_DEG * pi / 180.0;
 	plume_mesh_report best, tried;
+	const size_t variant_count = sizeof variants / sizeof variants[0];
 	plume_status status = mesh_try(input, def, (mesh_variant){0.0, 0.0, false}, out, &best, err);
+	// A first try whose faces overlap is passed over like the others: the first later try that
+	// succeeds takes its place (the Franco-Walter hawk at e = 0.6 mm folds at the rachis unthinned
+	// and meshes thinned), and the error stands when none does.
+	size_t i = 0;
+	while (status == PLUME_ERROR_NUMERIC && i < variant_count) {
+		plume_error scratch = {0};
+		plume_status tried_status = mesh_try(input, def, variants[i++], out, &best, &scratch);
+		if (tried_status == PLUME_ERROR_MEMORY)
+			return plume_error_set(err, PLUME_ERROR_MEMORY, "%s", scratch.message);
+		if (tried_status == PLUME_OK) {
+			status = PLUME_OK;
+			if (err != NULL)
+				*err = (plume_error){0};
+		} else {
+			plume_mesh_destroy(*out);
+			*out = NULL;
+		}
+	}
 	double first_area = status == PLUME_OK ? vane_area(*out) : 0.0;
-	for (size_t i = 0; status == PLUME_OK && best.vane_min_angle < bound && i < sizeof variants / sizeof variants[0];
-	     ++i) {
+	for (; status == PLUME_OK && best.vane_min_angle < bound && i < variant_count; ++i) {
 		plume_mesh *candidate = NULL;
 		plume_error scratch = {0};
 		plume_status tried_status = mesh_try(input, def, variants[i], &candidate, &tried, &scratch);
