@@ -2111,6 +2111,14 @@ static plume_status build_mesh(mesher *m, int vane_faces, plume_mesh **out, plum
 			                       m->e, extent, in->guide_count[0], in->guide_count[1],
 			                       floor(0.25 * extent / unit) * unit);
 		}
+		if (in->boundary != NULL) // explicit guides start where the band ends and end at the boundary
+			return plume_error_set(m->err, PLUME_ERROR_SPEC,
+			                       "no vane to mesh: %d usable barb guides on the left, %d on the right (%d input "
+			                       "guides left out), and no guide vertex beside the rachis band inside the boundary "
+			                       "polygon; the boundary must enclose the rachis and reach past the band (%g m wide "
+			                       "at the base, rachis_width_base, and %g m at the tip, rachis_width_tip)",
+			                       in->guide_count[0], in->guide_count[1], in->guides_dropped, in->rachis.width[0],
+			                       in->rachis.width[in->rachis.count - 1]);
 		return plume_error_set(m->err, PLUME_ERROR_SPEC,
 		                       "no vane to mesh: %d usable barb guides on the left, %d on the right (%d input barbs "
 		                       "left out); the feather needs barbs with a length in the feather plane",

@@ -61,6 +61,17 @@ r = json.load(open('$scratch/folds/report.json'))
 assert r['vane_face_count'] > 0 and r['aligned_fraction'] == 1, r
 "
 
+# A boundary that leaves no guide beside the band is named as the cause (it read "the feather
+# needs barbs with a length in the feather plane", a feather's cause, for explicit guides).
+python3 -c "
+import json
+d = json.load(open('$source_dir/examples/meshes/guides.json'))
+d['boundary'] = [[1.0, 1.0], [1.1, 1.0], [1.1, 1.1]]
+json.dump(d, open('$scratch/far.json', 'w'))"
+expect_no_output "a boundary away from the rachis" 3 \
+	"far.json: no vane to mesh: 4 usable barb guides on the left, 4 on the right (0 input guides left out), and no guide vertex beside the rachis band inside the boundary polygon; the boundary must enclose the rachis and reach past the band (0.0025 m wide at the base, rachis_width_base, and 0.0008 m at the tip, rachis_width_tip)" \
+	"$scratch/far" "$plume" mesh "$scratch/far.json" -o "$scratch/far"
+
 # Without --size mesh.png is 1200 tall and as wide as the mesh, at most 16384 (--size's bound). A flat
 # mesh (guides 0.1 m long, 1e-8 m apart) is 16384 wide: its width, 1.2e10 pixels, was cast to an int.
 cat >"$scratch/flat.json" <<'EOF'
