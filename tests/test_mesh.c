@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "io/spec.h"
 #include "io/spec_mesh.h"
@@ -1088,6 +1089,56 @@ static void test_overlap_reported(void **state)
 // ---------------------------------------------------------------------------
 // OBJ
 
+/// A mesh with a NaN, an infinite number or one past single precision (3.4e38, glTF's floats)
+/// is refused by the OBJ and glTF writers, naming the vertex, and no file is written: the OBJ
+/// writer printed "nan" (which no reader, plume's included, takes for a number) and the glTF
+/// writer NaN positions, bounds without them, and a max of two numbers for 1e300 (JSON has no
+/// infinity), exit 0.
+static void test_mesh_writers_refuse_non_finite(void **state)
+{
+	(void)state;
+	char dir[512], obj[640], glb[640];
+	test_make_temp_dir(dir, sizeof dir);
+	snprintf(obj, sizeof obj, "%s/mesh.obj", dir);
+	snprintf(glb, sizeof glb, "%s/mesh.glb", dir);
+	plume_feather *feather = example("figure6a");
+	plume_mesh_def def = plume_mesh_default_def();
+	plume_mesh *mesh = NULL;
+	assert_int_equal(plume_mesh_from_feather(feather, &def, &mesh, NULL, NULL), PLUME_OK);
+	plume_error err;
+	mesh->rest[3].y = NAN;
+	assert_int_equal(plume_mesh_write_obj(mesh, NULL, obj, &err), PLUME_ERROR_NUMERIC);
+	assert_non_null(strstr(err.message, "mesh.obj: vertex 4 has a NaN or infinite number"));
+	assert_int_equal(plume_mesh_write_glb(mesh, NULL, NULL, glb, &err), PLUME_ERROR_NUMERIC);
+	assert_non_null(strstr(err.message, "mesh.glb: vertex 4 has a NaN or infinite number"));
+	mesh->rest[3].y = 1e300; // a double, written by OBJ; past glTF's floats
+	assert_int_equal(plume_mesh_write_glb(mesh, NULL, NULL, glb, &err), PLUME_ERROR_NUMERIC);
+	assert_int_equal(access(glb, F_OK), -1);
+	mesh->rest[3].y = 0.0;
+	mesh->uv[5].x = INFINITY;
+	assert_int_equal(plume_mesh_write_obj(mesh, NULL, obj, &err), PLUME_ERROR_NUMERIC);
+	assert_non_null(strstr(err.message, "vertex 6"));
+	assert_int_equal(access(obj, F_OK), -1);
+	mesh->uv[5].x = 0.0;
+	// Positions other than rest, through the frame writer too.
+	plume_vec3 *moved = malloc((size_t)mesh->vertex_count * sizeof *moved);
+	memcpy(moved, mesh->rest, (size_t)mesh->vertex_count * sizeof *moved);
+	moved[7].z = -INFINITY;
+	assert_int_equal(plume_mesh_write_obj(mesh, moved, obj, &err), PLUME_ERROR_NUMERIC);
+	plume_mesh_obj_writer *writer = NULL;
+	assert_int_equal(plume_mesh_obj_writer_create(mesh, &writer, &err), PLUME_OK);
+	assert_int_equal(plume_mesh_obj_writer_write(writer, moved, obj, &err), PLUME_ERROR_NUMERIC);
+	assert_non_null(strstr(err.message, "vertex 8"));
+	assert_int_equal(access(obj, F_OK), -1);
+	assert_int_equal(plume_mesh_obj_writer_write(writer, NULL, obj, &err), PLUME_OK);
+	assert_int_equal(plume_mesh_write_glb(mesh, NULL, NULL, glb, &err), PLUME_OK);
+	plume_mesh_obj_writer_destroy(writer);
+	free(moved);
+	plume_mesh_destroy(mesh);
+	plume_feather_destroy(feather);
+	test_remove_tree(dir);
+}
+
 static void test_obj_round_trip(void **state)
 {
 	(void)state;
@@ -1287,6 +1338,7 @@ int main(void)
 	    cmocka_unit_test(test_tall_guides),
 	    cmocka_unit_test(test_overlap_reported),
 	    cmocka_unit_test(test_obj_round_trip),
+	    cmocka_unit_test(test_mesh_writers_refuse_non_finite),
 	    cmocka_unit_test(test_obj_reader),
 	    cmocka_unit_test(test_groups_and_barb_edges),
 	};
