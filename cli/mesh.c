@@ -162,8 +162,10 @@ static plume_status draw_mesh(const plume_mesh *mesh, int width, int height, con
 	double x0, y0, x1, y1;
 	mesh_bounds(mesh, &x0, &y0, &x1, &y1);
 	double span_x = fmax(x1 - x0, 1e-9), span_y = fmax(y1 - y0, 1e-9);
-	double margin = 20.0;
 	picture_size(mesh, &width, &height);
+	// 20 pixels, at most a quarter of the picture: a --size under 40 made the scale negative,
+	// the mesh drawn turned half a turn (and the wrong side's scale picked).
+	double margin = fmin(20.0, 0.25 * fmin(width, height));
 	view v = {fmin((width - 2.0 * margin) / span_x, (height - 2.0 * margin) / span_y), x0, y1, margin};
 	cairo_surface_t *surface = cairo_image_surface_create(CAIRO_FORMAT_RGB24, width, height);
 	cairo_t *cr = cairo_create(surface);

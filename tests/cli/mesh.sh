@@ -72,6 +72,40 @@ expect_no_output "a boundary away from the rachis" 3 \
 	"far.json: no vane to mesh: 4 usable barb guides on the left, 4 on the right (0 input guides left out), and no guide vertex beside the rachis band inside the boundary polygon; the boundary must enclose the rachis and reach past the band (0.0025 m wide at the base, rachis_width_base, and 0.0008 m at the tip, rachis_width_tip)" \
 	"$scratch/far" "$plume" mesh "$scratch/far.json" -o "$scratch/far"
 
+# A picture smaller than its 20-pixel margins: the margins shrink to a quarter of it, and the mesh
+# fills it the right way up (at --size 32x32 the scale was negative: rows 1 to 20, turned half a turn).
+"$plume" mesh "$source_dir/examples/meshes/guides.json" -o "$scratch/thumb" --format png --size 32x32 2>"$scratch/err.txt"
+succeeded "a 32x32 picture"
+check "a 32x32 picture: the mesh between the margins, its height filling them" python3 -c "
+# The PNG decoded (8-bit RGB, the five filters): the bounds of what is drawn.
+import struct, zlib
+data = open('$scratch/thumb/mesh.png', 'rb').read()
+at, idat = 8, b''
+while at < len(data):
+    length, kind = struct.unpack('>I4s', data[at:at + 8])
+    if kind == b'IHDR':
+        width, height, depth, colour = struct.unpack('>IIBB', data[at + 8:at + 18])
+    elif kind == b'IDAT':
+        idat += data[at + 8:at + 8 + length]
+    at += 12 + length
+assert depth == 8 and colour in (2, 6), (depth, colour)
+step = 3 if colour == 2 else 4
+raw, rows, previous, drawn = zlib.decompress(idat), [], bytearray(width * step), []
+for y in range(height):
+    kind, line = raw[y * (width * step + 1)], bytearray(raw[y * (width * step + 1) + 1:(y + 1) * (width * step + 1)])
+    for i in range(len(line)):
+        a = line[i - step] if i >= step else 0
+        b, c = previous[i], previous[i - step] if i >= step else 0
+        p = a + b - c
+        predictor = [0, a, b, (a + b) // 2, a if abs(p - a) <= abs(p - b) and abs(p - a) <= abs(p - c) else b if abs(p - b) <= abs(p - c) else c][kind]
+        line[i] = (line[i] + predictor) & 255
+    previous = line
+    drawn += [(y, x) for x in range(width) if min(line[x * step:x * step + 3]) < 250]
+rows, columns = [y for y, x in drawn], [x for y, x in drawn]
+assert 6 <= min(rows) and max(rows) <= 25 and max(rows) - min(rows) >= 14, (min(rows), max(rows))
+assert 6 <= min(columns) and max(columns) <= 25, (min(columns), max(columns))
+"
+
 # Without --size mesh.png is 1200 tall and as wide as the mesh, at most 16384 (--size's bound). A flat
 # mesh (guides 0.1 m long, 1e-8 m apart) is 16384 wide: its width, 1.2e10 pixels, was cast to an int.
 cat >"$scratch/flat.json" <<'EOF'
