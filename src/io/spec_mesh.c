@@ -151,6 +151,12 @@ static bool read_spline(plume_spec_reader *reader, const json_t *value, const ch
 		plume_spec_fail(reader, child, "unknown spline type \"%s\"; allowed: polyline, catmull-rom, bezier", type);
 		return false;
 	}
+	if (samples != -1 && polyline) { // it would be ignored: the points are the polyline
+		plume_spec_path(child, sizeof child, path, "samples");
+		plume_spec_fail(reader, child,
+		                "a polyline takes its points as they are; \"samples\" is for catmull-rom and bezier");
+		return false;
+	}
 	if (samples != -1 && (samples < 2 || samples > 10000)) {
 		plume_spec_path(child, sizeof child, path, "samples");
 		plume_spec_fail(reader, child, "is %d, allowed [2, 10000]", samples);

@@ -106,6 +106,16 @@ assert 6 <= min(rows) and max(rows) <= 25 and max(rows) - min(rows) >= 14, (min(
 assert 6 <= min(columns) and max(columns) <= 25, (min(columns), max(columns))
 "
 
+# "samples" on a polyline did nothing (its points are the polyline): refused, naming the key.
+python3 -c "
+import json
+d = json.load(open('$source_dir/examples/meshes/guides.json'))
+d['guides'][6] = {'type': 'polyline', 'samples': 500, 'points': d['guides'][6]}
+json.dump(d, open('$scratch/polyline.json', 'w'))"
+expect_no_output "samples on a polyline" 3 \
+	"polyline.json: \$.guides[6].samples: a polyline takes its points as they are; \"samples\" is for catmull-rom and bezier" \
+	"$scratch/polyline" "$plume" mesh "$scratch/polyline.json" -o "$scratch/polyline"
+
 # Without --size mesh.png is 1200 tall and as wide as the mesh, at most 16384 (--size's bound). A flat
 # mesh (guides 0.1 m long, 1e-8 m apart) is 16384 wide: its width, 1.2e10 pixels, was cast to an int.
 cat >"$scratch/flat.json" <<'EOF'
