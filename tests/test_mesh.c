@@ -1054,6 +1054,30 @@ static void test_tall_guides(void **state)
 	assert_int_equal(plume_bytes_in_use(), before);
 }
 
+/// The try that cuts tails along the outline (trim_outline_tails) checks the closing edges of
+/// a guide's strips; a strip whose other guide was left out as a stub before it
+/// (drop_short_end_guides: no vertices) had its closing edge read at vertex -1, before the
+/// point pool (AddressSanitizer, heap-buffer-overflow; garbage in other builds). Such strips are
+/// skipped, as walk_line_strips skips them.
+static void test_tails_past_dropped_guide(void **state)
+{
+	(void)state;
+	int64_t before = plume_bytes_in_use();
+	char path[640];
+	snprintf(path, sizeof path, "%s/tests/data/tails-dropped-guide.json", PLUME_SOURCE_DIR);
+	plume_mesh_spec_options options = plume_mesh_spec_default_options();
+	plume_mesh *mesh = NULL;
+	plume_mesh_report report;
+	plume_error err;
+	if (plume_mesh_spec_read(path, &options, &mesh, &report, &err) != PLUME_OK)
+		fail_msg("%s", err.message);
+	assert_int_equal(mesh->vertex_count, 20);
+	assert_int_equal(mesh->face_count, 22);
+	assert_true(report.aligned_fraction == 1.0);
+	plume_mesh_destroy(mesh);
+	assert_int_equal(plume_bytes_in_use(), before);
+}
+
 /// The last safety net finds overlapping faces through a grid (src/mesh/aligned.c,
 /// find_overlap) and names a face, when every try folds (tests/data/folding-guides.json).
 /// A first try that folds is passed over: the Franco-Walter peacock at seed 4 and e = 1 mm,
@@ -1336,6 +1360,7 @@ int main(void)
 	    cmocka_unit_test(test_guides_spec_errors),
 	    cmocka_unit_test(test_guides_spec_splines),
 	    cmocka_unit_test(test_tall_guides),
+	    cmocka_unit_test(test_tails_past_dropped_guide),
 	    cmocka_unit_test(test_overlap_reported),
 	    cmocka_unit_test(test_obj_round_trip),
 	    cmocka_unit_test(test_mesh_writers_refuse_non_finite),

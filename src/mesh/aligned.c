@@ -1320,12 +1320,14 @@ static bool crosses_nearby(const mesher *m, int side, int r, plume_vec3 p, plume
 }
 
 /// True when the closing edge of a strip of line l (from one guide's last vertex
-/// to the other's) crosses a guide of the rows near either guide.
+/// to the other's) crosses a guide of the rows near either guide. Strips of a
+/// guide left out (drop_short_end_guides: no vertices) are gone, as in
+/// walk_line_strips: their last vertex was read before the guide's first.
 static bool closing_edges_cross(const mesher *m, int l)
 {
 	for (int s = 0; s < m->strip_count; ++s) {
 		const mesh_strip *strip = m->strip_list + s;
-		if (strip->a != l && strip->b != l)
+		if ((strip->a != l && strip->b != l) || !m->lines[strip->a].present || !m->lines[strip->b].present)
 			continue;
 		strip_view view = view_strip(m, strip);
 		plume_vec3 p = view.A[view.ma], q = view.B[view.nb];
