@@ -1054,6 +1054,34 @@ static void test_tall_guides(void **state)
 	assert_int_equal(plume_bytes_in_use(), before);
 }
 
+/// Every vertex belongs to a face (one outside them is massless in the simulator). Two short
+/// guides joined from both sides to the same vertex of the guide between them closed both of
+/// its strips there, and its tip belonged to no face (tests/data/orphan-tip.json, random
+/// guides); a build with such a vertex fails, so the unjoined mesh stands.
+static void test_every_vertex_in_a_face(void **state)
+{
+	(void)state;
+	int64_t before = plume_bytes_in_use();
+	char path[640];
+	snprintf(path, sizeof path, "%s/tests/data/orphan-tip.json", PLUME_SOURCE_DIR);
+	plume_mesh_spec_options options = plume_mesh_spec_default_options();
+	plume_mesh *mesh = NULL;
+	plume_mesh_report report;
+	plume_error err;
+	if (plume_mesh_spec_read(path, &options, &mesh, &report, &err) != PLUME_OK)
+		fail_msg("%s", err.message);
+	bool *used = calloc((size_t)mesh->vertex_count, sizeof *used);
+	for (int i = 0; i < 3 * mesh->face_count; ++i)
+		used[mesh->faces[i]] = true;
+	for (int v = 0; v < mesh->vertex_count; ++v)
+		if (!used[v])
+			fail_msg("vertex %d of %d is in no face", v, mesh->vertex_count);
+	free(used);
+	assert_true(report.aligned_fraction == 1.0);
+	plume_mesh_destroy(mesh);
+	assert_int_equal(plume_bytes_in_use(), before);
+}
+
 /// The try that cuts tails along the outline (trim_outline_tails) checks the closing edges of
 /// a guide's strips; a strip whose other guide was left out as a stub before it
 /// (drop_short_end_guides: no vertices) had its closing edge read at vertex -1, before the
@@ -1360,6 +1388,7 @@ int main(void)
 	    cmocka_unit_test(test_guides_spec_errors),
 	    cmocka_unit_test(test_guides_spec_splines),
 	    cmocka_unit_test(test_tall_guides),
+	    cmocka_unit_test(test_every_vertex_in_a_face),
 	    cmocka_unit_test(test_tails_past_dropped_guide),
 	    cmocka_unit_test(test_overlap_reported),
 	    cmocka_unit_test(test_obj_round_trip),

@@ -2160,6 +2160,24 @@ static plume_status build_mesh(mesher *m, int vane_faces, plume_mesh **out, plum
 		(void)ok;
 	}
 	assert(status != PLUME_OK || emitted.faces == face_count);
+	// Every vertex must belong to a face: one outside them has no mass in the simulator. Two
+	// short guides joined from both sides to one vertex of a guide between them close both of
+	// its strips there, and its vertices past it belonged to none; such a build fails (the
+	// joined one is then dropped for the unjoined, a try passed over).
+	if (status == PLUME_OK) {
+		bool *used = plume_calloc((size_t)vertex_count, sizeof *used);
+		if (used == NULL)
+			status = plume_error_set(m->err, PLUME_ERROR_MEMORY, "out of memory checking the mesh");
+		for (int i = 0; used != NULL && i < 3 * face_count; ++i)
+			used[mesh->faces[i]] = true;
+		for (int v = 0; used != NULL && v < vertex_count && status == PLUME_OK; ++v)
+			if (!used[v])
+				status = plume_error_set(m->err, PLUME_ERROR_NUMERIC,
+				                         "vertex %d at (%g, %g) m belongs to no face at edge length %g m; try "
+				                         "another edge length",
+				                         v, mesh->reference[v].x, mesh->reference[v].y, m->e);
+		plume_free(used);
+	}
 	// The walk's positions are kept until the slid ones pass the overlap check.
 	size_t n = (size_t)mesh->vertex_count, f = (size_t)mesh->face_count;
 	plume_vec2 *kept_reference = NULL, *kept_uv = NULL;
