@@ -40,8 +40,9 @@ void cli_help_mesh(void)
 	     "  -s, --seed N            random seed of a feather spec; overrides its \"seed\"\n"
 	     "      --size WxH          image size in pixels (default: 1200 tall)\n"
 	     "  -f, --format LIST       comma-separated: obj,png,glb (default: obj,png)\n"
-	     "      --max-memory BYTES  refuse a mesh estimated past BYTES (K, M, G suffixes;\n"
-	     "                          default 4G): about 320 bytes a vertex (docs/cli.md)\n"
+	     "      --max-memory BYTES  refuse a mesh, or its outputs, estimated past BYTES (K, M,\n"
+	     "                          G suffixes; default 4G): about 320 bytes a vertex, 4 a\n"
+	     "                          pixel of mesh.png (docs/cli.md)\n"
 	     "  -h, --help              this help\n"
 	     "\n"
 	     "The guides spec is described in docs/meshing.md.");
@@ -67,6 +68,12 @@ static bool parse_mesh_formats(const char *list, unsigned *formats)
 		unsigned bit;
 	} names[] = {{"obj", CLI_FORMAT_OBJ}, {"png", CLI_FORMAT_PNG}, {"glb", CLI_FORMAT_GLB}};
 	*formats = 0;
+	// An empty item ("obj,", ",obj", "obj,,png") is a typo, refused as cli_parse_formats does.
+	size_t size = strlen(list);
+	if (size > 0 && (list[0] == ',' || list[size - 1] == ',' || strstr(list, ",,") != NULL)) {
+		cli_usage_error("mesh", "--format '%s' has an empty item; a mesh writes obj, png, glb", list);
+		return false;
+	}
 	for (const char *cursor = list; *cursor != '\0';) {
 		size_t length = strcspn(cursor, ",");
 		size_t i = 0;
@@ -103,27 +110,62 @@ static void to_pixels(const view *v, plume_vec2 p, double *x, double *y)
 	*y = v->margin + (v->y1 - p.y) * v->scale;
 }
 
-static plume_status draw_mesh(const plume_mesh *mesh, int width, int height, const char *path, plume_error *err)
+/// The reference mesh's bounds in the feather plane.
+static void mesh_bounds(const plume_mesh *mesh, double *x0, double *y0, double *x1, double *y1)
 {
-	double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
+	*x0 = *y0 = INFINITY;
+	*x1 = *y1 = -INFINITY;
 	for (int i = 0; i < mesh->vertex_count; ++i) {
-		x0 = fmin(x0, mesh->reference[i].x);
-		x1 = fmax(x1, mesh->reference[i].x);
-		y0 = fmin(y0, mesh->reference[i].y);
-		y1 = fmax(y1, mesh->reference[i].y);
+		*x0 = fmin(*x0, mesh->reference[i].x);
+		*x1 = fmax(*x1, mesh->reference[i].x);
+		*y0 = fmin(*y0, mesh->reference[i].y);
+		*y1 = fmax(*y1, mesh->reference[i].y);
 	}
+}
+
+/// mesh.png's size: --size's (width, height > 0), else 1200 tall and as wide as the mesh needs.
+static void picture_size(const plume_mesh *mesh, int *width, int *height)
+{
+	double x0, y0, x1, y1;
+	mesh_bounds(mesh, &x0, &y0, &x1, &y1);
 	double span_x = fmax(x1 - x0, 1e-9), span_y = fmax(y1 - y0, 1e-9);
 	double margin = 20.0;
-	if (height <= 0)
-		height = 1200;
-	if (width <= 0) {
+	if (*height <= 0)
+		*height = 1200;
+	if (*width <= 0) {
 		// As wide as the mesh needs, up to what --size allows; clamped as a double: a flat mesh's
 		// span_x / span_y (a 0.1 m row of guides 1e-8 m apart) is past an int.
-		double wide = ceil(2.0 * margin + (height - 2.0 * margin) * span_x / span_y);
-		width = !(wide <= 16384.0) ? 16384 : (int)wide;
+		double wide = ceil(2.0 * margin + (*height - 2.0 * margin) * span_x / span_y);
+		*width = !(wide <= 16384.0) ? 16384 : (int)wide;
 	}
-	if (width < 16)
-		width = 16;
+	if (*width < 16)
+		*width = 16;
+}
+
+/// Bytes writing the formats adds to the mesh, at most: the largest format's (each frees its
+/// memory before the next). png: Cairo's surface, 4 B a pixel, and 256 KiB; glb: the attributes
+/// as doubles (64 B a vertex), the indices (12 B a face) and 1 MiB; obj and the report: 64 KiB.
+static double output_bytes(const plume_mesh *mesh, unsigned formats, int width, int height)
+{
+	double most = 64.0 * 1024;
+	if ((formats & CLI_FORMAT_PNG) != 0) {
+		picture_size(mesh, &width, &height);
+		most = fmax(most, 256.0 * 1024 + 4.0 * width * (double)height);
+	}
+	if ((formats & CLI_FORMAT_GLB) != 0)
+		most = fmax(most, 1024.0 * 1024 + 64.0 * mesh->vertex_count + 12.0 * mesh->face_count);
+	return most;
+}
+
+static plume_status draw_mesh(const plume_mesh *mesh, int width, int height, const char *path, plume_error *err)
+{
+	double x0, y0, x1, y1;
+	mesh_bounds(mesh, &x0, &y0, &x1, &y1);
+	double span_x = fmax(x1 - x0, 1e-9), span_y = fmax(y1 - y0, 1e-9);
+	picture_size(mesh, &width, &height);
+	// 20 pixels, at most a quarter of the picture: a --size under 40 made the scale negative,
+	// the mesh drawn turned half a turn (and the wrong side's scale picked).
+	double margin = fmin(20.0, 0.25 * fmin(width, height));
 	view v = {fmin((width - 2.0 * margin) / span_x, (height - 2.0 * margin) / span_y), x0, y1, margin};
 	cairo_surface_t *surface = cairo_image_surface_create(CAIRO_FORMAT_RGB24, width, height);
 	cairo_t *cr = cairo_create(surface);
@@ -270,6 +312,22 @@ int cli_mesh(int argc, char **argv)
 	plume_mesh *mesh = NULL;
 	plume_mesh_report report;
 	plume_status status = plume_mesh_spec_read(argv[optind], &spec_options, &mesh, &report, &err);
+	if (status == PLUME_OK) {
+		// The outputs are held to --max-memory as well, before any is written (a --size of
+		// 16384x16384 is a 1 GiB picture), with the mesh the library holds.
+		double limit = (double)(spec_options.max_memory > 0 ? spec_options.max_memory : PLUME_DEFAULT_MAX_MEMORY);
+		double held = (double)plume_bytes_in_use(), outputs = output_bytes(mesh, formats, width, height);
+		if (!(held + outputs <= limit)) {
+			char list[64];
+			cli_format_list(formats, list, sizeof list);
+			status = plume_error_set(&err, PLUME_ERROR_LIMIT,
+			                         "%s: writing %s (--format%s) takes up to %.3g GB besides the mesh's %.3g GB: %.3g "
+			                         "GB in all; the limit is %.3g GB (raise it with --max-memory, or write fewer or "
+			                         "smaller formats)",
+			                         argv[optind], list, (formats & CLI_FORMAT_PNG) != 0 ? ", --size" : "",
+			                         outputs / 1e9, held / 1e9, (held + outputs) / 1e9, limit / 1e9);
+		}
+	}
 	cli_output output;
 	if (status == PLUME_OK && (status = cli_output_begin(&output, output_dir, &err)) == PLUME_OK) {
 		char path[4400];

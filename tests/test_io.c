@@ -851,7 +851,9 @@ static void test_read_json_errors(void **state)
 	    {"\"format\": \"plume-feather\"", "\"format\": \"feather\"", "$.format:", "plume-feather"},
 	    {"\"side\": \"left\"", "\"side\": \"up\"", "$.barbs[0].side:", "\"left\" or \"right\""},
 	    {"\"segment\": 0", "\"segment\": 0.5", "$.barbs[0].segment:", "integer"},
-	    {"\"segment\": 0", "\"segment\": 0, \"colour\": 3", "$.barbs[0]:", "unknown key \"colour\""},
+	    {"\"segment\": 0", "\"segment\": 0, \"colour\": 3", "$.barbs[0]:",
+	     "unknown key \"colour\"; the keys here are: side, rachis_t, segment, position, normal, arc_length, width, uv, "
+	     "barbules"},
 	    {"\"rachis_t\": 0.5, \"segment\": 0", "\"segment\": 0", "$.barbs[0]:", "missing key \"rachis_t\""},
 	    {"\"arc_length\": [0, 0.0141]", "\"arc_length\": [0, 0.0141, 3]", "$.barbs[0].arc_length:", "found 3"},
 	    {"\"position\": [0, 0.05, 0, -0.01", "\"position\": [0, 0.05, \"x\", -0.01",
@@ -864,7 +866,7 @@ static void test_read_json_errors(void **state)
 	    {"\"barbs\": [],", "\"barbs\": [7],", "$.afterfeather.feather.barbs[0]:", "expected an object"},
 	    {"\"t\": 0.15", "\"t\": null", "$.afterfeather.t:", "expected a number"},
 	    {"\"afterfeather\": null", "\"afterfeather\": null, \"format\": \"plume-feather\"",
-	     "$.afterfeather.feather:", "unknown key \"format\""},
+	     "$.afterfeather.feather:", "unknown key \"format\"; the keys here are: shaft, barbs, afterfeather"},
 	    {"\"barbules\": []", "\"barbules\": {}", "$.barbs[0].barbules:", "expected an array"},
 	};
 	for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {

@@ -138,3 +138,13 @@ bool plume_feather_find_non_finite(const plume_feather *feather, bool single_pre
 {
 	return find_non_finite(feather, single_precision, "", what, size);
 }
+
+int plume_mesh_find_non_finite(const plume_mesh *mesh, const plume_vec3 *positions, bool single_precision)
+{
+	const plume_vec3 *x = positions != NULL ? positions : mesh->rest;
+	for (int i = 0; i < mesh->vertex_count; ++i)
+		if (!vec_fits(x[i], single_precision) || (mesh->uv != NULL && !(number_fits(mesh->uv[i].x, single_precision) &&
+		                                                                number_fits(mesh->uv[i].y, single_precision))))
+			return i;
+	return -1;
+}

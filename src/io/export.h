@@ -13,6 +13,7 @@
 
 #include "../core/atomic_file.h"
 #include "plume/feather.h"
+#include "plume/mesh.h"
 
 /// A text output: an atomic file (temporary file renamed on success) with a
 /// large stdio buffer, written while the calling thread uses the "C" numeric
@@ -73,5 +74,10 @@ void plume_curve_set_count(const plume_feather *feather, plume_curve_set set, in
 /// would print "nan" and "inf", which no OBJ or USD reader takes for a number, and glTF's
 /// bounds would be infinite. Checked before a file is opened: nothing is written.
 bool plume_feather_find_non_finite(const plume_feather *feather, bool single_precision, char *what, size_t size);
+
+/// The same for a mesh's vertices: the first vertex whose position (positions[i], or the
+/// mesh's rest shape when positions is NULL) or texture coordinate no exporter can write,
+/// -1 when there is none.
+int plume_mesh_find_non_finite(const plume_mesh *mesh, const plume_vec3 *positions, bool single_precision);
 
 #endif

@@ -437,8 +437,12 @@ static plume_status check_object(reader *r, json_t *value, const char *what, con
 	const char *key;
 	json_t *member;
 	json_object_foreach (value, key, member) {
-		if (!in_list(key, keys, count))
-			return fail(r, "unknown key \"%s\"", key);
+		if (!in_list(key, keys, count)) {
+			char list[256] = "";
+			for (size_t i = 0; i < count; ++i)
+				snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", i > 0 ? ", " : "", keys[i]);
+			return fail(r, "unknown key \"%.100s\"; the keys here are: %s", key, list);
+		}
 	}
 	for (size_t i = 0; i < count; ++i)
 		if (json_object_get(value, keys[i]) == NULL)

@@ -16,6 +16,7 @@
 // AnimationMixer) play this. The animated mesh has no NORMAL attribute, so
 // clients compute normals from the moving triangles (glTF requires flat normals
 // then; Blender recomputes smooth ones).
+#define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -23,6 +24,7 @@
 #include "../core/asserts.h"
 #include "../core/alloc.h"
 #include "animation.h"
+#include "export.h"
 #include "glb.h"
 #include "plume/gltf.h"
 
@@ -150,6 +152,12 @@ plume_status plume_mesh_write_glb(const plume_mesh *mesh, const plume_vec3 *posi
 {
 	PLUME_ASSERT(mesh != NULL && path != NULL);
 	PLUME_ASSERT_DEF_OR_NULL(def);
+	int bad = plume_mesh_find_non_finite(mesh, positions, true);
+	if (bad >= 0)
+		return plume_error_set(err, PLUME_ERROR_NUMERIC,
+		                       "%s: vertex %d has a NaN or infinite number (or one past single precision, 3.4e38), "
+		                       "which glTF's float accessors cannot hold",
+		                       path, bad + 1);
 	plume_gltf_def defaults = plume_gltf_default_def();
 	if (def == NULL)
 		def = &defaults;

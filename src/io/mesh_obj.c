@@ -68,6 +68,10 @@ static plume_status write_obj(const plume_mesh *mesh, const plume_vec3 *position
 {
 	if (positions == NULL)
 		positions = mesh->rest;
+	int bad = plume_mesh_find_non_finite(mesh, positions, false);
+	if (bad >= 0)
+		return plume_error_set(err, PLUME_ERROR_NUMERIC,
+		                       "%s: vertex %d has a NaN or infinite number, which OBJ cannot hold", path, bad + 1);
 	plume_text_file text;
 	plume_status status = plume_text_open(&text, path, err);
 	if (status != PLUME_OK)

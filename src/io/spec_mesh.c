@@ -8,6 +8,7 @@
 //   "bezier"       one Bézier curve of degree count - 1 with the points as its
 //                  control points, "samples" points in all (64).
 #define _POSIX_C_SOURCE 200809L
+#include <limits.h>
 #include <math.h>
 #include <string.h>
 
@@ -150,6 +151,12 @@ static bool read_spline(plume_spec_reader *reader, const json_t *value, const ch
 		plume_spec_fail(reader, child, "unknown spline type \"%s\"; allowed: polyline, catmull-rom, bezier", type);
 		return false;
 	}
+	if (samples != -1 && polyline) { // it would be ignored: the points are the polyline
+		plume_spec_path(child, sizeof child, path, "samples");
+		plume_spec_fail(reader, child,
+		                "a polyline takes its points as they are; \"samples\" is for catmull-rom and bezier");
+		return false;
+	}
 	if (samples != -1 && (samples < 2 || samples > 10000)) {
 		plume_spec_path(child, sizeof child, path, "samples");
 		plume_spec_fail(reader, child, "is %d, allowed [2, 10000]", samples);
@@ -196,8 +203,66 @@ static bool read_spline(plume_spec_reader *reader, const json_t *value, const ch
 	return ok;
 }
 
+/// The points read_spline samples value into (0 where it will refuse value: a wrong type,
+/// too few points, samples outside [2, 10000]).
+static double spline_sample_count(const json_t *value)
+{
+	if (json_is_array(value))
+		return (double)json_array_size(value);
+	const json_t *points = json_object_get(value, "points"), *type = json_object_get(value, "type"),
+	             *samples = json_object_get(value, "samples");
+	if (!json_is_object(value) || !json_is_array(points) || json_array_size(points) < 2)
+		return 0.0;
+	double n = (double)json_array_size(points), per = -1.0;
+	if (samples != NULL) {
+		if (!json_is_integer(samples) || json_integer_value(samples) < 2 || json_integer_value(samples) > 10000)
+			return 0.0;
+		per = (double)json_integer_value(samples);
+	}
+	const char *name = type == NULL ? "polyline" : json_is_string(type) ? json_string_value(type) : "";
+	if (strcmp(name, "catmull-rom") == 0)
+		return (n - 1.0) * (per > 0.0 ? per : 16.0) + 1.0;
+	if (strcmp(name, "bezier") == 0)
+		return per > 0.0 ? per : 64.0;
+	return strcmp(name, "polyline") == 0 ? n : 0.0;
+}
+
+/// Refuses splines whose samples would pass max_memory (0: PLUME_DEFAULT_MAX_MEMORY) at
+/// PLUME_MESH_BYTES_PER_GUIDE_POINT each, or an int's count, before any is sampled: a few
+/// kilobytes of JSON ("samples": 10000 on long point lists) sampled into gigabytes. Names the
+/// spline at which the running count passes the limit (PLUME_ERROR_LIMIT).
+static bool check_sample_counts(plume_spec_reader *reader, const json_t *object, const char *path, uint64_t max_memory)
+{
+	double limit = (double)(max_memory > 0 ? max_memory : PLUME_DEFAULT_MAX_MEMORY), total = 0.0;
+	const json_t *guides = json_object_get(object, "guides");
+	size_t count = json_is_array(guides) ? json_array_size(guides) : 0;
+	for (size_t i = 0; i <= count; ++i) {
+		const json_t *spline = i == 0 ? json_object_get(object, "rachis") : json_array_get(guides, i - 1);
+		total += spline_sample_count(spline);
+		double bytes = total * PLUME_MESH_BYTES_PER_GUIDE_POINT;
+		if (bytes <= limit && total <= INT_MAX / 2)
+			continue;
+		char list[520], child[560];
+		plume_spec_path(list, sizeof list, path, i == 0 ? "rachis" : "guides");
+		if (i > 0)
+			plume_spec_index_path(child, sizeof child, list, i - 1);
+		else
+			snprintf(child, sizeof child, "%s", list);
+		plume_spec_fail(reader, child,
+		                "the splines up to here sample into %.0f points, about %.3g GB at %d B a point; the limit is "
+		                "%.3g GB%s (fewer \"samples\" or points, or raise --max-memory)",
+		                total, bytes / 1e9, PLUME_MESH_BYTES_PER_GUIDE_POINT, limit / 1e9,
+		                total > INT_MAX / 2 ? " and 1073741823 points" : "");
+		reader->status = PLUME_ERROR_LIMIT;
+		if (reader->err != NULL)
+			reader->err->status = PLUME_ERROR_LIMIT;
+		return false;
+	}
+	return true;
+}
+
 plume_status plume_spec_mesh_guides(plume_spec_reader *reader, const json_t *object, const char *path,
-                                    plume_mesh_guides_storage *storage)
+                                    uint64_t max_memory, plume_mesh_guides_storage *storage)
 {
 	memset(storage, 0, sizeof *storage);
 	char child[512];
@@ -207,6 +272,8 @@ plume_status plume_spec_mesh_guides(plume_spec_reader *reader, const json_t *obj
 	for (int i = 0; i < 3 && reader->status == PLUME_OK; ++i)
 		if (json_object_get(object, required[i]) == NULL)
 			plume_spec_fail(reader, path, "a guides spec needs \"%s\"", required[i]);
+	if (reader->status == PLUME_OK)
+		check_sample_counts(reader, object, path, max_memory);
 	if (reader->status == PLUME_OK) {
 		plume_spec_path(child, sizeof child, path, "boundary");
 		read_points(reader, json_object_get(object, "boundary"), child, 3, &boundary);
@@ -285,7 +352,7 @@ plume_status plume_mesh_spec_read(const char *path, const plume_mesh_spec_option
 			plume_spec_mesh_def(&reader, mesh, "$.mesh", &def);
 		plume_mesh_guides_storage storage = {0};
 		if (reader.status == PLUME_OK)
-			plume_spec_mesh_guides(&reader, root, "$", &storage);
+			plume_spec_mesh_guides(&reader, root, "$", def.max_memory, &storage);
 		status = reader.status;
 		if (status == PLUME_OK) {
 			if (options->edge_length > 0.0)

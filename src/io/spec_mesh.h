@@ -23,10 +23,17 @@ typedef struct plume_mesh_guides_storage {
 /// Reads "boundary" (array of [x, y]), "rachis" (a spline) and "guides" (array
 /// of splines) of object. A spline is an array of points (a polyline) or an
 /// object {"type": "polyline" | "catmull-rom" | "bezier", "points": [...],
-/// "samples": n}. Other keys of object are the caller's to check. On failure
-/// storage is empty and the reader holds the error.
+/// "samples": n}. Other keys of object are the caller's to check. Splines that
+/// would sample into more than max_memory bytes (0: PLUME_DEFAULT_MAX_MEMORY) at
+/// PLUME_MESH_BYTES_PER_GUIDE_POINT a point are refused before any is sampled
+/// (PLUME_ERROR_LIMIT). On failure storage is empty and the reader holds the error.
 plume_status plume_spec_mesh_guides(plume_spec_reader *reader, const json_t *object, const char *path,
-                                    plume_mesh_guides_storage *storage);
+                                    uint64_t max_memory, plume_mesh_guides_storage *storage);
+
+/// Bytes a sampled guide point takes while read and meshed: 16 in the list, up to twice
+/// that while it grows, and 24 in the mesher's copy (measured about 40: 16 million points,
+/// 635 MB).
+#define PLUME_MESH_BYTES_PER_GUIDE_POINT 64
 
 void plume_mesh_guides_storage_free(plume_mesh_guides_storage *storage);
 

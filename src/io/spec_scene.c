@@ -1174,7 +1174,7 @@ static plume_status build_mesh(const char *file, const json_t *root, const plume
 		}
 	} else {
 		plume_mesh_guides_storage storage;
-		status = plume_spec_mesh_guides(&reader, guides, "$.guides", &storage);
+		status = plume_spec_mesh_guides(&reader, guides, "$.guides", mesh_def.max_memory, &storage);
 		if (status == PLUME_OK) {
 			status = plume_mesh_from_guides(&storage.guides, &mesh_def, &scene->mesh, &scene->mesh_report, err);
 			if (status != PLUME_OK)

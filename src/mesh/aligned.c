@@ -1320,12 +1320,14 @@ static bool crosses_nearby(const mesher *m, int side, int r, plume_vec3 p, plume
 }
 
 /// True when the closing edge of a strip of line l (from one guide's last vertex
-/// to the other's) crosses a guide of the rows near either guide.
+/// to the other's) crosses a guide of the rows near either guide. Strips of a
+/// guide left out (drop_short_end_guides: no vertices) are gone, as in
+/// walk_line_strips: their last vertex was read before the guide's first.
 static bool closing_edges_cross(const mesher *m, int l)
 {
 	for (int s = 0; s < m->strip_count; ++s) {
 		const mesh_strip *strip = m->strip_list + s;
-		if (strip->a != l && strip->b != l)
+		if ((strip->a != l && strip->b != l) || !m->lines[strip->a].present || !m->lines[strip->b].present)
 			continue;
 		strip_view view = view_strip(m, strip);
 		plume_vec3 p = view.A[view.ma], q = view.B[view.nb];
@@ -2111,6 +2113,14 @@ static plume_status build_mesh(mesher *m, int vane_faces, plume_mesh **out, plum
 			                       m->e, extent, in->guide_count[0], in->guide_count[1],
 			                       floor(0.25 * extent / unit) * unit);
 		}
+		if (in->boundary != NULL) // explicit guides start where the band ends and end at the boundary
+			return plume_error_set(m->err, PLUME_ERROR_SPEC,
+			                       "no vane to mesh: %d usable barb guides on the left, %d on the right (%d input "
+			                       "guides left out), and no guide vertex beside the rachis band inside the boundary "
+			                       "polygon; the boundary must enclose the rachis and reach past the band (%g m wide "
+			                       "at the base, rachis_width_base, and %g m at the tip, rachis_width_tip)",
+			                       in->guide_count[0], in->guide_count[1], in->guides_dropped, in->rachis.width[0],
+			                       in->rachis.width[in->rachis.count - 1]);
 		return plume_error_set(m->err, PLUME_ERROR_SPEC,
 		                       "no vane to mesh: %d usable barb guides on the left, %d on the right (%d input barbs "
 		                       "left out); the feather needs barbs with a length in the feather plane",
@@ -2150,6 +2160,24 @@ static plume_status build_mesh(mesher *m, int vane_faces, plume_mesh **out, plum
 		(void)ok;
 	}
 	assert(status != PLUME_OK || emitted.faces == face_count);
+	// Every vertex must belong to a face: one outside them has no mass in the simulator. Two
+	// short guides joined from both sides to one vertex of a guide between them close both of
+	// its strips there, and its vertices past it belonged to none; such a build fails (the
+	// joined one is then dropped for the unjoined, a try passed over).
+	if (status == PLUME_OK) {
+		bool *used = plume_calloc((size_t)vertex_count, sizeof *used);
+		if (used == NULL)
+			status = plume_error_set(m->err, PLUME_ERROR_MEMORY, "out of memory checking the mesh");
+		for (int i = 0; used != NULL && i < 3 * face_count; ++i)
+			used[mesh->faces[i]] = true;
+		for (int v = 0; used != NULL && v < vertex_count && status == PLUME_OK; ++v)
+			if (!used[v])
+				status = plume_error_set(m->err, PLUME_ERROR_NUMERIC,
+				                         "vertex %d at (%g, %g) m belongs to no face at edge length %g m; try "
+				                         "another edge length",
+				                         v, mesh->reference[v].x, mesh->reference[v].y, m->e);
+		plume_free(used);
+	}
 	// The walk's positions are kept until the slid ones pass the overlap check.
 	size_t n = (size_t)mesh->vertex_count, f = (size_t)mesh->face_count;
 	plume_vec2 *kept_reference = NULL, *kept_uv = NULL;
@@ -2419,10 +2447,28 @@ static plume_status mesh_run(const mesh_input *input, const plume_mesh_def *def,
 	                                        {0.0, 0.4, false},  {32.0, 0.15, true}};
 	const double bound = PLUME_MESH_QUALITY_ANGLE_DEG * pi / 180.0;
 	plume_mesh_report best, tried;
+	const size_t variant_count = sizeof variants / sizeof variants[0];
 	plume_status status = mesh_try(input, def, (mesh_variant){0.0, 0.0, false}, out, &best, err);
+	// A first try whose faces overlap is passed over like the others: the first later try that
+	// succeeds takes its place (the Franco-Walter hawk at e = 0.6 mm folds at the rachis unthinned
+	// and meshes thinned), and the error stands when none does.
+	size_t i = 0;
+	while (status == PLUME_ERROR_NUMERIC && i < variant_count) {
+		plume_error scratch = {0};
+		plume_status tried_status = mesh_try(input, def, variants[i++], out, &best, &scratch);
+		if (tried_status == PLUME_ERROR_MEMORY)
+			return plume_error_set(err, PLUME_ERROR_MEMORY, "%s", scratch.message);
+		if (tried_status == PLUME_OK) {
+			status = PLUME_OK;
+			if (err != NULL)
+				*err = (plume_error){0};
+		} else {
+			plume_mesh_destroy(*out);
+			*out = NULL;
+		}
+	}
 	double first_area = status == PLUME_OK ? vane_area(*out) : 0.0;
-	for (size_t i = 0; status == PLUME_OK && best.vane_min_angle < bound && i < sizeof variants / sizeof variants[0];
-	     ++i) {
+	for (; status == PLUME_OK && best.vane_min_angle < bound && i < variant_count; ++i) {
 		plume_mesh *candidate = NULL;
 		plume_error scratch = {0};
 		plume_status tried_status = mesh_try(input, def, variants[i], &candidate, &tried, &scratch);

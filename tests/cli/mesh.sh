@@ -42,6 +42,80 @@ assert h['excepted_count'] < h['vane_face_count'] and 20 <= h['vane_min_angle_de
 check "guides: exit 0" test $? -eq 0
 check "guides: aligned fraction 1" grep -q '"aligned_fraction": 1,' "$scratch/guides/report.json"
 
+# Guides whose first try folds (overlapping faces) are meshed by a later try: three guides at e =
+# 15 mm (the hawk at e = 0.6 mm the same) failed with exit 1, "the barb guides fold over one another",
+# though the tries after the first, which pass over a try that folds, mesh them.
+cat >"$scratch/folds.json" <<'EOF'
+{"mesh": {"edge_length": 0.015, "rachis_width_base": 0.00229, "rachis_width_tip": 0.00445},
+ "boundary": [[0.0438, 0.15], [0.0249, 0.293], [-0.0267, 0.303], [-0.0412, 0.15], [-0.0259, 0.00118], [0.0177, 0.0483]],
+ "rachis": {"type": "catmull-rom", "points": [[0.0, 0.0], [-0.00737, 0.075], [-0.0104, 0.15], [-0.00737, 0.225], [0.0, 0.3]]},
+ "guides": [{"type": "catmull-rom", "points": [[-0.00873, 0.205], [-0.0211, 0.225]]},
+            {"type": "catmull-rom", "points": [[-0.0104, 0.149], [-0.0191, 0.156], [-0.0257, 0.164]]},
+            {"type": "bezier", "points": [[-0.0018, 0.0166], [0.00054, 0.0266], [0.00221, 0.0369]]}]}
+EOF
+"$plume" mesh "$scratch/folds.json" -o "$scratch/folds" 2>"$scratch/err.txt"
+succeeded "guides whose first try folds: a later try meshes them"
+check "guides whose first try folds: a vane, every face aligned" python3 -c "
+import json
+r = json.load(open('$scratch/folds/report.json'))
+assert r['vane_face_count'] > 0 and r['aligned_fraction'] == 1, r
+"
+
+# A boundary that leaves no guide beside the band is named as the cause (it read "the feather
+# needs barbs with a length in the feather plane", a feather's cause, for explicit guides).
+python3 -c "
+import json
+d = json.load(open('$source_dir/examples/meshes/guides.json'))
+d['boundary'] = [[1.0, 1.0], [1.1, 1.0], [1.1, 1.1]]
+json.dump(d, open('$scratch/far.json', 'w'))"
+expect_no_output "a boundary away from the rachis" 3 \
+	"far.json: no vane to mesh: 4 usable barb guides on the left, 4 on the right (0 input guides left out), and no guide vertex beside the rachis band inside the boundary polygon; the boundary must enclose the rachis and reach past the band (0.0025 m wide at the base, rachis_width_base, and 0.0008 m at the tip, rachis_width_tip)" \
+	"$scratch/far" "$plume" mesh "$scratch/far.json" -o "$scratch/far"
+
+# A picture smaller than its 20-pixel margins: the margins shrink to a quarter of it, and the mesh
+# fills it the right way up (at --size 32x32 the scale was negative: rows 1 to 20, turned half a turn).
+"$plume" mesh "$source_dir/examples/meshes/guides.json" -o "$scratch/thumb" --format png --size 32x32 2>"$scratch/err.txt"
+succeeded "a 32x32 picture"
+check "a 32x32 picture: the mesh between the margins, its height filling them" python3 -c "
+# The PNG decoded (8-bit RGB, the five filters): the bounds of what is drawn.
+import struct, zlib
+data = open('$scratch/thumb/mesh.png', 'rb').read()
+at, idat = 8, b''
+while at < len(data):
+    length, kind = struct.unpack('>I4s', data[at:at + 8])
+    if kind == b'IHDR':
+        width, height, depth, colour = struct.unpack('>IIBB', data[at + 8:at + 18])
+    elif kind == b'IDAT':
+        idat += data[at + 8:at + 8 + length]
+    at += 12 + length
+assert depth == 8 and colour in (2, 6), (depth, colour)
+step = 3 if colour == 2 else 4
+raw, rows, previous, drawn = zlib.decompress(idat), [], bytearray(width * step), []
+for y in range(height):
+    kind, line = raw[y * (width * step + 1)], bytearray(raw[y * (width * step + 1) + 1:(y + 1) * (width * step + 1)])
+    for i in range(len(line)):
+        a = line[i - step] if i >= step else 0
+        b, c = previous[i], previous[i - step] if i >= step else 0
+        p = a + b - c
+        predictor = [0, a, b, (a + b) // 2, a if abs(p - a) <= abs(p - b) and abs(p - a) <= abs(p - c) else b if abs(p - b) <= abs(p - c) else c][kind]
+        line[i] = (line[i] + predictor) & 255
+    previous = line
+    drawn += [(y, x) for x in range(width) if min(line[x * step:x * step + 3]) < 250]
+rows, columns = [y for y, x in drawn], [x for y, x in drawn]
+assert 6 <= min(rows) and max(rows) <= 25 and max(rows) - min(rows) >= 14, (min(rows), max(rows))
+assert 6 <= min(columns) and max(columns) <= 25, (min(columns), max(columns))
+"
+
+# "samples" on a polyline did nothing (its points are the polyline): refused, naming the key.
+python3 -c "
+import json
+d = json.load(open('$source_dir/examples/meshes/guides.json'))
+d['guides'][6] = {'type': 'polyline', 'samples': 500, 'points': d['guides'][6]}
+json.dump(d, open('$scratch/polyline.json', 'w'))"
+expect_no_output "samples on a polyline" 3 \
+	"polyline.json: \$.guides[6].samples: a polyline takes its points as they are; \"samples\" is for catmull-rom and bezier" \
+	"$scratch/polyline" "$plume" mesh "$scratch/polyline.json" -o "$scratch/polyline"
+
 # Without --size mesh.png is 1200 tall and as wide as the mesh, at most 16384 (--size's bound). A flat
 # mesh (guides 0.1 m long, 1e-8 m apart) is 16384 wide: its width, 1.2e10 pixels, was cast to an int.
 cat >"$scratch/flat.json" <<'EOF'
@@ -67,12 +141,37 @@ check "edge length 1e-300: a short message" test "$(wc -c <"$scratch/err.txt")" 
 # Small enough to need 26.9 GB: the memory estimate refuses it (exit 5).
 expect_no_output "edge length 1e-5" 5 "the limit is" "$scratch/tiny" \
 	"$plume" mesh "$source_dir/examples/franco-walter/hawk.json" -o "$scratch/tiny" --edge-length 1e-5
+# Splines sampled past --max-memory are refused before they are sampled (exit 5, naming the spline):
+# 10 KB of JSON, a guide of 500 points at 10000 samples a span, took 5 million points (200 MB).
+python3 -c "
+import json
+d = json.load(open('$source_dir/examples/meshes/guides.json'))
+d['guides'][1] = {'type': 'catmull-rom', 'samples': 10000,
+                  'points': [[0.001 - 0.027 * i / 499, 0.045 + 0.03 * i / 499] for i in range(500)]}
+json.dump(d, open('$scratch/samples.json', 'w'))"
+expect_no_output "guides sampled past --max-memory" 5 \
+	"samples.json: \$.guides[1]: the splines up to here sample into 4990114 points, about 0.319 GB at 64 B a point; the limit is 0.105 GB" \
+	"$scratch/heavy" "$plume" mesh "$scratch/samples.json" -o "$scratch/heavy" --max-memory 100M
+# The outputs are held to --max-memory too: a 16384x16384 mesh.png is a 1 GiB surface (it was
+# drawn at --max-memory 100M, 1 GB of RSS); without png the same --size is nothing to write.
+expect_no_output "a picture past --max-memory" 5 \
+	"guides.json: writing png, obj (--format, --size) takes up to 1.07 GB besides the mesh's" \
+	"$scratch/huge" "$plume" mesh "$source_dir/examples/meshes/guides.json" -o "$scratch/huge" \
+	--size 16384x16384 --max-memory 100M
+"$plume" mesh "$source_dir/examples/meshes/guides.json" -o "$scratch/huge" --format obj --size 16384x16384 \
+	--max-memory 100M 2>"$scratch/err.txt"
+succeeded "--size without png: nothing past --max-memory"
 # --format lists what a mesh is written as, not a feather's formats.
 expect_failure "format foo" 2 "unknown format 'foo' in --format: a mesh writes obj, png, glb" \
 	"$plume" mesh "$source_dir/examples/meshes/guides.json" -o "$scratch/bad" --format foo
 check "format foo: no svg offered" bash -c "! grep -q svg '$scratch/err.txt'"
 expect_failure "format svg" 2 "unknown format 'svg' in --format: a mesh writes obj, png, glb" \
 	"$plume" mesh "$source_dir/examples/meshes/guides.json" -o "$scratch/bad" --format png,svg
+# An empty item is refused wherever it is ('obj,' was taken as obj; generate's list refused it).
+for list in obj, ,obj obj,,png; do
+	expect_failure "format '$list'" 2 "--format '$list' has an empty item; a mesh writes obj, png, glb" \
+		"$plume" mesh "$source_dir/examples/meshes/guides.json" -o "$scratch/bad" --format "$list"
+done
 check "bad formats: nothing written" test ! -e "$scratch/bad"
 "$plume" mesh "$source_dir/examples/meshes/guides.json" -o "$scratch/glb" --format glb,obj 2>"$scratch/err.txt"
 succeeded "format glb,obj"

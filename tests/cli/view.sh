@@ -83,6 +83,11 @@ head -c 500 "$in/a.glb" >"$scratch/fake/cut.glb"
 rm "$scratch/fake/fake.glb"
 expect_no_output "a .glb cut short" 3 "cut.glb: its GLB header gives 1001 bytes, but the file has 500" \
 	"$scratch/fake/view" "$plume" view "$scratch/fake/cut.glb" --viewer "$viewer"
+# A folder of more than 24 .glb files: refused (exit 4) with a pointer to giving one file.
+mkdir -p "$scratch/many"
+for i in $(seq 25); do cp "$in/a.glb" "$scratch/many/m$i.glb"; done
+expect_no_output "25 .glb files in a folder" 4 "more than 24 .glb files; give one file as INPUT" \
+	"$scratch/many/view" "$plume" view "$scratch/many" --viewer "$viewer"
 expect_no_output "viewer not built" 4 "no built viewer there" "$scratch/v2" \
 	env PLUME_VIEWER_DIR="$scratch/empty" "$plume" view "$in" -o "$scratch/v2"
 expect_no_output "--serve not a port" 2 "--serve '99999' must be a port number" "$scratch/v3" \
