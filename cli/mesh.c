@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "plume/lab.h"
 
 // Also declared in cli.h beside the other commands.
 int cli_mesh(int argc, char **argv);
@@ -227,9 +228,11 @@ static plume_status write_report(const plume_mesh *mesh, const plume_mesh_report
 	if (measured_faces > 0)
 		snprintf(vane_min_angle, sizeof vane_min_angle, "%.6f",
 		         report->vane_min_angle * 180.0 / 3.14159265358979323846);
+	char edge_length[PLUME_LAB_NUMBER_TEXT]; // 0.004, not %.17g's 0.0040000000000000001
+	plume_lab_format_number(edge_length, sizeof edge_length, report->edge_length);
 	fprintf(stream,
 	        "{\n"
-	        "  \"edge_length\": %.17g,\n"
+	        "  \"edge_length\": %s,\n"
 	        "  \"vertex_count\": %d,\n"
 	        "  \"face_count\": %d,\n"
 	        "  \"rachis_face_count\": %d,\n"
@@ -244,7 +247,7 @@ static plume_status write_report(const plume_mesh *mesh, const plume_mesh_report
 	        "  \"vertices_trimmed\": %d,\n"
 	        "  \"guide_count\": [%d, %d],\n"
 	        "  \"groups\": {",
-	        report->edge_length, mesh->vertex_count, mesh->face_count, rachis_faces, mesh->face_count - rachis_faces,
+	        edge_length, mesh->vertex_count, mesh->face_count, rachis_faces, mesh->face_count - rachis_faces,
 	        mesh->barb_edge_count, report->min_angle * 180.0 / 3.14159265358979323846, vane_min_angle,
 	        report->excepted_count, report->aligned_fraction, report->guides_dropped, report->barbs_averaged,
 	        report->vertices_trimmed, report->guide_count[0], report->guide_count[1]);

@@ -22,7 +22,7 @@ check "fine: exit 0" test $? -eq 0
 coarse=$(grep -c '^v ' "$scratch/hawk/mesh.obj")
 fine=$(grep -c '^v ' "$scratch/fine/mesh.obj")
 check "fine: more vertices ($fine > 2 x $coarse)" test "$fine" -gt $((2 * coarse))
-check "fine: edge length in report" grep -q '"edge_length": 0.0025' "$scratch/fine/report.json"
+check "fine: edge length in report, shortest form" grep -q '"edge_length": 0.0025,' "$scratch/fine/report.json"
 
 # Every vane face a junction face (the filoplume at 5 mm): no angle to report, null (it read
 # 180, the pi the library holds then); a hawk's vane has one.
