@@ -668,6 +668,21 @@ static void test_runaway_growth_is_a_spec_error(void **state)
 	def.barb_count = 1;
 	def.barb_speed = plume_zk_constant(1e-8);
 	expect_invalid(&def, "a barb needs more than 2000000 steps of $.step (0.02 s)");
+	// Each bound above is an item's; their product is not: a fuzzed spec (a 9 m collar, an emitter
+	// at 800 m/s on part of it) emitted 86,000 barbs of pathlines 10^4 steps long, 21 s. The steps
+	// of all pathlines are bounded too (4e7; the benchmark feather takes 5.6e4).
+	def = plume_zk_default_def();
+	def.collar_radius = 9.01;
+	def.anterior[0] = 0.98, def.anterior[1] = 0.02;
+	def.posterior[0] = 0.51, def.posterior[1] = 0.49;
+	def.ridge_width = 0.0008;
+	def.emitter_speed =
+	    (plume_zk_curve){.count = 5, .s = {0.0, 0.25, 0.5, 0.75, 1.0}, .value = {0.012, 800.0, 0.004, 0.008, 0.012}};
+	def.barb_speed = plume_zk_constant(0.008);
+	def.growth_speed = 0.005;
+	def.barb_count = 115;
+	def.downsample = 4;
+	expect_invalid(&def, "the growth is too long: its pathlines need more than 4e+07 steps of $.step (0.02 s) in all");
 	// Finite times near 1e299 (V_e about 1e-300 at I_P, reached in one huge step) whose heights
 	// v_grow (t_curr - t) overflow: refused, not built with inf vertices.
 	def = plume_zk_default_def();

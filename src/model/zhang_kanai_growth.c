@@ -25,6 +25,12 @@
 
 /// Upper bounds that turn a runaway spec into an error instead of a hang.
 enum { MAX_STEPS_PER_PATH = 2000000, MAX_EMISSIONS_PER_VANE = 200000 };
+/// The bound on the steps of all pathlines of one growth, both vanes. The bounds above are
+/// each item's: 86,000 emissions of pathlines 10^4 steps long passed neither and took 21 s
+/// (a fuzzed spec: a 9 m collar, an emitter at 800 m/s on part of it). Measured: the 2 x
+/// 400-barb benchmark feather takes 5.6e4 (bench_zhang_kanai), the examples 1.4e3 to 7.8e3;
+/// 4e7 take about 0.3 s.
+#define MAX_GROWTH_PATHLINE_STEPS 4e7
 /// An emitter may take this many steps: it crosses the whole I_A-I_P path once, where a pathline crosses part.
 #define MAX_EMITTER_STEPS (8L * MAX_STEPS_PER_PATH)
 
@@ -33,6 +39,7 @@ typedef enum zk_runaway {
 	RUNAWAY_PATHLINE,  ///< a barb needs more than MAX_STEPS_PER_PATH steps to reach I_A
 	RUNAWAY_EMISSIONS, ///< a vane emits more than MAX_EMISSIONS_PER_VANE barbs before barb N - 1 matures
 	RUNAWAY_EMITTER,   ///< an emitter needs more than MAX_EMITTER_STEPS steps to its next emission
+	RUNAWAY_WORK,      ///< the pathlines together need more than MAX_GROWTH_PATHLINE_STEPS steps
 } zk_runaway;
 
 typedef struct zk_flow {
@@ -83,6 +90,7 @@ typedef struct zk_vane {
 	int f;
 	double ridge_width, variation;
 	plume_rng rng;
+	double *pathline_steps; ///< the steps of every pathline integrated so far, both vanes'
 } zk_vane;
 
 /// Where a pathline ends: K whole steps, then a last part of length tail.
@@ -154,6 +162,10 @@ static plume_status pathline(const zk_vane *vane, double s0, double t0, double t
 	for (long k = 0;; ++k) {
 		if (k >= MAX_STEPS_PER_PATH)
 			return PLUME_ERROR_NUMERIC;
+		if (*vane->pathline_steps + (double)k >= MAX_GROWTH_PATHLINE_STEPS) {
+			*vane->pathline_steps += (double)k; // fail_runaway reads which bound it was
+			return PLUME_ERROR_NUMERIC;
+		}
 		double tk = t0 + (double)k * h;
 		double step = h;
 		bool last = false;
@@ -170,6 +182,7 @@ static plume_status pathline(const zk_vane *vane, double s0, double t0, double t
 			int at = (tail <= 1e-9 * h && kept == k && count > 1) ? count - 1 : count;
 			keep_point(points, at, reached ? target : next, reached ? tk + tail : t_stop);
 			*end = (path_end){.steps = k, .tail = tail, .reached = reached, .count = at + 1};
+			*vane->pathline_steps += (double)k + 1.0;
 			return PLUME_OK;
 		}
 		s = next;
@@ -436,7 +449,15 @@ static plume_status fail_runaway(plume_status status, const vane_run *runs, plum
 	int side = runs[PLUME_SIDE_LEFT].runaway != RUNAWAY_PATHLINE ? PLUME_SIDE_LEFT : PLUME_SIDE_RIGHT;
 	const vane_run *run = runs + side;
 	const char *name = side == PLUME_SIDE_LEFT ? "left" : "right";
-	switch (run->runaway) {
+	zk_runaway runaway = *run->vane.pathline_steps >= MAX_GROWTH_PATHLINE_STEPS ? RUNAWAY_WORK : run->runaway;
+	switch (runaway) {
+	case RUNAWAY_WORK:
+		return plume_error_set(err, PLUME_ERROR_SPEC,
+		                       "the growth is too long: its pathlines need more than %g steps of $.step (%g s) in "
+		                       "all (%d barbs emitted on the left vane, %d on the right, of a %g m collar); raise "
+		                       "$.step, $.barb_speed or $.ridge_width, or lower $.emitter_speed or $.collar.radius",
+		                       MAX_GROWTH_PATHLINE_STEPS, run->vane.h, runs[PLUME_SIDE_LEFT].count,
+		                       runs[PLUME_SIDE_RIGHT].count, run->vane.length);
 	case RUNAWAY_EMITTER:
 		return plume_error_set(
 		    err, PLUME_ERROR_SPEC,
@@ -470,6 +491,8 @@ plume_status zk_grow(const plume_zk_def *def, const zk_collar *collar, uint64_t 
 	vane_run runs[2];
 	vane_setup(runs + PLUME_SIDE_LEFT, def, collar, &ve, &vb, PLUME_SIDE_LEFT, plume_rng_split(&rng));
 	vane_setup(runs + PLUME_SIDE_RIGHT, def, collar, &ve, &vb, PLUME_SIDE_RIGHT, plume_rng_split(&rng));
+	double pathline_steps = 0;
+	runs[PLUME_SIDE_LEFT].vane.pathline_steps = runs[PLUME_SIDE_RIGHT].vane.pathline_steps = &pathline_steps;
 
 	// Barb i leaves the ridge after the emitter moved (i + 1) d: a ridge wider
 	// than the emitter's whole path from I_A to I_P emits every barb at the
