@@ -88,6 +88,13 @@ typedef struct cli_image_options {
 	const plume_texture *texture; ///< NULL: the line style
 } cli_image_options;
 
+/// PLUME_ERROR_LIMIT when what the library holds now (the input, named held_name: "feather")
+/// and the largest output's bytes pass max_memory (0: the default), checked before any file is
+/// written: "SPEC: writing FORMATS (--format OPTIONS) takes up to ...". options: the other flags
+/// that size the outputs, each after ", " (", --size 800x600"), or "".
+plume_status cli_check_output_memory(const char *spec, const char *held_name, unsigned formats, const char *options,
+                                     double outputs, uint64_t max_memory, plume_error *err);
+
 /// Makes the missing parent folders of path (mkdir -p of its parent): 0, or the errno of the
 /// folder that could not be made (*made then its path's length, and none left made). *made:
 /// the length of the path of the topmost folder made, 0 when every one existed.

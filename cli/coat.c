@@ -142,25 +142,6 @@ static double output_bytes(const plume_coat *coat, unsigned formats, const plume
 	return most;
 }
 
-/// PLUME_ERROR_LIMIT when the coat (what the library holds now) and its largest output pass the limit.
-static plume_status check_outputs(const char *spec, const plume_coat *coat, unsigned formats,
-                                  const plume_render2d_def *image, uint64_t max_memory, plume_error *err)
-{
-	double limit = (double)(max_memory > 0 ? max_memory : PLUME_DEFAULT_MAX_MEMORY);
-	double held = (double)plume_bytes_in_use(), outputs = output_bytes(coat, formats, image);
-	if (held + outputs <= limit)
-		return PLUME_OK;
-	char names[64];
-	cli_format_list(formats, names, sizeof names);
-	return plume_error_set(err, PLUME_ERROR_LIMIT,
-	                       "%s: writing %s (--format, --size %dx%d%s) takes up to %.3g GB besides the coat's %.3g GB: "
-	                       "%.3g GB in all; the limit is %.3g GB (raise it with --max-memory, or write fewer or "
-	                       "smaller formats)",
-	                       spec, names, image->width, image->height,
-	                       image->style == PLUME_STYLE_STRIPS ? ", --style strips" : "", outputs / 1e9, held / 1e9,
-	                       (held + outputs) / 1e9, limit / 1e9);
-}
-
 /// The picture shows the feathers whose follicle faces +z (plume_coat_render2d): says so when none does.
 static void warn_hidden(const plume_coat *coat)
 {
@@ -282,8 +263,13 @@ int cli_coat(int argc, char **argv)
 	spec_options.progress_user = &progress;
 	plume_status status = plume_coat_spec_generate(argv[optind], &spec_options, &coat, &err);
 	cli_progress_end(&progress);
-	if (status == PLUME_OK)
-		status = check_outputs(argv[optind], coat, formats, &image, spec_options.max_memory, &err);
+	if (status == PLUME_OK) {
+		char sizing[64];
+		snprintf(sizing, sizeof sizing, ", --size %dx%d%s", image.width, image.height,
+		         image.style == PLUME_STYLE_STRIPS ? ", --style strips" : "");
+		status = cli_check_output_memory(argv[optind], "coat", formats, sizing, output_bytes(coat, formats, &image),
+		                                 spec_options.max_memory, &err);
+	}
 	if (status == PLUME_OK && (formats & (CLI_FORMAT_PNG | CLI_FORMAT_SVG | CLI_FORMAT_PDF)) != 0)
 		warn_hidden(coat);
 	if (status == PLUME_OK && (status = cli_output_begin(&output, output_dir, &err)) == PLUME_OK) {

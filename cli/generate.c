@@ -84,23 +84,6 @@ static double output_bytes(const plume_feather *feather, unsigned formats, const
 	return most;
 }
 
-/// PLUME_ERROR_LIMIT when the feather (what the library holds now) and its largest output pass the limit.
-static plume_status check_outputs(const char *spec, const plume_feather *feather, unsigned formats,
-                                  const cli_image_options *images, uint64_t max_memory, plume_error *err)
-{
-	double limit = (double)(max_memory > 0 ? max_memory : PLUME_DEFAULT_MAX_MEMORY);
-	double held = (double)plume_bytes_in_use(), outputs = output_bytes(feather, formats, images);
-	if (held + outputs <= limit)
-		return PLUME_OK;
-	char list[64];
-	cli_format_list(formats, list, sizeof list);
-	return plume_error_set(err, PLUME_ERROR_LIMIT,
-	                       "%s: writing %s (--format%s) takes up to %.3g GB besides the feather's %.3g GB: %.3g GB in "
-	                       "all; the limit is %.3g GB (raise it with --max-memory, or write fewer or smaller formats)",
-	                       spec, list, images->texture != NULL ? ", --texture" : "", outputs / 1e9, held / 1e9,
-	                       (held + outputs) / 1e9, limit / 1e9);
-}
-
 void cli_help_generate(void)
 {
 	puts("Usage: plume generate SPEC.json -o DIR [options]\n"
@@ -180,7 +163,8 @@ int cli_generate(int argc, char **argv)
 	cli_output output;
 	plume_status status = plume_spec_generate(argv[optind], &spec_options, &feather, &err);
 	if (status == PLUME_OK)
-		status = check_outputs(argv[optind], feather, formats, &images, spec_options.max_memory, &err);
+		status = cli_check_output_memory(argv[optind], "feather", formats, images.texture != NULL ? ", --texture" : "",
+		                                 output_bytes(feather, formats, &images), spec_options.max_memory, &err);
 	if (status == PLUME_OK && (status = cli_output_begin(&output, output_dir, &err)) == PLUME_OK) {
 		status = cli_write_feather(&output, feather, "feather", formats, &images, &err);
 		if (status == PLUME_OK)

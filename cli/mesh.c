@@ -318,18 +318,9 @@ int cli_mesh(int argc, char **argv)
 	if (status == PLUME_OK) {
 		// The outputs are held to --max-memory as well, before any is written (a --size of
 		// 16384x16384 is a 1 GiB picture), with the mesh the library holds.
-		double limit = (double)(spec_options.max_memory > 0 ? spec_options.max_memory : PLUME_DEFAULT_MAX_MEMORY);
-		double held = (double)plume_bytes_in_use(), outputs = output_bytes(mesh, formats, width, height);
-		if (!(held + outputs <= limit)) {
-			char list[64];
-			cli_format_list(formats, list, sizeof list);
-			status = plume_error_set(&err, PLUME_ERROR_LIMIT,
-			                         "%s: writing %s (--format%s) takes up to %.3g GB besides the mesh's %.3g GB: %.3g "
-			                         "GB in all; the limit is %.3g GB (raise it with --max-memory, or write fewer or "
-			                         "smaller formats)",
-			                         argv[optind], list, (formats & CLI_FORMAT_PNG) != 0 ? ", --size" : "",
-			                         outputs / 1e9, held / 1e9, (held + outputs) / 1e9, limit / 1e9);
-		}
+		status =
+		    cli_check_output_memory(argv[optind], "mesh", formats, (formats & CLI_FORMAT_PNG) != 0 ? ", --size" : "",
+		                            output_bytes(mesh, formats, width, height), spec_options.max_memory, &err);
 	}
 	cli_output output;
 	if (status == PLUME_OK && (status = cli_output_begin(&output, output_dir, &err)) == PLUME_OK) {

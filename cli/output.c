@@ -530,6 +530,22 @@ void cli_remove_parents(const char *path, int made)
 	}
 }
 
+plume_status cli_check_output_memory(const char *spec, const char *held_name, unsigned formats, const char *options,
+                                     double outputs, uint64_t max_memory, plume_error *err)
+{
+	double limit = (double)(max_memory > 0 ? max_memory : PLUME_DEFAULT_MAX_MEMORY);
+	double held = (double)plume_bytes_in_use();
+	if (held + outputs <= limit)
+		return PLUME_OK;
+	char list[64];
+	cli_format_list(formats, list, sizeof list);
+	return plume_error_set(err, PLUME_ERROR_LIMIT,
+	                       "%s: writing %s (--format%s) takes up to %.3g GB besides the %s's %.3g GB: %.3g GB in all; "
+	                       "the limit is %.3g GB (raise it with --max-memory, or write fewer or smaller formats)",
+	                       spec, list, options, outputs / 1e9, held_name, held / 1e9, (held + outputs) / 1e9,
+	                       limit / 1e9);
+}
+
 int cli_make_parents(const char *path, int *made)
 {
 	*made = 0;
