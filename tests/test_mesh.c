@@ -1024,6 +1024,19 @@ static void test_guides_spec_splines(void **state)
 	test_remove_tree(dir);
 }
 
+/// tests/data/NAME meshed with the default options; fails the test with the error's message.
+static plume_mesh *mesh_test_data(const char *name, plume_mesh_report *report)
+{
+	char path[640];
+	snprintf(path, sizeof path, "%s/tests/data/%s", PLUME_SOURCE_DIR, name);
+	plume_mesh_spec_options options = plume_mesh_spec_default_options();
+	plume_mesh *mesh = NULL;
+	plume_error err;
+	if (plume_mesh_spec_read(path, &options, &mesh, report, &err) != PLUME_OK)
+		fail_msg("%s: %s", name, err.message);
+	return mesh;
+}
+
 /// A feather five times the example's size: the strip walk's spatial index
 /// (src/mesh/aligned.c) gives the scan's mesh. The counts are those the
 /// mesher gives with every query scanned (MESH_SCAN_MAX raised past the pool;
@@ -1035,14 +1048,8 @@ static void test_tall_guides(void **state)
 {
 	(void)state;
 	int64_t before = plume_bytes_in_use();
-	char path[640];
-	snprintf(path, sizeof path, "%s/tests/data/tall-guides.json", PLUME_SOURCE_DIR);
-	plume_mesh_spec_options options = plume_mesh_spec_default_options();
-	plume_mesh *mesh = NULL;
 	plume_mesh_report report;
-	plume_error err;
-	if (plume_mesh_spec_read(path, &options, &mesh, &report, &err) != PLUME_OK)
-		fail_msg("%s", err.message);
+	plume_mesh *mesh = mesh_test_data("tall-guides.json", &report);
 	assert_int_equal(mesh->vertex_count, 10039);
 	assert_int_equal(mesh->face_count, 19771);
 	assert_int_equal(mesh->barb_edge_count, 9747);
@@ -1062,14 +1069,8 @@ static void test_every_vertex_in_a_face(void **state)
 {
 	(void)state;
 	int64_t before = plume_bytes_in_use();
-	char path[640];
-	snprintf(path, sizeof path, "%s/tests/data/orphan-tip.json", PLUME_SOURCE_DIR);
-	plume_mesh_spec_options options = plume_mesh_spec_default_options();
-	plume_mesh *mesh = NULL;
 	plume_mesh_report report;
-	plume_error err;
-	if (plume_mesh_spec_read(path, &options, &mesh, &report, &err) != PLUME_OK)
-		fail_msg("%s", err.message);
+	plume_mesh *mesh = mesh_test_data("orphan-tip.json", &report);
 	bool *used = calloc((size_t)mesh->vertex_count, sizeof *used);
 	for (int i = 0; i < 3 * mesh->face_count; ++i)
 		used[mesh->faces[i]] = true;
@@ -1091,14 +1092,8 @@ static void test_tails_past_dropped_guide(void **state)
 {
 	(void)state;
 	int64_t before = plume_bytes_in_use();
-	char path[640];
-	snprintf(path, sizeof path, "%s/tests/data/tails-dropped-guide.json", PLUME_SOURCE_DIR);
-	plume_mesh_spec_options options = plume_mesh_spec_default_options();
-	plume_mesh *mesh = NULL;
 	plume_mesh_report report;
-	plume_error err;
-	if (plume_mesh_spec_read(path, &options, &mesh, &report, &err) != PLUME_OK)
-		fail_msg("%s", err.message);
+	plume_mesh *mesh = mesh_test_data("tails-dropped-guide.json", &report);
 	assert_int_equal(mesh->vertex_count, 20);
 	assert_int_equal(mesh->face_count, 22);
 	assert_true(report.aligned_fraction == 1.0);
