@@ -159,10 +159,12 @@ static plume_status pathline(const zk_vane *vane, double s0, double t0, double t
 		end->count = 1;
 		return PLUME_OK;
 	}
+	// What is left of the growth's budget, counted in this loop's k (the shared total once, here).
+	const double budget = MAX_GROWTH_PATHLINE_STEPS - *vane->pathline_steps;
 	for (long k = 0;; ++k) {
 		if (k >= MAX_STEPS_PER_PATH)
 			return PLUME_ERROR_NUMERIC;
-		if (*vane->pathline_steps + (double)k >= MAX_GROWTH_PATHLINE_STEPS) {
+		if ((double)k >= budget) {
 			*vane->pathline_steps += (double)k; // fail_runaway reads which bound it was
 			return PLUME_ERROR_NUMERIC;
 		}
